@@ -1,0 +1,186 @@
+#include "common/codec/container.h"
+
+#include <cstring>
+
+#include "common/codec/crc32.h"
+
+namespace meshstream {
+namespace {
+
+constexpr size_t kIndexEntryBytes = 24;
+// The header fields this version writes, in order; `extra` follows.
+constexpr size_t kHeaderFixedBytes = 4 * 4 + 6 * 4 + 4 + 4;
+
+void put_u16(std::vector<uint8_t>& out, uint16_t v) {
+  out.push_back(uint8_t(v));
+  out.push_back(uint8_t(v >> 8));
+}
+void put_u32(std::vector<uint8_t>& out, uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+}
+void put_u64(std::vector<uint8_t>& out, uint64_t v) {
+  for (int i = 0; i < 8; ++i) out.push_back(uint8_t(v >> (8 * i)));
+}
+void put_f32(std::vector<uint8_t>& out, float f) {
+  uint32_t v;
+  std::memcpy(&v, &f, 4);
+  put_u32(out, v);
+}
+
+uint32_t get_u32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+uint16_t get_u16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
+uint64_t get_u64(const uint8_t* p) { return uint64_t(get_u32(p)) | uint64_t(get_u32(p + 4)) << 32; }
+float get_f32(const uint8_t* p) {
+  uint32_t v = get_u32(p);
+  float f;
+  std::memcpy(&f, &v, 4);
+  return f;
+}
+
+std::vector<uint8_t> encode_header(const StreamHeader& h) {
+  std::vector<uint8_t> out;
+  put_u32(out, h.vertex_count);
+  put_u32(out, h.face_count);
+  put_u32(out, h.base_vertex_count);
+  put_u32(out, h.base_face_count);
+  put_f32(out, h.bounds.min.x);
+  put_f32(out, h.bounds.min.y);
+  put_f32(out, h.bounds.min.z);
+  put_f32(out, h.bounds.max.x);
+  put_f32(out, h.bounds.max.y);
+  put_f32(out, h.bounds.max.z);
+  out.push_back(h.quant_bits);
+  out.push_back(h.base_coder);
+  out.push_back(h.structure_coder);
+  out.push_back(h.geometry_coder);
+  put_u32(out, h.layer_count);
+  out.insert(out.end(), h.extra.begin(), h.extra.end());
+  return out;
+}
+
+}  // namespace
+
+std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
+                                            std::vector<RecordEntry>& records) {
+  std::vector<uint8_t> head = encode_header(header);
+  std::vector<uint8_t> out(kContainerMagic, kContainerMagic + 4);
+  put_u16(out, kContainerVersion);
+  put_u16(out, 0);
+  put_u32(out, static_cast<uint32_t>(head.size()));
+  out.insert(out.end(), head.begin(), head.end());
+  put_u32(out, crc32(0, head.data(), head.size()));
+  const size_t index_start = out.size();  // the index checksum covers its count too
+  put_u32(out, static_cast<uint32_t>(records.size()));
+
+  uint64_t offset = out.size() + records.size() * kIndexEntryBytes + 4;
+  for (RecordEntry& r : records) {
+    r.offset = offset;
+    offset += r.size;
+    put_u64(out, r.offset);
+    put_u32(out, r.size);
+    put_u32(out, r.vertices);
+    put_u32(out, r.faces);
+    put_u32(out, r.crc32);
+  }
+  put_u32(out, crc32(0, out.data() + index_start, out.size() - index_start));
+  return out;
+}
+
+Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
+  auto need = [&](size_t bytes) -> Status {
+    if (in.size() < bytes) {
+      return make_error(ErrorCode::kTruncated,
+                        "stream ends after " + std::to_string(in.size()) +
+                            " bytes, inside its header or record index");
+    }
+    return {};
+  };
+  if (auto s = need(12); !s) return tl::unexpected(s.error());
+  if (std::memcmp(in.data(), kContainerMagic, 4) != 0) {
+    return make_error(ErrorCode::kParse, "not an .hcs stream (bad magic bytes)");
+  }
+  const uint16_t version = get_u16(in.data() + 4);
+  if (version != kContainerVersion) {
+    return make_error(ErrorCode::kUnsupported,
+                      "unsupported .hcs version " + std::to_string(version) + " (this build reads " +
+                          std::to_string(kContainerVersion) + ")");
+  }
+  // No flags are defined yet; a set one means a feature this build lacks.
+  if (get_u16(in.data() + 6) != 0) {
+    return make_error(ErrorCode::kUnsupported, ".hcs stream uses flags this build does not know");
+  }
+  const uint32_t header_size = get_u32(in.data() + 8);
+  if (header_size < kHeaderFixedBytes || header_size > kMaxHeaderBytes) {
+    return make_error(ErrorCode::kParse,
+                      "implausible .hcs header size " + std::to_string(header_size));
+  }
+  if (auto s = need(12 + size_t(header_size) + 8); !s) return tl::unexpected(s.error());
+  const uint8_t* h = in.data() + 12;
+  if (crc32(0, h, header_size) != get_u32(h + header_size)) {
+    return make_error(ErrorCode::kCorrupt, ".hcs header checksum mismatch");
+  }
+
+  StreamIndex index;
+  StreamHeader& hd = index.header;
+  hd.vertex_count = get_u32(h);
+  hd.face_count = get_u32(h + 4);
+  hd.base_vertex_count = get_u32(h + 8);
+  hd.base_face_count = get_u32(h + 12);
+  hd.bounds.min = {get_f32(h + 16), get_f32(h + 20), get_f32(h + 24)};
+  hd.bounds.max = {get_f32(h + 28), get_f32(h + 32), get_f32(h + 36)};
+  hd.quant_bits = h[40];
+  hd.base_coder = h[41];
+  hd.structure_coder = h[42];
+  hd.geometry_coder = h[43];
+  hd.layer_count = get_u32(h + 44);
+  hd.extra.assign(h + kHeaderFixedBytes, h + header_size);
+
+  const size_t count_at = 12 + size_t(header_size) + 4;
+  const uint32_t record_count = get_u32(in.data() + count_at);
+  if (record_count == 0 || record_count > kMaxRecords) {
+    return make_error(ErrorCode::kParse,
+                      "implausible record count " + std::to_string(record_count));
+  }
+  const size_t index_start = count_at;  // the index CRC covers the count too
+  const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
+  if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
+  if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
+    return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
+  }
+  index.payload_offset = index_end + 4;
+
+  index.records.resize(record_count);
+  uint64_t expected_offset = index.payload_offset;
+  for (uint32_t i = 0; i < record_count; ++i) {
+    const uint8_t* e = in.data() + count_at + 4 + size_t(i) * kIndexEntryBytes;
+    RecordEntry& r = index.records[i];
+    r.offset = get_u64(e);
+    r.size = get_u32(e + 8);
+    r.vertices = get_u32(e + 12);
+    r.faces = get_u32(e + 16);
+    r.crc32 = get_u32(e + 20);
+    if (r.offset != expected_offset) {
+      return make_error(ErrorCode::kParse,
+                        "record " + std::to_string(i) + " does not start where record " +
+                            std::to_string(i == 0 ? 0 : i - 1) + " ends");
+    }
+    if (i > 0 && (r.vertices < index.records[i - 1].vertices)) {
+      return make_error(ErrorCode::kParse,
+                        "record " + std::to_string(i) + " has fewer vertices than the one before");
+    }
+    expected_offset += r.size;
+  }
+  if (index.records.back().vertices != hd.vertex_count ||
+      index.records.back().faces != hd.face_count) {
+    return make_error(ErrorCode::kParse, "the last record's counts do not match the header's");
+  }
+  return index;
+}
+
+bool record_intact(const RecordEntry& record, std::span<const uint8_t> payload) {
+  return payload.size() == record.size && crc32(0, payload.data(), payload.size()) == record.crc32;
+}
+
+}  // namespace meshstream

@@ -1,0 +1,49 @@
+// The triangle mesh every module exchanges: plain arrays, nothing hidden.
+//
+// Optional attributes are either empty or have exactly one entry per vertex.
+// Adjacency (see adjacency.h) is a separate structure built from a Mesh.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/mesh/vec.h"
+
+namespace meshstream {
+
+using Triangle = std::array<uint32_t, 3>;
+
+struct Mesh {
+  std::vector<Vec3f> positions;
+  std::vector<Triangle> triangles;
+  std::vector<Vec3f> normals;    // optional, per vertex
+  std::vector<Vec4f> colors;     // optional, per vertex, RGBA in [0, 1]
+  std::vector<Vec2f> texcoords;  // optional, per vertex
+
+  uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
+  uint32_t face_count() const { return static_cast<uint32_t>(triangles.size()); }
+  bool empty() const { return triangles.empty(); }
+};
+
+struct BoundingBox {
+  Vec3f min{}, max{};
+  float diagonal() const { return length(max - min); }
+};
+
+// Bounding box of the positions; {0,0,0}-{0,0,0} for an empty mesh. O(V).
+BoundingBox bounding_box(const Mesh& mesh);
+
+// Checks the array-level rules: attribute sizes match, every index is in
+// range, no triangle repeats a vertex, every coordinate is finite.
+// The error names the first offending element. O(V + F).
+Status validate_arrays(const Mesh& mesh);
+
+// Area-weighted per-vertex normals (unit length; zero for isolated vertices). O(V + F).
+std::vector<Vec3f> compute_vertex_normals(const Mesh& mesh);
+
+// Unit normal of triangle f (zero vector for a degenerate triangle).
+Vec3f face_normal(const Mesh& mesh, uint32_t f);
+
+}  // namespace meshstream

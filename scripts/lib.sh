@@ -1,0 +1,54 @@
+# Shared by scripts/demo, scripts/test and the other scripts: install what is
+# missing, configure and build. Source it; do not run it.
+set -euo pipefail
+
+MESHSTREAM_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+
+# Debian packages the build, tests and benchmarks need. The scripts install
+# only what is missing, so a machine that has everything is left alone.
+MESHSTREAM_PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libdraco-dev draco libzstd-dev zstd
+  libboost-dev protobuf-compiler libprotobuf-dev
+  libcli11-dev nlohmann-json3-dev libexpected-dev libspdlog-dev libfmt-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmesh-dev libmeshoptimizer-dev
+)
+
+ms_install_packages() {
+  local missing=()
+  local pkg
+  for pkg in "$@"; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("$pkg")
+    fi
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "installing missing packages: ${missing[*]}"
+  local sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null; then sudo="sudo"; else
+      echo "error: need root (or sudo) to install: ${missing[*]}" >&2
+      exit 1
+    fi
+  fi
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+# ms_build BUILD_DIR [cmake args...]: configure once, then build everything.
+ms_build() {
+  local dir="$1"
+  shift
+  if [ ! -f "$dir/build.ninja" ]; then
+    cmake -S "$MESHSTREAM_ROOT" -B "$dir" -G Ninja "$@"
+  fi
+  cmake --build "$dir" -j "$(nproc)"
+}
+
+# Where the real test meshes live: $MESHSTREAM_TEST_MESHES or ../shared/meshes.
+ms_find_meshes() {
+  if [ -n "${MESHSTREAM_TEST_MESHES:-}" ]; then echo "$MESHSTREAM_TEST_MESHES"; return; fi
+  local candidate="$MESHSTREAM_ROOT/../shared/meshes"
+  if [ -d "$candidate" ]; then (cd "$candidate" && pwd); fi
+}
