@@ -1,0 +1,57 @@
+// ASA: adaptive modified-Butterfly subdivision driven by local flatness
+// (Cheang 1998; stencils of Zorin, Schröder and Sweldens 1996). See
+// ../shared/ALGORITHMS.md sections 2 and 3.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream {
+
+enum class ButterflyRule {
+  kZorin,       // weights applied to 3-D points
+  kProjection,  // the thesis's local planar parameterization
+};
+
+struct AsaOptions {
+  int levels = 1;
+  float flatness = 0.85f;   // t: an interior edge is flat when t < N1.N2 <= 1
+  bool uniform = false;     // split every triangle (classic modified Butterfly)
+  ButterflyRule rule = ButterflyRule::kZorin;
+  float tension = 0.0f;     // omega of the ten-point stencil
+  float crease_degrees = 0; // > 0: edges bending more than this stay sharp
+};
+
+// Per-face label of the last level, for viewers: what ASA did to it.
+enum class FaceKind : uint8_t { kUntouched = 0, kTarget = 1, kBisected = 2 };
+
+struct AsaResult {
+  Mesh mesh;
+  std::vector<FaceKind> face_kind;  // one per output face
+};
+
+// Buffers reused across calls (the client calls ASA after every record).
+class AsaWorkspace {
+ public:
+  AsaWorkspace();
+  ~AsaWorkspace();
+  AsaWorkspace(AsaWorkspace&&) noexcept;
+  AsaWorkspace& operator=(AsaWorkspace&&) noexcept;
+  struct Buffers;
+  Buffers& buffers();
+
+ private:
+  std::unique_ptr<Buffers> buffers_;
+};
+
+// Subdivides a manifold mesh. Old vertices keep their index and position
+// bit for bit; new vertices follow. kNonManifold for a mesh adjacency cannot
+// be built on; kInvalidArgument for bad options.
+Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options);
+Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace);
+
+}  // namespace meshstream

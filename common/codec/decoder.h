@@ -1,0 +1,79 @@
+// Incremental decoding of an `.hcs` stream: feed bytes in pieces of any size
+// (a network read may end anywhere); each record is applied as soon as its
+// last byte arrives. The decoder never trusts its input: a bad stream yields
+// an error and leaves the last good mesh intact.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/codec/container.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream {
+
+// Which vertices and faces one record changed, so a post-processor (ASA) can
+// redo only that region. Indices refer to the mesh after the record.
+struct RecordDelta {
+  uint32_t record = 0;
+  std::vector<uint32_t> added_vertices;
+  std::vector<uint32_t> touched_faces;  // faces created or rewritten
+  bool full_rebuild = false;            // e.g. the base mesh: everything changed
+};
+
+class IncrementalDecoder {
+ public:
+  IncrementalDecoder();
+  ~IncrementalDecoder();
+  IncrementalDecoder(IncrementalDecoder&&) noexcept;
+  IncrementalDecoder& operator=(IncrementalDecoder&&) noexcept;
+
+  // Appends bytes and applies every record they complete. Returns how many
+  // records were applied by this call. After an error, further feeds fail
+  // with the same error; mesh() keeps the last good state.
+  Result<uint32_t> feed(std::span<const uint8_t> bytes);
+
+  // Null until magic, header and index have arrived.
+  const StreamIndex* index() const;
+  // Records applied so far (0 until the base mesh is complete).
+  uint32_t records_decoded() const;
+  // Bytes consumed up to the end of the last applied record: the offset to
+  // resume from after a lost connection.
+  uint64_t resume_offset() const;
+  // True once every record of the stream is applied.
+  bool finished() const;
+
+  // The current mesh: dequantized positions and triangles.
+  const Mesh& mesh() const;
+  // What the most recent record changed.
+  const std::vector<RecordDelta>& last_deltas() const;
+
+  // Starts over from a resume offset: the caller feeds bytes starting at
+  // `offset`, which must be a record boundary this decoder has reached.
+  Status resume_at(uint64_t offset);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Decodes a whole stream (or the prefix given). Convenience over
+// IncrementalDecoder for tools and tests.
+Result<Mesh> decode_hcs(std::span<const uint8_t> stream);
+
+// The prefix length (a record boundary) to decode for a budget, following
+// HCS's decoder controls. Exactly one kind is used.
+struct DecodeBudget {
+  enum class Kind { kAll, kBytes, kVertices, kPercentVertices, kRatio };
+  Kind kind = Kind::kAll;
+  double value = 0;
+};
+// The largest record boundary within the budget (at least the base mesh).
+uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget);
+
+}  // namespace meshstream

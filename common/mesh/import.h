@@ -1,0 +1,54 @@
+// Reading mesh files: OBJ, PLY, STL and Draco .drc through Draco's io, OFF
+// through our own reader (Draco has none). Import cleans the mesh into what
+// the codec and ASA need and reports every change it made.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "common/base/result.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream {
+
+// What import changed, so `meshstream info` can show it: repairs are
+// visible, never silent.
+struct CleanReport {
+  uint32_t vertices_in_file = 0;
+  uint32_t faces_in_file = 0;          // triangles after fan-triangulating polygons
+  uint32_t welded_vertices = 0;        // merged because bit-identical positions
+  uint32_t degenerate_faces = 0;       // dropped: a repeated vertex index
+  uint32_t duplicate_faces = 0;        // dropped: same vertex set as an earlier face
+  uint32_t unreferenced_vertices = 0;  // dropped
+  uint32_t nonmanifold_edges = 0;      // found (edges with more than two faces)
+  uint32_t nonmanifold_vertices = 0;   // found (vertices joining several fans)
+  uint32_t split_vertices = 0;         // copies added by the non-manifold repair
+  uint32_t detached_faces = 0;         // faces given their own copies of an edge's vertices
+  uint32_t flipped_faces = 0;          // re-oriented to make orientation consistent
+  bool changed() const;
+};
+
+struct ImportOptions {
+  // Weld vertices with bit-identical positions (OBJ and STL split them).
+  bool weld = true;
+  // Repair non-manifold edges and vertices by splitting vertices, so the
+  // result is manifold. When false, import refuses such meshes with
+  // kNonManifold and a message naming the first offending edge or vertex.
+  bool repair_nonmanifold = true;
+};
+
+struct ImportedMesh {
+  Mesh mesh;
+  CleanReport report;
+};
+
+// Reads and cleans `path`. Errors name the file and the problem: unreadable
+// file (kIo), unknown format or malformed content (kParse), NaN/Inf
+// coordinates, out-of-range indices or no usable triangle (kInvalidMesh),
+// non-manifold when repair is off (kNonManifold). Never crashes on bad input.
+Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& options = {});
+
+// The cleaning step alone, on a mesh already in memory (same rules as import).
+Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options = {});
+
+}  // namespace meshstream
