@@ -1,0 +1,216 @@
+#include "common/metrics/bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/metrics/closest_point.h"
+
+namespace meshstream {
+namespace {
+
+constexpr uint32_t kMaxLeafTriangles = 4;
+constexpr uint32_t kBins = 16;
+// Beyond this depth splits are by median count, so the depth (and the query
+// stack) stays bounded even on pathological inputs.
+constexpr uint32_t kSahDepthLimit = 40;
+constexpr uint32_t kStackSize = 128;  // > kSahDepthLimit + log2(2^32) + 1
+
+struct Box {
+  Vec3d lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+           std::numeric_limits<double>::infinity()};
+  Vec3d hi{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+           -std::numeric_limits<double>::infinity()};
+  void grow(Vec3d p) {
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], p[i]);
+      hi[i] = std::max(hi[i], p[i]);
+    }
+  }
+  void grow(const Box& b) {
+    grow(b.lo);
+    grow(b.hi);
+  }
+  bool valid() const { return lo.x <= hi.x; }
+  double half_area() const {
+    if (!valid()) return 0;
+    const Vec3d e = hi - lo;
+    return e.x * e.y + e.y * e.z + e.z * e.x;
+  }
+};
+
+}  // namespace
+
+TriangleBvh TriangleBvh::build(const Mesh& mesh) {
+  TriangleBvh bvh;
+  const uint32_t n = mesh.face_count();
+  if (n == 0) return bvh;
+  std::vector<std::array<Vec3d, 3>> corners(n);
+  std::vector<Vec3d> centroids(n);
+  double max_abs = 0;
+  for (uint32_t f = 0; f < n; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      corners[f][k] = to_double(mesh.positions[mesh.triangles[f][k]]);
+      for (int i = 0; i < 3; ++i) max_abs = std::max(max_abs, std::abs(corners[f][k][i]));
+    }
+    centroids[f] = (corners[f][0] + corners[f][1] + corners[f][2]) * (1.0 / 3.0);
+  }
+  // A computed closest point may stray from its triangle by a few units in
+  // the last place of the largest coordinate; boxes grown by far more than
+  // that keep squared_distance_to_box a true lower bound after rounding.
+  bvh.inflate_ = 1e-12 * max_abs;
+
+  std::vector<uint32_t> refs(n);
+  for (uint32_t f = 0; f < n; ++f) refs[f] = f;
+  bvh.nodes_.reserve(2 * n / kMaxLeafTriangles + 1);
+  bvh.build_node(refs, 0, n, 0, corners, centroids);
+
+  bvh.triangles_.resize(n);
+  bvh.slot_of_.resize(n);
+  for (uint32_t s = 0; s < n; ++s) {
+    bvh.triangles_[s] = Slot{corners[refs[s]], refs[s]};
+    bvh.slot_of_[refs[s]] = s;
+  }
+  return bvh;
+}
+
+uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, uint32_t end,
+                                 uint32_t depth, const std::vector<std::array<Vec3d, 3>>& corners,
+                                 const std::vector<Vec3d>& centroids) {
+  depth_ = std::max(depth_, depth + 1);
+  const uint32_t index = static_cast<uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+
+  Box bounds, centroid_bounds;
+  for (uint32_t i = begin; i < end; ++i) {
+    for (const Vec3d& c : corners[refs[i]]) bounds.grow(c);
+    centroid_bounds.grow(centroids[refs[i]]);
+  }
+  const Vec3d pad{inflate_, inflate_, inflate_};
+  nodes_[index].lo = bounds.lo - pad;
+  nodes_[index].hi = bounds.hi + pad;
+
+  const uint32_t count = end - begin;
+  auto make_leaf = [&] {
+    nodes_[index].first = begin;
+    nodes_[index].count = count;
+    return index;
+  };
+  if (count <= kMaxLeafTriangles) return make_leaf();
+
+  const Vec3d extent = centroid_bounds.hi - centroid_bounds.lo;
+  int axis = 0;
+  if (extent.y > extent[axis]) axis = 1;
+  if (extent.z > extent[axis]) axis = 2;
+
+  uint32_t mid = begin;
+  if (depth < kSahDepthLimit && extent[axis] > 0) {
+    // Binned SAH along the widest centroid axis.
+    Box bin_box[kBins];
+    uint32_t bin_count[kBins] = {};
+    const double scale = kBins / extent[axis];
+    auto bin_of = [&](uint32_t f) {
+      const double t = (centroids[f][axis] - centroid_bounds.lo[axis]) * scale;
+      return std::min<uint32_t>(kBins - 1, static_cast<uint32_t>(std::max(0.0, t)));
+    };
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t b = bin_of(refs[i]);
+      ++bin_count[b];
+      for (const Vec3d& c : corners[refs[i]]) bin_box[b].grow(c);
+    }
+    double right_area[kBins];
+    uint32_t right_count[kBins];
+    Box acc;
+    uint32_t acc_count = 0;
+    for (uint32_t b = kBins - 1; b > 0; --b) {
+      acc.grow(bin_box[b]);
+      acc_count += bin_count[b];
+      right_area[b] = acc.half_area();
+      right_count[b] = acc_count;
+    }
+    double best_cost = std::numeric_limits<double>::infinity();
+    uint32_t best_split = 0;
+    Box left;
+    uint32_t left_count = 0;
+    for (uint32_t b = 1; b < kBins; ++b) {
+      left.grow(bin_box[b - 1]);
+      left_count += bin_count[b - 1];
+      if (left_count == 0 || right_count[b] == 0) continue;
+      const double cost = left.half_area() * left_count + right_area[b] * right_count[b];
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_split = b;
+      }
+    }
+    if (best_split > 0) {
+      auto* split = std::partition(refs.data() + begin, refs.data() + end,
+                                   [&](uint32_t f) { return bin_of(f) < best_split; });
+      mid = static_cast<uint32_t>(split - refs.data());
+    }
+  }
+  if (mid <= begin || mid >= end) {
+    // Median split by count (ties in centroid broken by index, so the
+    // result does not depend on the standard library's nth_element).
+    mid = begin + count / 2;
+    std::sort(refs.begin() + begin, refs.begin() + end, [&](uint32_t x, uint32_t y) {
+      if (centroids[x][axis] != centroids[y][axis]) return centroids[x][axis] < centroids[y][axis];
+      return x < y;
+    });
+  }
+
+  build_node(refs, begin, mid, depth + 1, corners, centroids);
+  const uint32_t right = build_node(refs, mid, end, depth + 1, corners, centroids);
+  nodes_[index].first = right;
+  nodes_[index].count = 0;
+  return index;
+}
+
+ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
+  ClosestHit best;
+  best.squared_distance = std::numeric_limits<double>::infinity();
+  auto test_slot = [&](uint32_t s) {
+    const Slot& t = triangles_[s];
+    const Vec3d q = closest_point_on_triangle(query, t.corners[0], t.corners[1], t.corners[2]);
+    const double d2 = squared_length(query - q);
+    if (d2 < best.squared_distance) {
+      best.squared_distance = d2;
+      best.point = q;
+      best.triangle = t.triangle;
+    }
+  };
+  if (hint < slot_of_.size()) test_slot(slot_of_[hint]);
+
+  struct Entry {
+    uint32_t node;
+    double d2;
+  };
+  Entry stack[kStackSize];
+  uint32_t top = 0;
+  stack[top++] = {0, squared_distance_to_box(query, nodes_[0].lo, nodes_[0].hi)};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    // Every triangle below lies at least e.d2 away (closest_point.h), so a
+    // box farther than the best so far cannot hold a strictly better one.
+    if (e.d2 > best.squared_distance) continue;
+    const Node& node = nodes_[e.node];
+    if (node.count > 0) {
+      for (uint32_t s = node.first; s < node.first + node.count; ++s) test_slot(s);
+      continue;
+    }
+    const uint32_t left = e.node + 1;
+    const uint32_t right = node.first;
+    const double dl = squared_distance_to_box(query, nodes_[left].lo, nodes_[left].hi);
+    const double dr = squared_distance_to_box(query, nodes_[right].lo, nodes_[right].hi);
+    // Push the farther child first so the nearer one is searched first.
+    if (dl <= dr) {
+      if (dr <= best.squared_distance) stack[top++] = {right, dr};
+      if (dl <= best.squared_distance) stack[top++] = {left, dl};
+    } else {
+      if (dl <= best.squared_distance) stack[top++] = {left, dl};
+      if (dr <= best.squared_distance) stack[top++] = {right, dr};
+    }
+  }
+  return best;
+}
+
+}  // namespace meshstream

@@ -1,0 +1,130 @@
+#include "common/metrics/bvh.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "common/metrics/closest_point.h"
+#include "tests/metrics/procedural_meshes.h"
+
+namespace meshstream {
+namespace {
+
+double brute_force_squared_distance(const Mesh& m, Vec3d q) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Triangle& t : m.triangles) {
+    const Vec3d p = closest_point_on_triangle(q, to_double(m.positions[t[0]]),
+                                              to_double(m.positions[t[1]]),
+                                              to_double(m.positions[t[2]]));
+    best = std::min(best, squared_length(q - p));
+  }
+  return best;
+}
+
+// Random triangles of all sizes, some degenerate, some sharing a centroid.
+Mesh triangle_soup(uint32_t count, std::mt19937& rng) {
+  std::uniform_real_distribution<float> coord(-10, 10), small(-0.01f, 0.01f);
+  Mesh m;
+  for (uint32_t i = 0; i < count; ++i) {
+    const Vec3f base{coord(rng), coord(rng), coord(rng)};
+    const uint32_t v = m.vertex_count();
+    if (i % 10 == 0) {  // collinear
+      m.positions.push_back(base);
+      m.positions.push_back(base + Vec3f{1, 1, 1});
+      m.positions.push_back(base + Vec3f{2, 2, 2});
+    } else if (i % 10 == 1) {  // same point three times
+      m.positions.insert(m.positions.end(), 3, base);
+    } else if (i % 10 == 2) {  // all around one shared centroid
+      m.positions.push_back({1 + small(rng), 0, 0});
+      m.positions.push_back({-0.5f, 0.8f + small(rng), 0});
+      m.positions.push_back({-0.5f, -0.8f, small(rng)});
+    } else {
+      m.positions.push_back(base);
+      m.positions.push_back(base + Vec3f{small(rng) * 300, small(rng) * 300, small(rng) * 300});
+      m.positions.push_back(base + Vec3f{small(rng) * 300, small(rng) * 300, small(rng) * 300});
+    }
+    m.triangles.push_back({v, v + 1, v + 2});
+  }
+  return m;
+}
+
+void expect_matches_brute_force(const Mesh& m, const std::vector<Vec3d>& queries) {
+  const TriangleBvh bvh = TriangleBvh::build(m);
+  ASSERT_EQ(bvh.triangle_count(), m.face_count());
+  uint32_t hint = TriangleBvh::kNoHint;
+  for (const Vec3d& q : queries) {
+    const double want = brute_force_squared_distance(m, q);
+    const ClosestHit hit = bvh.closest(q);
+    ASSERT_EQ(hit.squared_distance, want) << "query " << q.x << " " << q.y << " " << q.z;
+    // The reported triangle really is at that distance.
+    const Triangle& t = m.triangles[hit.triangle];
+    const Vec3d p = closest_point_on_triangle(q, to_double(m.positions[t[0]]),
+                                              to_double(m.positions[t[1]]),
+                                              to_double(m.positions[t[2]]));
+    EXPECT_EQ(squared_length(q - p), want);
+    // A hint (right or wrong) never changes the answer.
+    EXPECT_EQ(bvh.closest(q, hint).squared_distance, want);
+    hint = hit.triangle;
+  }
+}
+
+TEST(TriangleBvh, MatchesBruteForceOnASphere) {
+  const Mesh m = testing::icosphere(3);  // 1280 triangles
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coord(-2, 2);
+  std::normal_distribution<double> near(0, 1e-6);
+  std::vector<Vec3d> queries;
+  for (int i = 0; i < 1500; ++i) queries.push_back({coord(rng), coord(rng), coord(rng)});
+  // Queries a hair off the surface, where rounding matters most.
+  for (int i = 0; i < 500; ++i) {
+    const Vec3d p = to_double(m.positions[rng() % m.vertex_count()]);
+    const Vec3d o = to_double(m.positions[rng() % m.vertex_count()]);
+    queries.push_back(p * 0.9 + o * 0.1 + Vec3d{near(rng), near(rng), near(rng)});
+  }
+  expect_matches_brute_force(m, queries);
+}
+
+TEST(TriangleBvh, MatchesBruteForceOnADegenerateSoup) {
+  std::mt19937 rng(11);
+  const Mesh m = triangle_soup(3000, rng);
+  std::uniform_real_distribution<double> coord(-12, 12);
+  std::vector<Vec3d> queries;
+  for (int i = 0; i < 1000; ++i) queries.push_back({coord(rng), coord(rng), coord(rng)});
+  for (int i = 0; i < 200; ++i) queries.push_back(to_double(m.positions[rng() % m.vertex_count()]));
+  expect_matches_brute_force(m, queries);
+}
+
+TEST(TriangleBvh, DepthStaysBoundedWhenEveryCentroidCoincides) {
+  Mesh m;
+  for (uint32_t i = 0; i < 5000; ++i) {  // a fan of triangles all centred on the origin
+    const float a = 0.001f * static_cast<float>(i);
+    const uint32_t v = m.vertex_count();
+    m.positions.push_back({std::cos(a), std::sin(a), 0});
+    m.positions.push_back({std::cos(a + 2.0944f), std::sin(a + 2.0944f), 0.5f});
+    m.positions.push_back({std::cos(a + 4.1888f), std::sin(a + 4.1888f), -0.5f});
+    m.triangles.push_back({v, v + 1, v + 2});
+  }
+  const TriangleBvh bvh = TriangleBvh::build(m);
+  EXPECT_LE(bvh.depth(), 80u);
+  std::vector<Vec3d> queries = {{0, 0, 3}, {2, 0, 0}, {0.1, 0.1, 0.1}, {-5, 2, 1}};
+  expect_matches_brute_force(m, queries);
+}
+
+TEST(TriangleBvh, EmptyMeshGivesEmptyHierarchy) {
+  EXPECT_TRUE(TriangleBvh::build(Mesh{}).empty());
+}
+
+TEST(TriangleBvh, BuildIsDeterministic) {
+  const Mesh m = testing::icosphere(3);
+  const TriangleBvh x = TriangleBvh::build(m), y = TriangleBvh::build(m);
+  ASSERT_EQ(x.node_count(), y.node_count());
+  EXPECT_EQ(x.depth(), y.depth());
+  for (Vec3d q : {Vec3d{0.3, 0.2, 2}, Vec3d{-1, 0, 0.5}}) {
+    EXPECT_EQ(x.closest(q).triangle, y.closest(q).triangle);
+  }
+}
+
+}  // namespace
+}  // namespace meshstream
