@@ -13,6 +13,7 @@ MESHSTREAM_PACKAGES=(
   libcli11-dev nlohmann-json3-dev libexpected-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev libmeshoptimizer-dev
+  gnuplot-nox  # bench: the codec rate-distortion plot
 )
 
 ms_install_packages() {
