@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/base/result.h"
 #include "common/mesh/mesh.h"
@@ -25,6 +26,9 @@ struct CleanReport {
   uint32_t split_vertices = 0;         // copies added by the non-manifold repair
   uint32_t detached_faces = 0;         // faces given their own copies of an edge's vertices
   uint32_t flipped_faces = 0;          // re-oriented to make orientation consistent
+  // Everything else worth telling, e.g. "normals dropped: they differ
+  // between corners of one vertex (per-face normals)".
+  std::vector<std::string> notes;
   bool changed() const;
 };
 
@@ -35,6 +39,13 @@ struct ImportOptions {
   // result is manifold. When false, import refuses such meshes with
   // kNonManifold and a message naming the first offending edge or vertex.
   bool repair_nonmanifold = true;
+  // Drop faces with the same vertex set as an earlier face (the codec needs
+  // them gone). Off only for analysis.
+  bool drop_duplicate_faces = true;
+  // Analysis mode (`meshstream info`, manifest tests): stop after welding and
+  // dropping degenerate/unreferenced parts; non-manifold edges and vertices
+  // are counted in the report but neither repaired nor refused.
+  bool keep_nonmanifold = false;
 };
 
 struct ImportedMesh {

@@ -1,0 +1,243 @@
+// clean_mesh: from what a file holds to what the codec and ASA need — a
+// welded, manifold, consistently oriented triangle mesh — counting every
+// change in the CleanReport (repairs are visible, never silent).
+//
+// Order matters and follows ../shared/meshes/MANIFEST.md: weld bit-identical
+// positions, then drop faces that repeat a vertex, then duplicate faces, then
+// unreferenced vertices; only then look at the topology.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <sstream>
+
+#include "common/mesh/adjacency.h"
+#include "common/mesh/edge_groups.h"
+#include "common/mesh/import.h"
+#include "common/mesh/manifold_repair.h"
+#include "common/mesh/topology.h"
+
+namespace meshstream {
+namespace {
+
+std::array<uint32_t, 3> bits(const Vec3f& p) {
+  std::array<uint32_t, 3> b;
+  std::memcpy(b.data(), &p, sizeof(b));
+  return b;
+}
+
+std::string describe_non_finite(const Vec3f& p) {
+  auto one = [](float x) -> std::string {
+    if (std::isnan(x)) return "NaN";
+    if (std::isinf(x)) return x > 0 ? "Inf" : "-Inf";
+    std::ostringstream s;
+    s << x;
+    return s.str();
+  };
+  return "(" + one(p.x) + ", " + one(p.y) + ", " + one(p.z) + ")";
+}
+
+// Applies old->new vertex renumbering (kNone = removed; the first old vertex
+// mapped to a new index provides its data) to positions and attributes.
+template <class T>
+void remap_array(std::vector<T>& values, const std::vector<uint32_t>& new_index, uint32_t new_count) {
+  if (values.empty()) return;
+  std::vector<T> out(new_count);
+  std::vector<uint8_t> written(new_count, 0);
+  for (size_t v = 0; v < values.size(); ++v) {
+    const uint32_t n = new_index[v];
+    if (n == kNone || written[n]) continue;
+    out[n] = values[v];
+    written[n] = 1;
+  }
+  values.swap(out);
+}
+
+void renumber(Mesh& mesh, const std::vector<uint32_t>& new_index, uint32_t new_count) {
+  remap_array(mesh.positions, new_index, new_count);
+  remap_array(mesh.normals, new_index, new_count);
+  remap_array(mesh.colors, new_index, new_count);
+  remap_array(mesh.texcoords, new_index, new_count);
+  for (Triangle& t : mesh.triangles) {
+    for (uint32_t& v : t) v = new_index[v];
+  }
+}
+
+// True when every group of merged vertices has bit-identical values.
+template <class T>
+bool consistent_after_merge(const std::vector<T>& values, const std::vector<uint32_t>& representative) {
+  if (values.empty()) return true;
+  for (size_t v = 0; v < values.size(); ++v) {
+    if (std::memcmp(&values[v], &values[representative[v]], sizeof(T)) != 0) return false;
+  }
+  return true;
+}
+
+// Merges vertices whose positions are bit-identical (so -0 and +0 stay
+// apart, as the manifest counts them). Sort of the 96-bit keys: O(V log V).
+uint32_t weld(Mesh& mesh, std::vector<std::string>& notes) {
+  const uint32_t n = mesh.vertex_count();
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::vector<std::array<uint32_t, 3>> keys(n);
+  for (uint32_t v = 0; v < n; ++v) keys[v] = bits(mesh.positions[v]);
+  std::sort(order.begin(), order.end(), [&keys](uint32_t a, uint32_t b) {
+    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
+  });
+  std::vector<uint32_t> representative(n);
+  uint32_t merged = 0;
+  for (uint32_t k = 0; k < n; ++k) {
+    const uint32_t v = order[k];
+    if (k > 0 && keys[v] == keys[order[k - 1]]) {
+      representative[v] = representative[order[k - 1]];
+      ++merged;
+    } else {
+      representative[v] = v;
+    }
+  }
+  if (merged == 0) return 0;
+
+  auto check = [&](auto& values, const char* name) {
+    if (!consistent_after_merge(values, representative)) {
+      values.clear();
+      notes.push_back(std::string(name) +
+                      " dropped: welded vertices carried different values (per-face values)");
+    }
+  };
+  check(mesh.normals, "normals");
+  check(mesh.colors, "colors");
+  check(mesh.texcoords, "texture coordinates");
+
+  std::vector<uint32_t> new_index(n, kNone);
+  uint32_t count = 0;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (representative[v] == v) new_index[v] = count++;
+  }
+  for (uint32_t v = 0; v < n; ++v) new_index[v] = new_index[representative[v]];
+  renumber(mesh, new_index, count);
+  return merged;
+}
+
+uint32_t drop_degenerate(Mesh& mesh) {
+  const size_t before = mesh.triangles.size();
+  std::erase_if(mesh.triangles,
+                [](const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; });
+  return static_cast<uint32_t>(before - mesh.triangles.size());
+}
+
+// Drops every face whose vertex set equals an earlier face's (either
+// orientation); the first one stays.
+uint32_t drop_duplicates(Mesh& mesh) {
+  const uint32_t f_count = mesh.face_count();
+  std::vector<std::array<uint32_t, 3>> keys(f_count);
+  for (uint32_t f = 0; f < f_count; ++f) {
+    keys[f] = mesh.triangles[f];
+    std::sort(keys[f].begin(), keys[f].end());
+  }
+  std::vector<uint32_t> order(f_count);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&keys](uint32_t a, uint32_t b) {
+    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
+  });
+  std::vector<uint8_t> duplicate(f_count, 0);
+  uint32_t dups = 0;
+  for (uint32_t k = 1; k < f_count; ++k) {
+    if (keys[order[k]] == keys[order[k - 1]]) {
+      duplicate[order[k]] = 1;
+      ++dups;
+    }
+  }
+  if (dups == 0) return 0;
+  std::vector<Triangle> kept;
+  kept.reserve(f_count - dups);
+  for (uint32_t f = 0; f < f_count; ++f) {
+    if (!duplicate[f]) kept.push_back(mesh.triangles[f]);
+  }
+  mesh.triangles.swap(kept);
+  return dups;
+}
+
+uint32_t drop_unreferenced(Mesh& mesh) {
+  const uint32_t n = mesh.vertex_count();
+  std::vector<uint8_t> used(n, 0);
+  for (const Triangle& t : mesh.triangles) {
+    for (uint32_t v : t) used[v] = 1;
+  }
+  std::vector<uint32_t> new_index(n, kNone);
+  uint32_t count = 0;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (used[v]) new_index[v] = count++;
+  }
+  if (count == n) return 0;
+  renumber(mesh, new_index, count);
+  return n - count;
+}
+
+}  // namespace
+
+bool CleanReport::changed() const {
+  return welded_vertices || degenerate_faces || duplicate_faces || unreferenced_vertices ||
+         split_vertices || detached_faces || flipped_faces || !notes.empty();
+}
+
+Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
+  CleanReport report;
+  report.vertices_in_file = mesh.vertex_count();
+  report.faces_in_file = mesh.face_count();
+  const size_t n = mesh.positions.size();
+  auto attribute_ok = [n](size_t size) { return size == 0 || size == n; };
+  if (!attribute_ok(mesh.normals.size()) || !attribute_ok(mesh.colors.size()) ||
+      !attribute_ok(mesh.texcoords.size())) {
+    return make_error(ErrorCode::kInvalidMesh, "per-vertex attribute count does not match the " +
+                                                   std::to_string(n) + " vertices");
+  }
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    for (uint32_t v : mesh.triangles[f]) {
+      if (v >= n) {
+        return make_error(ErrorCode::kInvalidMesh,
+                          "face " + std::to_string(f) + " refers to vertex " + std::to_string(v) +
+                              " but there are only " + std::to_string(n) + " vertices");
+      }
+    }
+  }
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3f& p = mesh.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return make_error(ErrorCode::kInvalidMesh,
+                        "vertex " + std::to_string(v) + " has a non-finite coordinate (NaN/Inf): " +
+                            describe_non_finite(p));
+    }
+  }
+
+  if (options.weld) report.welded_vertices = weld(mesh, report.notes);
+  report.degenerate_faces = drop_degenerate(mesh);
+  if (options.drop_duplicate_faces) report.duplicate_faces = drop_duplicates(mesh);
+  report.unreferenced_vertices = drop_unreferenced(mesh);
+  if (mesh.triangles.empty()) {
+    if (report.faces_in_file == 0) {
+      return make_error(ErrorCode::kInvalidMesh, "no usable triangle: the mesh has no faces");
+    }
+    return make_error(ErrorCode::kInvalidMesh,
+                      "no usable triangle: all " + std::to_string(report.faces_in_file) +
+                          " faces are degenerate (a repeated vertex" +
+                          (options.weld ? ", after welding equal positions)" : ")"));
+  }
+
+  const MeshStats found = compute_stats(mesh);
+  report.nonmanifold_edges = found.nonmanifold_edges;
+  report.nonmanifold_vertices = found.nonmanifold_vertices;
+  if (options.keep_nonmanifold) return report;
+  if (!options.repair_nonmanifold) {
+    if (auto status = check_manifold(mesh); !status) return tl::unexpected(status.error());
+    return report;
+  }
+  auto repaired = make_manifold(mesh);
+  if (!repaired) return tl::unexpected(repaired.error());
+  report.split_vertices = repaired->split_vertices;
+  report.detached_faces = repaired->detached_faces;
+  report.flipped_faces = repaired->flipped_faces;
+  return report;
+}
+
+}  // namespace meshstream

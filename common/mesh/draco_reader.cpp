@@ -1,0 +1,174 @@
+// OBJ, PLY, STL and .drc through Draco's io.
+//
+// Checked against ../shared/meshes (MANIFEST.md): Draco's OBJ reader keeps
+// degenerate faces, fan-triangulates polygons like the manifest does, and
+// loses nothing we count, so we use it rather than a parser of our own.
+// Two Draco habits would hide what the file holds, and are undone here:
+//  - the OBJ reader merges equal attribute values by default: we turn that
+//    off so `vertices_in_file` is the number of `v` lines;
+//  - points (Draco's per-corner records) are not vertices: a vertex is the
+//    position *value* a corner maps to (STL: each point, since an STL file
+//    has no shared vertices and the reader merges them itself).
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <memory>
+
+#include <draco/compression/decode.h>
+#include <draco/io/obj_decoder.h>
+#include <draco/io/ply_decoder.h>
+#include <draco/io/stl_decoder.h>
+#include <draco/mesh/mesh.h>
+
+#include "common/mesh/mesh_readers.h"
+
+namespace meshstream {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of("/\\");
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+Result<std::unique_ptr<draco::Mesh>> decode(const std::string& path, const std::string& ext) {
+  auto fail = [](const draco::Status& status) {
+    return make_error(ErrorCode::kParse, std::string("Draco could not read it: ") + status.error_msg());
+  };
+  auto mesh = std::make_unique<draco::Mesh>();
+  if (ext == "obj") {
+    draco::ObjDecoder decoder;
+    decoder.set_deduplicate_input_values(false);
+    if (auto status = decoder.DecodeFromFile(path, mesh.get()); !status.ok()) return fail(status);
+    return mesh;
+  }
+  if (ext == "ply") {
+    draco::PlyDecoder decoder;
+    if (auto status = decoder.DecodeFromFile(path, mesh.get()); !status.ok()) return fail(status);
+    return mesh;
+  }
+  if (ext == "stl") {
+    draco::StlDecoder decoder;
+    auto result = decoder.DecodeFromFile(path);
+    if (!result.ok()) return fail(result.status());
+    return std::move(result).value();
+  }
+  if (ext == "drc") {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    draco::DecoderBuffer buffer;
+    buffer.Init(bytes.data(), bytes.size());
+    draco::Decoder decoder;
+    auto result = decoder.DecodeMeshFromBuffer(&buffer);
+    if (!result.ok()) return fail(result.status());
+    return std::move(result).value();
+  }
+  return make_error(ErrorCode::kParse,
+                    "unknown mesh format '." + ext + "' (expected .obj, .ply, .stl, .off or .drc)");
+}
+
+// Gathers one attribute per vertex from the corners. Returns false when two
+// corners of one vertex disagree (e.g. per-face normals): then the attribute
+// cannot be per-vertex and is dropped.
+template <class V, int N>
+bool gather(const draco::Mesh& dm, const draco::PointAttribute& attribute,
+            const std::vector<uint32_t>& corner_vertex, uint32_t vertex_count, float fill,
+            std::vector<V>& out) {
+  static_assert(sizeof(V) == N * sizeof(float));
+  out.assign(vertex_count, V{});
+  std::vector<uint8_t> set(vertex_count, 0);
+  for (uint32_t f = 0; f < dm.num_faces(); ++f) {
+    const auto& face = dm.face(draco::FaceIndex(f));
+    for (int i = 0; i < 3; ++i) {
+      float value[N];
+      for (float& x : value) x = fill;
+      const auto index = attribute.mapped_index(face[i]);
+      const int n = std::min<int>(N, attribute.num_components());
+      if (!attribute.ConvertValue<float>(index, static_cast<int8_t>(n), value)) return false;
+      const uint32_t v = corner_vertex[3 * f + i];
+      V converted;
+      std::memcpy(&converted, value, sizeof(V));
+      if (!set[v]) {
+        out[v] = converted;
+        set[v] = 1;
+      } else if (std::memcmp(&out[v], &converted, sizeof(V)) != 0) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+Result<RawMesh> read_with_draco(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  auto decoded = decode(path, ext);
+  if (!decoded) return tl::unexpected(std::move(decoded).error());
+  const draco::Mesh& dm = **decoded;
+  const draco::PointAttribute* position = dm.GetNamedAttribute(draco::GeometryAttribute::POSITION);
+  if (position == nullptr || position->num_components() != 3) {
+    return make_error(ErrorCode::kParse, "the file has no 3-D vertex positions");
+  }
+
+  // Vertex of every corner, and the vertex positions.
+  RawMesh raw;
+  Mesh& mesh = raw.mesh;
+  const bool per_point = ext == "stl";
+  const uint32_t vertex_count =
+      per_point ? dm.num_points() : static_cast<uint32_t>(position->size());
+  mesh.positions.resize(vertex_count);
+  for (uint32_t v = 0; v < vertex_count; ++v) {
+    const auto index = per_point ? position->mapped_index(draco::PointIndex(v))
+                                 : draco::AttributeValueIndex(v);
+    if (!position->ConvertValue<float>(index, 3, &mesh.positions[v].x)) {
+      return make_error(ErrorCode::kParse, "vertex " + std::to_string(v) + " could not be read");
+    }
+  }
+  std::vector<uint32_t> corner_vertex(static_cast<size_t>(dm.num_faces()) * 3);
+  mesh.triangles.resize(dm.num_faces());
+  for (uint32_t f = 0; f < dm.num_faces(); ++f) {
+    const auto& face = dm.face(draco::FaceIndex(f));
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t point = face[i].value();
+      uint32_t v = 0;
+      if (point >= dm.num_points()) {
+        v = 0xFFFFFFFFu;  // out of range: clean_mesh reports it
+      } else {
+        v = per_point ? point : position->mapped_index(face[i]).value();
+      }
+      mesh.triangles[f][i] = v;
+      corner_vertex[3 * f + i] = v;
+      if (v >= vertex_count) {
+        return make_error(ErrorCode::kInvalidMesh, "face " + std::to_string(f) +
+                                                       " refers to a vertex that does not exist");
+      }
+    }
+  }
+  raw.vertices_in_file = vertex_count;
+
+  auto optional = [&](draco::GeometryAttribute::Type type, const char* name, auto& target,
+                      auto tag, float fill) {
+    const draco::PointAttribute* attribute = dm.GetNamedAttribute(type);
+    if (attribute == nullptr) return;
+    using V = typename std::remove_reference_t<decltype(target)>::value_type;
+    constexpr int N = decltype(tag)::value;
+    if (!gather<V, N>(dm, *attribute, corner_vertex, vertex_count, fill, target)) {
+      target.clear();
+      raw.notes.push_back(std::string(name) +
+                          " dropped: they differ between corners of one vertex (per-face values)");
+    }
+  };
+  optional(draco::GeometryAttribute::NORMAL, "normals", mesh.normals,
+           std::integral_constant<int, 3>{}, 0.0f);
+  optional(draco::GeometryAttribute::COLOR, "colors", mesh.colors,
+           std::integral_constant<int, 4>{}, 1.0f);
+  optional(draco::GeometryAttribute::TEX_COORD, "texture coordinates", mesh.texcoords,
+           std::integral_constant<int, 2>{}, 0.0f);
+  return raw;
+}
+
+}  // namespace meshstream

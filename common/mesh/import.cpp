@@ -1,0 +1,42 @@
+#include "common/mesh/import.h"
+
+#include <fstream>
+
+#include "common/mesh/mesh_readers.h"
+
+namespace meshstream {
+namespace {
+
+bool has_off_extension(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".off";
+}
+
+}  // namespace
+
+Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& options) {
+  // Checked first so an unreadable file is kIo, not whatever a parser makes of it.
+  {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) return make_error(ErrorCode::kIo, path + ": cannot open the file for reading");
+    char byte;
+    probe.read(&byte, 1);
+    if (probe.bad()) return make_error(ErrorCode::kIo, path + ": cannot read the file");
+    if (probe.gcount() == 0) return make_error(ErrorCode::kParse, path + ": the file is empty");
+  }
+  Result<RawMesh> raw = has_off_extension(path) ? read_off(path) : read_with_draco(path);
+  if (!raw) return tl::unexpected(std::move(raw.error()).with_context(path));
+
+  ImportedMesh imported;
+  imported.mesh = std::move(raw->mesh);
+  auto report = clean_mesh(imported.mesh, options);
+  if (!report) return tl::unexpected(std::move(report.error()).with_context(path));
+  imported.report = std::move(*report);
+  imported.report.vertices_in_file = raw->vertices_in_file;
+  imported.report.notes.insert(imported.report.notes.begin(), raw->notes.begin(), raw->notes.end());
+  return imported;
+}
+
+}  // namespace meshstream

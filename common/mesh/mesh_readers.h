@@ -1,0 +1,34 @@
+// The format readers behind import_mesh: each returns the file's content as
+// it is (positions, fan-triangulated faces, per-vertex attributes), before
+// any cleaning. Errors name the problem; import_mesh adds the file name.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream {
+
+struct RawMesh {
+  Mesh mesh;                       // indices may be anything: clean_mesh validates
+  uint32_t vertices_in_file = 0;   // as the file counts them (STL: 3 per triangle)
+  std::vector<std::string> notes;  // e.g. attributes that could not be kept
+};
+
+// OFF, COFF, NOFF, STOFF and combinations ("CNOFF", ...), headerless counts
+// too. Comments (#) anywhere; polygons are fan-triangulated (v0, vk, vk+1).
+// Strict: wrong counts, malformed numbers, indices out of range and
+// polygons with fewer than 3 vertices are kParse/kInvalidMesh errors with the
+// line number. O(file size).
+Result<RawMesh> read_off(const std::string& path);
+
+// OBJ, PLY, STL and .drc through Draco's io. Positions are read per face
+// corner through the point-to-value mapping, so Draco's own de-duplication
+// does not hide what the file holds. Normals, colours and texture
+// coordinates are kept when every vertex has one consistent value.
+Result<RawMesh> read_with_draco(const std::string& path);
+
+}  // namespace meshstream

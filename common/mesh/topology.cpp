@@ -1,0 +1,119 @@
+#include "common/mesh/topology.h"
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "common/mesh/edge_groups.h"
+#include "common/mesh/union_find.h"
+
+namespace meshstream {
+namespace {
+
+bool usable(const Triangle& t, uint32_t n) {
+  return t[0] < n && t[1] < n && t[2] < n && t[0] != t[1] && t[1] != t[2] && t[2] != t[0];
+}
+
+uint32_t count_duplicates(const Mesh& mesh) {
+  std::vector<std::array<uint32_t, 3>> keys;
+  keys.reserve(mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles) {
+    if (!usable(t, mesh.vertex_count())) continue;
+    std::array<uint32_t, 3> k = t;
+    std::sort(k.begin(), k.end());
+    keys.push_back(k);
+  }
+  std::sort(keys.begin(), keys.end());
+  uint32_t dups = 0;
+  for (size_t i = 1; i < keys.size(); ++i) dups += keys[i] == keys[i - 1];
+  return dups;
+}
+
+}  // namespace
+
+MeshStats compute_stats(const Mesh& mesh) {
+  MeshStats s;
+  const uint32_t n = mesh.vertex_count();
+  s.vertices = n;
+  s.faces = mesh.face_count();
+  s.bbox = bounding_box(mesh);
+
+  std::vector<uint8_t> referenced(n, 0);
+  UnionFind vertex_sets(n);
+  uint32_t valid_faces = 0;
+  for (const Triangle& t : mesh.triangles) {
+    if (!usable(t, n)) {
+      ++s.invalid_faces;
+      continue;
+    }
+    ++valid_faces;
+    for (uint32_t v : t) referenced[v] = 1;
+    vertex_sets.unite(t[0], t[1]);
+    vertex_sets.unite(t[1], t[2]);
+  }
+  for (uint32_t v = 0; v < n; ++v) {
+    if (!referenced[v]) continue;
+    ++s.referenced_vertices;
+    if (vertex_sets.find(v) == v) ++s.components;
+  }
+  s.isolated_vertices = n - s.referenced_vertices;
+  s.duplicate_faces = count_duplicates(mesh);
+
+  // Edges, boundary, non-manifold edges; fans by joining, at each endpoint,
+  // the corners of all faces that share an edge.
+  const EdgeGroups groups = build_edge_groups(mesh);
+  s.edges = groups.edge_count();
+  UnionFind corner_sets(3 * s.faces);
+  UnionFind boundary_sets(n);
+  std::vector<uint8_t> on_boundary(n, 0);
+  auto corner_at = [&mesh](uint32_t f, uint32_t v) {
+    const Triangle& t = mesh.triangles[f];
+    return 3 * f + (t[0] == v ? 0 : (t[1] == v ? 1 : 2));
+  };
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    const uint32_t count = groups.use_count(e);
+    const EdgeUse* uses = &groups.uses[groups.begin[e]];
+    if (count == 1) {
+      ++s.boundary_edges;
+      boundary_sets.unite(groups.lo[e], groups.hi[e]);
+      on_boundary[groups.lo[e]] = on_boundary[groups.hi[e]] = 1;
+    } else if (count > 2) {
+      ++s.nonmanifold_edges;
+    } else if (uses[0].forward == uses[1].forward) {
+      ++s.orientation_conflicts;
+    }
+    for (uint32_t k = 1; k < count; ++k) {
+      corner_sets.unite(corner_at(uses[0].face, groups.lo[e]), corner_at(uses[k].face, groups.lo[e]));
+      corner_sets.unite(corner_at(uses[0].face, groups.hi[e]), corner_at(uses[k].face, groups.hi[e]));
+    }
+  }
+  for (uint32_t v = 0; v < n; ++v) {
+    if (on_boundary[v] && boundary_sets.find(v) == v) ++s.boundary_loops;
+  }
+
+  // A vertex is non-manifold when its corners fall into more than one set.
+  std::vector<uint32_t> first_fan(n, 0xFFFFFFFFu);
+  std::vector<uint8_t> counted(n, 0);
+  for (uint32_t f = 0; f < s.faces; ++f) {
+    const Triangle& t = mesh.triangles[f];
+    if (!usable(t, n)) continue;
+    for (uint32_t i = 0; i < 3; ++i) {
+      const uint32_t root = corner_sets.find(3 * f + i);
+      const uint32_t v = t[i];
+      if (first_fan[v] == 0xFFFFFFFFu) {
+        first_fan[v] = root;
+      } else if (first_fan[v] != root && !counted[v]) {
+        counted[v] = 1;
+        ++s.nonmanifold_vertices;
+      }
+    }
+  }
+
+  s.euler = static_cast<int64_t>(s.referenced_vertices) - s.edges + valid_faces;
+  s.manifold = s.nonmanifold_edges == 0 && s.nonmanifold_vertices == 0;
+  s.genus_valid = s.manifold && s.orientation_conflicts == 0;
+  s.genus = (2 * static_cast<int64_t>(s.components) - s.euler - s.boundary_loops) / 2;
+  return s;
+}
+
+}  // namespace meshstream
