@@ -1,4 +1,5 @@
-// OBJ, PLY, STL and .drc through Draco's io.
+// OBJ, STL and .drc through Draco's io (PLY has its own reader: Draco's
+// merges equal positions and drops texture coordinates; see ply_reader.cpp).
 //
 // Checked against ../shared/meshes (MANIFEST.md): Draco's OBJ reader keeps
 // degenerate faces, fan-triangulates polygons like the manifest does, and
@@ -16,7 +17,6 @@
 
 #include <draco/compression/decode.h>
 #include <draco/io/obj_decoder.h>
-#include <draco/io/ply_decoder.h>
 #include <draco/io/stl_decoder.h>
 #include <draco/mesh/mesh.h>
 
@@ -42,11 +42,6 @@ Result<std::unique_ptr<draco::Mesh>> decode(const std::string& path, const std::
   if (ext == "obj") {
     draco::ObjDecoder decoder;
     decoder.set_deduplicate_input_values(false);
-    if (auto status = decoder.DecodeFromFile(path, mesh.get()); !status.ok()) return fail(status);
-    return mesh;
-  }
-  if (ext == "ply") {
-    draco::PlyDecoder decoder;
     if (auto status = decoder.DecodeFromFile(path, mesh.get()); !status.ok()) return fail(status);
     return mesh;
   }

@@ -1,5 +1,6 @@
 #include "common/mesh/import.h"
 
+#include <cctype>
 #include <fstream>
 
 #include "common/mesh/mesh_readers.h"
@@ -7,11 +8,18 @@
 namespace meshstream {
 namespace {
 
-bool has_off_extension(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string ext = path.substr(path.size() - 4);
+bool has_extension(const std::string& path, const char* wanted) {
+  const size_t n = std::char_traits<char>::length(wanted);
+  if (path.size() < n) return false;
+  std::string ext = path.substr(path.size() - n);
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".off";
+  return ext == wanted;
+}
+
+Result<RawMesh> read_by_format(const std::string& path) {
+  if (has_extension(path, ".off")) return read_off(path);
+  if (has_extension(path, ".ply")) return read_ply(path);
+  return read_with_draco(path);
 }
 
 }  // namespace
@@ -26,7 +34,7 @@ Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& o
     if (probe.bad()) return make_error(ErrorCode::kIo, path + ": cannot read the file");
     if (probe.gcount() == 0) return make_error(ErrorCode::kParse, path + ": the file is empty");
   }
-  Result<RawMesh> raw = has_off_extension(path) ? read_off(path) : read_with_draco(path);
+  Result<RawMesh> raw = read_by_format(path);
   if (!raw) return tl::unexpected(std::move(raw.error()).with_context(path));
 
   ImportedMesh imported;

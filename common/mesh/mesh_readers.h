@@ -25,7 +25,17 @@ struct RawMesh {
 // line number. O(file size).
 Result<RawMesh> read_off(const std::string& path);
 
-// OBJ, PLY, STL and .drc through Draco's io. Positions are read per face
+// PLY, ASCII and binary (either byte order): vertex x y z, optional normals
+// (nx ny nz), colours (red green blue [alpha]; integers scaled to 0..1) and
+// texture coordinates (u v, s t, texture_u texture_v); faces from the
+// "vertex_indices" (or "vertex_index") list, fan-triangulated; other
+// elements and properties skipped. Vertices are kept exactly as the file has
+// them (Draco's PLY reader merges equal positions and drops texture
+// coordinates, which would break export/import round trips). Strict bounds
+// and count checks. O(file size).
+Result<RawMesh> read_ply(const std::string& path);
+
+// OBJ, STL and .drc through Draco's io. Positions are read per face
 // corner through the point-to-value mapping, so Draco's own de-duplication
 // does not hide what the file holds. Normals, colours and texture
 // coordinates are kept when every vertex has one consistent value.

@@ -1,0 +1,219 @@
+// PLY and OBJ writers. Coordinates are written so that reading them back
+// gives the same float bits: binary PLY stores the floats themselves, text
+// formats use the shortest decimal that round-trips (std::to_chars), which a
+// correctly rounding reader (strtof, from_chars, Draco's parser for
+// ordinary decimals) maps back to the same float.
+#include "common/mesh/export.h"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+
+namespace meshstream {
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f) std::fclose(f);
+  }
+};
+using File = std::unique_ptr<std::FILE, FileCloser>;
+
+// Buffered writer: formats into a string, flushes in large blocks.
+class Writer {
+ public:
+  explicit Writer(std::FILE* file) : file_(file) { buffer_.reserve(kBlock + 256); }
+  void text(const char* s) { buffer_ += s; maybe_flush(); }
+  void text(const std::string& s) { buffer_ += s; maybe_flush(); }
+  void number(float x) {
+    char tmp[32];
+    auto [end, ec] = std::to_chars(tmp, tmp + sizeof(tmp), x);
+    buffer_.append(tmp, end);
+  }
+  void number(uint32_t x) {
+    char tmp[16];
+    auto [end, ec] = std::to_chars(tmp, tmp + sizeof(tmp), x);
+    buffer_.append(tmp, end);
+  }
+  void raw(const void* data, size_t size) {
+    buffer_.append(static_cast<const char*>(data), size);
+    maybe_flush();
+  }
+  void put(char c) { buffer_.push_back(c); }
+  bool finish() {
+    flush();
+    return ok_ && std::fflush(file_) == 0;
+  }
+  void maybe_flush() {
+    if (buffer_.size() >= kBlock) flush();
+  }
+
+ private:
+  void flush() {
+    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
+      ok_ = false;
+    }
+    buffer_.clear();
+  }
+  static constexpr size_t kBlock = 1 << 20;
+  std::FILE* file_;
+  std::string buffer_;
+  bool ok_ = true;
+};
+
+Status open_for_writing(const std::string& path, File& file) {
+  file.reset(std::fopen(path.c_str(), "wb"));
+  if (!file) {
+    return make_error(ErrorCode::kIo, path + ": cannot open for writing: " + std::strerror(errno));
+  }
+  return {};
+}
+
+Status check_writable(const Mesh& mesh, const std::string& path) {
+  if (auto status = validate_arrays(mesh); !status) {
+    return make_error(ErrorCode::kInvalidMesh, path + ": refusing to write: " + status.error().message);
+  }
+  return {};
+}
+
+uint8_t to_byte(float c) {
+  const float clamped = std::clamp(std::isnan(c) ? 0.0f : c, 0.0f, 1.0f);
+  return static_cast<uint8_t>(std::lround(clamped * 255.0f));
+}
+
+std::string lower_extension(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace
+
+Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding) {
+  if (auto status = check_writable(mesh, path); !status) return status;
+  File file;
+  if (auto status = open_for_writing(path, file); !status) return status;
+  Writer out(file.get());
+  const bool binary = encoding == PlyEncoding::kBinary;
+  const bool normals = !mesh.normals.empty();
+  const bool colors = !mesh.colors.empty();
+  const bool texcoords = !mesh.texcoords.empty();
+  out.text(std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+           " 1.0\ncomment written by meshstream\n");
+  out.text("element vertex " + std::to_string(mesh.vertex_count()) + "\n");
+  out.text("property float x\nproperty float y\nproperty float z\n");
+  if (normals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
+  if (colors) {
+    out.text("property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n");
+  }
+  if (texcoords) out.text("property float u\nproperty float v\n");
+  out.text("element face " + std::to_string(mesh.face_count()) + "\n");
+  out.text("property list uchar int vertex_indices\nend_header\n");
+
+  static_assert(std::endian::native == std::endian::little, "binary PLY writer assumes little-endian");
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (binary) {
+      out.raw(&mesh.positions[v], 12);
+      if (normals) out.raw(&mesh.normals[v], 12);
+      if (colors) {
+        const Vec4f& c = mesh.colors[v];
+        const uint8_t rgba[4] = {to_byte(c.x), to_byte(c.y), to_byte(c.z), to_byte(c.w)};
+        out.raw(rgba, 4);
+      }
+      if (texcoords) out.raw(&mesh.texcoords[v], 8);
+      continue;
+    }
+    const Vec3f& p = mesh.positions[v];
+    out.number(p.x), out.put(' '), out.number(p.y), out.put(' '), out.number(p.z);
+    if (normals) {
+      const Vec3f& n = mesh.normals[v];
+      out.put(' '), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '), out.number(n.z);
+    }
+    if (colors) {
+      const Vec4f& c = mesh.colors[v];
+      for (float x : {c.x, c.y, c.z, c.w}) out.put(' '), out.number(uint32_t{to_byte(x)});
+    }
+    if (texcoords) {
+      out.put(' '), out.number(mesh.texcoords[v].x), out.put(' '), out.number(mesh.texcoords[v].y);
+    }
+    out.put('\n');
+    out.maybe_flush();
+  }
+  for (const Triangle& t : mesh.triangles) {
+    if (binary) {
+      uint8_t record[13];
+      record[0] = 3;
+      std::memcpy(record + 1, t.data(), 12);
+      out.raw(record, sizeof(record));
+      continue;
+    }
+    out.text("3 ");
+    out.number(t[0]), out.put(' '), out.number(t[1]), out.put(' '), out.number(t[2]), out.put('\n');
+  }
+  if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
+  return {};
+}
+
+Status write_obj(const Mesh& mesh, const std::string& path) {
+  if (auto status = check_writable(mesh, path); !status) return status;
+  File file;
+  if (auto status = open_for_writing(path, file); !status) return status;
+  Writer out(file.get());
+  const bool normals = !mesh.normals.empty();
+  const bool texcoords = !mesh.texcoords.empty();
+  // OBJ has no standard per-vertex colour; the common extension "v x y z r g b"
+  // is not read back by every tool, so colours are written only with a note.
+  out.text("# written by meshstream: " + std::to_string(mesh.vertex_count()) + " vertices, " +
+           std::to_string(mesh.face_count()) + " triangles\n");
+  if (!mesh.colors.empty()) out.text("# per-vertex colours are not stored in OBJ\n");
+  for (const Vec3f& p : mesh.positions) {
+    out.text("v "), out.number(p.x), out.put(' '), out.number(p.y), out.put(' '), out.number(p.z);
+    out.put('\n');
+  }
+  if (texcoords) {
+    for (const Vec2f& t : mesh.texcoords) {
+      out.text("vt "), out.number(t.x), out.put(' '), out.number(t.y), out.put('\n');
+    }
+  }
+  if (normals) {
+    for (const Vec3f& n : mesh.normals) {
+      out.text("vn "), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '), out.number(n.z);
+      out.put('\n');
+    }
+  }
+  for (const Triangle& t : mesh.triangles) {
+    out.text("f");
+    for (uint32_t i : t) {
+      const uint32_t k = i + 1;  // OBJ counts from 1
+      out.put(' ');
+      out.number(k);
+      if (texcoords || normals) {
+        out.put('/');
+        if (texcoords) out.number(k);
+        if (normals) out.put('/'), out.number(k);
+      }
+    }
+    out.put('\n');
+  }
+  if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
+  return {};
+}
+
+Status write_mesh(const Mesh& mesh, const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == "ply") return write_ply(mesh, path, PlyEncoding::kBinary);
+  if (ext == "obj") return write_obj(mesh, path);
+  return make_error(ErrorCode::kInvalidArgument,
+                    path + ": cannot write '." + ext + "' files (use .ply or .obj)");
+}
+
+}  // namespace meshstream
