@@ -34,6 +34,12 @@ struct AsaResult {
   std::vector<FaceKind> face_kind;  // one per output face
 };
 
+// What the last call did, per level (for tests, benchmarks and viewers).
+struct AsaStats {
+  std::vector<uint32_t> targets;      // faces marked by flatness (uniform: all)
+  std::vector<uint32_t> split_edges;  // new vertices added
+};
+
 // Buffers reused across calls (the client calls ASA after every record).
 class AsaWorkspace {
  public:
@@ -43,6 +49,7 @@ class AsaWorkspace {
   AsaWorkspace& operator=(AsaWorkspace&&) noexcept;
   struct Buffers;
   Buffers& buffers();
+  const AsaStats& last_stats() const;
 
  private:
   std::unique_ptr<Buffers> buffers_;
@@ -53,5 +60,15 @@ class AsaWorkspace {
 // be built on; kInvalidArgument for bad options.
 Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options);
 Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace);
+
+// Same, writing into `result` so that its arrays' capacity is reused too
+// (with the workspace, a repeated call allocates nothing once warmed up).
+// Cost: O(output size) per level; adjacency of the input is built once
+// (O(V + F)), later levels derive theirs while splitting. On error `result`
+// is left unspecified. Bad input: errors from validate_arrays and
+// Adjacency::build; kInvalidArgument for options out of range; kLimit when
+// the output would exceed 1e9 faces.
+Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
+                      AsaResult& result);
 
 }  // namespace meshstream

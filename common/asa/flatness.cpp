@@ -1,0 +1,75 @@
+// Flatness test of Cheang's ASA (K. M. Cheang, "Adaptive subdivision
+// algorithm in postprocessing of compressed three-dimensional graphic data",
+// M.S. thesis, USC, 1998): neighbouring triangles whose normals differ by more
+// than the user's t are refined. Crease tagging is our extension.
+#include "common/asa/flatness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace meshstream::asa {
+
+void compute_face_normals(const LevelView& m, std::vector<Vec3f>& normals) {
+  normals.resize(m.face_count);
+  for (uint32_t f = 0; f < m.face_count; ++f) {
+    const Vec3f p0 = m.positions[m.corner_vertex[3 * f]];
+    const Vec3f p1 = m.positions[m.corner_vertex[3 * f + 1]];
+    const Vec3f p2 = m.positions[m.corner_vertex[3 * f + 2]];
+    normals[f] = normalized(cross(p1 - p0, p2 - p0));
+  }
+}
+
+void tag_feature_edges(const LevelView& m, float crease_degrees, const std::vector<Vec3f>& normals,
+                       std::vector<uint8_t>& feature_edge) {
+  const uint32_t corners = 3 * m.face_count;
+  feature_edge.assign(corners, 0);
+  const bool creases = crease_degrees > 0;
+  const float cos_limit = std::cos(crease_degrees * static_cast<float>(std::numbers::pi) / 180.0f);
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = m.opposite[c];
+    if (o == kNone) {
+      feature_edge[c] = 1;
+    } else if (creases && c < o && dot(normals[c / 3], normals[o / 3]) < cos_limit) {
+      feature_edge[c] = feature_edge[o] = 1;
+    }
+  }
+}
+
+void count_vertex_features(const LevelView& m, std::vector<uint8_t>& vertex_features) {
+  vertex_features.assign(m.vertex_count, 0);
+  const uint32_t corners = 3 * m.face_count;
+  for (uint32_t c = 0; c < corners; ++c) {
+    if (!m.feature_edge[c]) continue;
+    const uint32_t o = m.opposite[c];
+    if (o != kNone && o < c) continue;  // count each edge once
+    for (uint32_t v : {m.corner_vertex[next_corner(c)], m.corner_vertex[prev_corner(c)]}) {
+      if (vertex_features[v] < 255) ++vertex_features[v];
+    }
+  }
+}
+
+uint32_t count_vertex_faces(const LevelView& m, std::vector<uint32_t>& faces) {
+  faces.assign(m.vertex_count, 0);
+  const uint32_t corners = 3 * m.face_count;
+  for (uint32_t c = 0; c < corners; ++c) ++faces[m.corner_vertex[c]];
+  uint32_t largest = 0;
+  for (uint32_t n : faces) largest = std::max(largest, n);
+  return largest;
+}
+
+uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, float t,
+                      std::vector<uint8_t>& target) {
+  target.assign(m.face_count, 0);
+  const uint32_t corners = 3 * m.face_count;
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = m.opposite[c];
+    if (o == kNone || o < c || m.feature_edge[c]) continue;
+    if (dot(normals[c / 3], normals[o / 3]) <= t) target[c / 3] = target[o / 3] = 1;
+  }
+  uint32_t count = 0;
+  for (uint8_t x : target) count += x;
+  return count;
+}
+
+}  // namespace meshstream::asa

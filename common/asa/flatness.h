@@ -1,0 +1,36 @@
+// Flatness marking (Cheang 1998, section 3 of ../shared/ALGORITHMS.md) and
+// crease tagging: which triangles ASA refines and which edges stay sharp.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/asa/level_mesh.h"
+
+namespace meshstream::asa {
+
+// Unit normal of every face (zero for a degenerate face). O(F).
+void compute_face_normals(const LevelView& mesh, std::vector<Vec3f>& normals);
+
+// Per corner: 1 when the edge it faces is a boundary edge or bends by more
+// than crease_degrees (angle between the two face normals); crease_degrees
+// <= 0 tags boundaries only. Both corners of an edge get the same flag.
+// Needs mesh.corner_vertex, opposite and positions. O(F).
+void tag_feature_edges(const LevelView& mesh, float crease_degrees, const std::vector<Vec3f>& normals,
+                       std::vector<uint8_t>& feature_edge);
+
+// Per vertex: the number of feature edges at it (saturating at 255). O(F).
+void count_vertex_features(const LevelView& mesh, std::vector<uint8_t>& vertex_features);
+
+// Per vertex: the number of faces around it (the valence of an interior
+// vertex). Returns the largest count. O(F).
+uint32_t count_vertex_faces(const LevelView& mesh, std::vector<uint32_t>& faces);
+
+// ASA targets: both faces of every interior, non-feature edge whose unit
+// normals satisfy N1.N2 <= t become targets (the pair is flat when
+// t < N1.N2 <= 1). Feature edges are sharp on purpose and ask for nothing.
+// Returns the number of targets. O(F).
+uint32_t mark_targets(const LevelView& mesh, const std::vector<Vec3f>& normals, float t,
+                      std::vector<uint8_t>& target);
+
+}  // namespace meshstream::asa

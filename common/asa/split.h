@@ -1,0 +1,42 @@
+// One subdivision level: new edge points by the Butterfly rules and the
+// triangles that replace each face, with the corner table of the result
+// derived directly (no re-hashing of edges), so levels chain in O(output).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/asa/butterfly_stencils.h"
+#include "common/asa/closure.h"
+#include "common/asa/level_mesh.h"
+#include "common/asa/subdivide.h"
+
+namespace meshstream::asa {
+
+struct SplitInput {
+  LevelView mesh;
+  const Vec4f* colors = nullptr;     // per vertex, or null
+  const Vec2f* texcoords = nullptr;  // per vertex, or null
+  const ButterflyWeights* weights = nullptr;
+  EdgePlacement placement = EdgePlacement::kZorin;
+  bool want_topology = true;  // fill opposite/feature/valence data for another level
+};
+
+struct SplitScratch {
+  std::vector<uint32_t> edge_vertex;  // per corner: new vertex on the faced edge or kNone
+  std::vector<uint32_t> slot_a, slot_b;
+};
+
+// Uniform 1-to-4 split of every face (classic modified Butterfly).
+// out gets V + E vertices (old ones first, bit-identical) and 4F faces:
+// face 4f + i is the corner child at vertex i of f, 4f + 3 the middle one.
+// O(V + F) time; no allocation once the buffers have capacity.
+void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
+                   std::vector<FaceKind>* face_kind);
+
+// Adaptive split following the closure's per-face actions and split edges.
+// Output faces appear in input face order (each face's children together).
+void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitScratch& scratch,
+                    LevelMesh& out, std::vector<FaceKind>* face_kind);
+
+}  // namespace meshstream::asa

@@ -1,0 +1,258 @@
+// Adaptive level: faces are kept, bisected (green), split 1-to-4 (red), or,
+// for a green pair whose parent must be refined, replaced by the parent's
+// 1-to-4 split (red-green refinement: a green triangle is never split again).
+//
+// The result's corner table is built without hashing: each parent corner
+// records which output corner(s) face its edge (two when the edge was split:
+// slot_a near vertex(next(c)), slot_b near vertex(prev(c))); a final pass pairs
+// the slots of opposite parent corners. Edges inside one parent are linked
+// while its children are written.
+#include <array>
+#include <cstring>
+
+#include "common/asa/split.h"
+
+namespace meshstream::asa {
+namespace {
+
+struct Emitter {
+  LevelMesh& out;
+  std::vector<FaceKind>* face_kind;
+  bool topology;
+
+  uint32_t emit(uint32_t a, uint32_t b, uint32_t c, uint8_t green, FaceKind kind) {
+    const uint32_t f = static_cast<uint32_t>(out.triangles.size());
+    out.triangles.push_back({a, b, c});
+    if (face_kind) face_kind->push_back(kind);
+    if (topology) {
+      for (int i = 0; i < 3; ++i) {
+        out.opposite.push_back(kNone);
+        out.feature_edge.push_back(0);
+      }
+      out.green.push_back(green);
+    }
+    return f;
+  }
+  uint32_t vertex(uint32_t corner) const { return out.triangles[corner / 3][corner % 3]; }
+};
+
+// A parent edge seen from one side: from p to q, split at s (or kNone),
+// faced by parent corner `corner`.
+struct BorderEdge {
+  uint32_t corner, p, q, s;
+};
+
+// Links the children of one opened green pair (up to six triangles starting
+// at face `first`) among themselves and records the parent corners' slots,
+// by matching directed edges; only used for the rare opened pairs.
+void link_local(Emitter& e, uint32_t first, uint32_t count, const std::array<BorderEdge, 4>& border,
+                const uint8_t* feature_edge, SplitScratch& s) {
+  const uint32_t c0 = 3 * first, c1 = 3 * (first + count);
+  auto from = [&](uint32_t c) { return e.vertex(next_corner(c)); };
+  auto to = [&](uint32_t c) { return e.vertex(prev_corner(c)); };
+  auto find = [&](uint32_t u, uint32_t w) {
+    for (uint32_t c = c0; c < c1; ++c)
+      if (from(c) == u && to(c) == w) return c;
+    return kNone;
+  };
+  if (e.topology) {
+    for (uint32_t c = c0; c < c1; ++c) {
+      const uint32_t o = find(to(c), from(c));
+      if (o != kNone) e.out.opposite[c] = o;
+    }
+  }
+  for (const BorderEdge& b : border) {
+    if (b.s == kNone) {
+      s.slot_a[b.corner] = s.slot_b[b.corner] = find(b.p, b.q);
+    } else {
+      s.slot_a[b.corner] = find(b.p, b.s);
+      s.slot_b[b.corner] = find(b.s, b.q);
+    }
+    if (e.topology) {
+      e.out.feature_edge[s.slot_a[b.corner]] = feature_edge[b.corner];
+      e.out.feature_edge[s.slot_b[b.corner]] = feature_edge[b.corner];
+    }
+  }
+}
+
+}  // namespace
+
+void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitScratch& s,
+                    LevelMesh& out, std::vector<FaceKind>* face_kind) {
+  const LevelView& m = in.mesh;
+  const uint32_t V = m.vertex_count, F = m.face_count, corners = 3 * F;
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
+  const uint8_t* split = closure.edge_split.data();
+
+  // New vertices, one per split edge, numbered in corner order.
+  s.edge_vertex.resize(corners);
+  uint32_t E = 0;
+  for (uint32_t c = 0; c < corners; ++c) {
+    if (!split[c]) {
+      s.edge_vertex[c] = kNone;
+      continue;
+    }
+    const uint32_t o = opp[c];
+    s.edge_vertex[c] = (o == kNone || c < o) ? V + E++ : s.edge_vertex[o];
+  }
+  out.positions.resize(static_cast<size_t>(V) + E);
+  std::memcpy(out.positions.data(), m.positions, sizeof(Vec3f) * V);
+  const bool colors = in.colors != nullptr, texcoords = in.texcoords != nullptr;
+  if (colors) {
+    out.colors.resize(static_cast<size_t>(V) + E);
+    std::memcpy(out.colors.data(), in.colors, sizeof(Vec4f) * V);
+  } else {
+    out.colors.clear();
+  }
+  if (texcoords) {
+    out.texcoords.resize(static_cast<size_t>(V) + E);
+    std::memcpy(out.texcoords.data(), in.texcoords, sizeof(Vec2f) * V);
+  } else {
+    out.texcoords.clear();
+  }
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t id = s.edge_vertex[c];
+    if (id == kNone || (opp[c] != kNone && opp[c] < c)) continue;
+    out.positions[id] = butterfly_point(m, c, *in.weights, in.placement);
+    const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
+    if (colors) {
+      const Vec4f ca = in.colors[a], cb = in.colors[b];
+      out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f, (ca.w + cb.w) * 0.5f};
+    }
+    if (texcoords) {
+      const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
+      out.texcoords[id] = {(ta.x + tb.x) * 0.5f, (ta.y + tb.y) * 0.5f};
+    }
+  }
+
+  out.triangles.clear();
+  out.triangles.reserve(4 * static_cast<size_t>(F));
+  if (face_kind) {
+    face_kind->clear();
+    face_kind->reserve(4 * static_cast<size_t>(F));
+  }
+  const bool topo = in.want_topology;
+  if (topo) {
+    out.opposite.clear();
+    out.opposite.reserve(12 * static_cast<size_t>(F));
+    out.feature_edge.clear();
+    out.feature_edge.reserve(12 * static_cast<size_t>(F));
+    out.green.clear();
+    out.green.reserve(4 * static_cast<size_t>(F));
+    s.slot_a.resize(corners);
+    s.slot_b.resize(corners);
+  }
+  Emitter e{out, face_kind, topo};
+  const uint8_t* fe = m.feature_edge;
+  auto set_slot = [&](uint32_t parent, uint32_t a, uint32_t b) {
+    s.slot_a[parent] = a;
+    s.slot_b[parent] = b;
+    out.feature_edge[a] = fe[parent];
+    out.feature_edge[b] = fe[parent];
+  };
+
+  for (uint32_t f = 0; f < F; ++f) {
+    const uint32_t v[3] = {cv[3 * f], cv[3 * f + 1], cv[3 * f + 2]};
+    switch (closure.action[f]) {
+      case kKeep: {
+        const uint32_t g = e.emit(v[0], v[1], v[2], m.green ? m.green[f] : static_cast<uint8_t>(kNotGreen), FaceKind::kUntouched);
+        if (topo) {
+          for (uint32_t i = 0; i < 3; ++i) set_slot(3 * f + i, 3 * g + i, 3 * g + i);
+        }
+        break;
+      }
+      case kRed: {
+        const uint32_t mid[3] = {s.edge_vertex[3 * f], s.edge_vertex[3 * f + 1], s.edge_vertex[3 * f + 2]};
+        const uint32_t base = e.emit(v[0], mid[2], mid[1], kNotGreen, FaceKind::kTarget);
+        e.emit(v[1], mid[0], mid[2], kNotGreen, FaceKind::kTarget);
+        e.emit(v[2], mid[1], mid[0], kNotGreen, FaceKind::kTarget);
+        e.emit(mid[0], mid[1], mid[2], kNotGreen, FaceKind::kTarget);
+        if (topo) {
+          const uint32_t b = 3 * base;
+          for (uint32_t i = 0; i < 3; ++i) {
+            out.opposite[b + 3 * i] = b + 9 + i;
+            out.opposite[b + 9 + i] = b + 3 * i;
+          }
+          for (uint32_t k = 0; k < 3; ++k) {
+            set_slot(3 * f + k, b + 3 * ((k + 1) % 3) + 2, b + 3 * ((k + 2) % 3) + 1);
+          }
+        }
+        break;
+      }
+      case kBisect: {
+        uint32_t k = 0;
+        while (!split[3 * f + k]) ++k;
+        const uint32_t A = v[k], B = v[(k + 1) % 3], C = v[(k + 2) % 3];
+        const uint32_t X = s.edge_vertex[3 * f + k];
+        const uint32_t g1 = e.emit(A, B, X, kGreenFirst, FaceKind::kBisected);
+        const uint32_t g2 = e.emit(A, X, C, kGreenSecond, FaceKind::kBisected);
+        if (topo) {
+          out.opposite[3 * g1 + 1] = 3 * g2 + 2;
+          out.opposite[3 * g2 + 2] = 3 * g1 + 1;
+          set_slot(3 * f + k, 3 * g1, 3 * g2);
+          set_slot(3 * f + (k + 2) % 3, 3 * g1 + 2, 3 * g1 + 2);  // A-B
+          set_slot(3 * f + (k + 1) % 3, 3 * g2 + 1, 3 * g2 + 1);  // C-A
+        }
+        break;
+      }
+      case kOpened: {
+        if (m.green[f] != kGreenFirst) break;  // the pair is written at its first half
+        const uint32_t g = f + 1;
+        const uint32_t A = v[0], B = v[1], M = v[2], C = cv[3 * g + 2];
+        const uint32_t mab = s.edge_vertex[3 * f + 2], mca = s.edge_vertex[3 * g + 1];
+        const uint32_t X = s.edge_vertex[3 * f], Y = s.edge_vertex[3 * g];
+        const uint32_t first = e.emit(A, mab, mca, kNotGreen, FaceKind::kTarget);
+        e.emit(mab, M, mca, kNotGreen, FaceKind::kTarget);
+        uint32_t count = 2;
+        if (X == kNone) {
+          e.emit(B, M, mab, kNotGreen, FaceKind::kTarget);
+          ++count;
+        } else {
+          e.emit(mab, B, X, kGreenFirst, FaceKind::kBisected);
+          e.emit(mab, X, M, kGreenSecond, FaceKind::kBisected);
+          count += 2;
+        }
+        if (Y == kNone) {
+          e.emit(C, mca, M, kNotGreen, FaceKind::kTarget);
+          ++count;
+        } else {
+          e.emit(mca, M, Y, kGreenFirst, FaceKind::kBisected);
+          e.emit(mca, Y, C, kGreenSecond, FaceKind::kBisected);
+          count += 2;
+        }
+        if (topo) {
+          const std::array<BorderEdge, 4> border{{
+              {3 * f + 2, A, B, mab},  // AB
+              {3 * f, B, M, X},        // BM
+              {3 * g, M, C, Y},        // MC
+              {3 * g + 1, C, A, mca},  // CA
+          }};
+          link_local(e, first, count, border, fe, s);
+          s.slot_a[3 * f + 1] = s.slot_b[3 * f + 1] = kNone;  // A-M vanished
+          s.slot_a[3 * g + 2] = s.slot_b[3 * g + 2] = kNone;
+        }
+        break;
+      }
+    }
+  }
+
+  if (!topo) return;
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = opp[c];
+    if (o == kNone || s.slot_a[c] == kNone) continue;
+    out.opposite[s.slot_a[c]] = s.slot_b[o];
+    out.opposite[s.slot_b[c]] = s.slot_a[o];
+  }
+  // Vertex data for the next level: faces per vertex are recounted by the
+  // caller; features: old vertices keep theirs, new ones have two when their
+  // edge was a feature edge.
+  out.vertex_features.resize(static_cast<size_t>(V) + E);
+  std::memcpy(out.vertex_features.data(), m.vertex_features, V);
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t id = s.edge_vertex[c];
+    if (id != kNone) out.vertex_features[id] = fe[c] ? 2 : 0;
+  }
+}
+
+}  // namespace meshstream::asa

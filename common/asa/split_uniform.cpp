@@ -1,0 +1,120 @@
+// Uniform level: every edge gets a Butterfly point, every face four children.
+// The children's corner table follows from the parent's by index arithmetic
+// (face 4f + i = (v_i, m_{i+2}, m_{i+1}), face 4f + 3 = (m_0, m_1, m_2)), which
+// is what makes chaining levels cheap.
+#include <cstring>
+
+#include "common/asa/split.h"
+
+namespace meshstream::asa {
+
+void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
+                   std::vector<FaceKind>* face_kind) {
+  const LevelView& m = in.mesh;
+  const uint32_t V = m.vertex_count, F = m.face_count, corners = 3 * F;
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
+
+  // Edge ids: the first corner of an edge (in corner order) names it.
+  std::vector<uint32_t>& edge_of = scratch.edge_vertex;
+  edge_of.resize(corners);
+  uint32_t E = 0;
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = opp[c];
+    edge_of[c] = (o == kNone || c < o) ? E++ : edge_of[o];
+  }
+
+  out.positions.resize(static_cast<size_t>(V) + E);
+  Vec3f* pos = out.positions.data();
+  if (pos != m.positions) std::memcpy(pos, m.positions, sizeof(Vec3f) * V);
+  const bool colors = in.colors != nullptr, texcoords = in.texcoords != nullptr;
+  if (colors) {
+    out.colors.resize(static_cast<size_t>(V) + E);
+    if (out.colors.data() != in.colors) std::memcpy(out.colors.data(), in.colors, sizeof(Vec4f) * V);
+  } else {
+    out.colors.clear();
+  }
+  if (texcoords) {
+    out.texcoords.resize(static_cast<size_t>(V) + E);
+    if (out.texcoords.data() != in.texcoords) std::memcpy(out.texcoords.data(), in.texcoords, sizeof(Vec2f) * V);
+  } else {
+    out.texcoords.clear();
+  }
+
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = opp[c];
+    if (o != kNone && o < c) continue;
+    const uint32_t id = V + edge_of[c];
+    pos[id] = butterfly_point(m, c, *in.weights, in.placement);
+    const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
+    if (colors) {
+      const Vec4f ca = in.colors[a], cb = in.colors[b];
+      out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f, (ca.w + cb.w) * 0.5f};
+    }
+    if (texcoords) {
+      const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
+      out.texcoords[id] = {(ta.x + tb.x) * 0.5f, (ta.y + tb.y) * 0.5f};
+    }
+  }
+
+  out.triangles.resize(4 * static_cast<size_t>(F));
+  uint32_t* t = out.triangles.front().data();
+  for (uint32_t f = 0; f < F; ++f) {
+    const uint32_t v0 = cv[3 * f], v1 = cv[3 * f + 1], v2 = cv[3 * f + 2];
+    const uint32_t m0 = V + edge_of[3 * f], m1 = V + edge_of[3 * f + 1], m2 = V + edge_of[3 * f + 2];
+    uint32_t* q = t + 12 * static_cast<size_t>(f);
+    q[0] = v0; q[1] = m2; q[2] = m1;
+    q[3] = v1; q[4] = m0; q[5] = m2;
+    q[6] = v2; q[7] = m1; q[8] = m0;
+    q[9] = m0; q[10] = m1; q[11] = m2;
+  }
+  if (face_kind) face_kind->assign(4 * static_cast<size_t>(F), FaceKind::kTarget);
+
+  if (!in.want_topology) return;
+  out.opposite.resize(12 * static_cast<size_t>(F));
+  out.feature_edge.resize(12 * static_cast<size_t>(F));
+  uint32_t* oo = out.opposite.data();
+  uint8_t* fe = out.feature_edge.data();
+  for (uint32_t f = 0; f < F; ++f) {
+    const uint32_t base = 12 * f;  // first corner of child 4f
+    for (uint32_t i = 0; i < 3; ++i) {
+      oo[base + 3 * i] = base + 9 + i;  // corner child's inner edge <-> middle child
+      oo[base + 9 + i] = base + 3 * i;
+      fe[base + 3 * i] = 0;
+      fe[base + 9 + i] = 0;
+    }
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t c = 3 * f + k;
+      // Halves of the parent edge faced by corner k: near v_{k+1} it is faced
+      // by corner 2 of child k+1, near v_{k+2} by corner 1 of child k+2.
+      const uint32_t near_next = base + 3 * ((k + 1) % 3) + 2;
+      const uint32_t near_prev = base + 3 * ((k + 2) % 3) + 1;
+      const uint32_t o = opp[c];
+      if (o == kNone) {
+        oo[near_next] = oo[near_prev] = kNone;
+      } else {
+        const uint32_t g = o / 3, j = o % 3;
+        oo[near_next] = 12 * g + 3 * ((j + 2) % 3) + 1;
+        oo[near_prev] = 12 * g + 3 * ((j + 1) % 3) + 2;
+      }
+      fe[near_next] = fe[near_prev] = m.feature_edge[c];
+    }
+  }
+  // Old vertices keep their faces count and features; a new vertex has six
+  // faces (three on a boundary) and two feature edges when its edge was one.
+  out.valence.resize(static_cast<size_t>(V) + E);
+  out.vertex_features.resize(static_cast<size_t>(V) + E);
+  if (out.valence.data() != m.valence) std::memcpy(out.valence.data(), m.valence, sizeof(uint32_t) * V);
+  if (out.vertex_features.data() != m.vertex_features)
+    std::memcpy(out.vertex_features.data(), m.vertex_features, V);
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = opp[c];
+    if (o != kNone && o < c) continue;
+    const uint32_t id = V + edge_of[c];
+    out.valence[id] = o == kNone ? 3 : 6;
+    out.vertex_features[id] = m.feature_edge[c] ? 2 : 0;
+  }
+  out.green.clear();
+}
+
+}  // namespace meshstream::asa

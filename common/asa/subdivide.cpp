@@ -1,0 +1,167 @@
+// ASA driver: levels of flatness marking, closure and splitting (Cheang 1998,
+// ../shared/ALGORITHMS.md section 3), or uniform modified Butterfly levels.
+#include "common/asa/subdivide.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "common/asa/butterfly_stencils.h"
+#include "common/asa/closure.h"
+#include "common/asa/flatness.h"
+#include "common/asa/level_mesh.h"
+#include "common/asa/split.h"
+#include "common/mesh/adjacency.h"
+
+namespace meshstream {
+
+struct AsaWorkspace::Buffers {
+  asa::LevelMesh base;       // level 0 topology (positions stay in the input)
+  asa::LevelMesh levels[2];  // ping-pong between levels
+  asa::ButterflyWeights weights;
+  asa::ClosureBuffers closure;
+  asa::SplitScratch scratch;
+  std::vector<Vec3f> normals;
+  std::vector<uint8_t> target;
+  AsaStats stats;
+};
+
+AsaWorkspace::AsaWorkspace() : buffers_(std::make_unique<Buffers>()) {}
+AsaWorkspace::~AsaWorkspace() = default;
+AsaWorkspace::AsaWorkspace(AsaWorkspace&&) noexcept = default;
+AsaWorkspace& AsaWorkspace::operator=(AsaWorkspace&&) noexcept = default;
+AsaWorkspace::Buffers& AsaWorkspace::buffers() { return *buffers_; }
+const AsaStats& AsaWorkspace::last_stats() const { return buffers_->stats; }
+
+namespace {
+
+Status check_options(const AsaOptions& o) {
+  if (o.levels < 0 || o.levels > 8) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "levels must be between 0 and 8 (got " + std::to_string(o.levels) + ")");
+  }
+  if (!std::isfinite(o.flatness) || o.flatness < -1.0f || o.flatness > 1.0f) {
+    return make_error(ErrorCode::kInvalidArgument, "flatness t must be in [-1, 1]");
+  }
+  if (!std::isfinite(o.tension) || std::fabs(o.tension) > 0.25f) {
+    return make_error(ErrorCode::kInvalidArgument, "tension must be in [-0.25, 0.25]");
+  }
+  if (!std::isfinite(o.crease_degrees) || o.crease_degrees < 0 || o.crease_degrees > 180) {
+    return make_error(ErrorCode::kInvalidArgument, "crease angle must be in [0, 180] degrees");
+  }
+  return {};
+}
+
+}  // namespace
+
+Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
+                      AsaResult& result) {
+  if (auto ok = check_options(options); !ok) return ok;
+  if (auto ok = validate_arrays(mesh); !ok) return ok;
+  auto adjacency = Adjacency::build(mesh);
+  if (!adjacency) return tl::unexpected(adjacency.error());
+  // Levels multiply faces by up to 4 each; refuse what cannot be indexed.
+  const double projected = static_cast<double>(mesh.face_count()) * std::pow(4.0, options.levels);
+  if (projected > 1.0e9) {
+    return make_error(ErrorCode::kLimit, "subdividing " + std::to_string(mesh.face_count()) +
+                                             " faces " + std::to_string(options.levels) +
+                                             " times exceeds 1e9 faces");
+  }
+
+  AsaWorkspace::Buffers& ws = workspace.buffers();
+  ws.stats = {};
+  const uint32_t F = mesh.face_count(), V = mesh.vertex_count();
+
+  // Level 0: the caller's arrays plus our corner table and feature flags.
+  asa::LevelMesh& base = ws.base;
+  base.opposite.resize(3 * static_cast<size_t>(F));
+  for (uint32_t c = 0; c < 3 * F; ++c) base.opposite[c] = adjacency->opposite(c);
+  asa::LevelView view;
+  view.positions = mesh.positions.data();
+  view.corner_vertex = F ? mesh.triangles.front().data() : nullptr;
+  view.opposite = base.opposite.data();
+  view.vertex_count = V;
+  view.face_count = F;
+  asa::compute_face_normals(view, ws.normals);
+  asa::tag_feature_edges(view, options.crease_degrees, ws.normals, base.feature_edge);
+  view.feature_edge = base.feature_edge.data();
+  asa::count_vertex_features(view, base.vertex_features);
+  view.vertex_features = base.vertex_features.data();
+  uint32_t max_faces = asa::count_vertex_faces(view, base.valence);
+  view.valence = base.valence.data();
+  view.green = nullptr;
+  ws.weights.configure(options.tension, max_faces);
+
+  const Vec4f* colors = mesh.colors.empty() ? nullptr : mesh.colors.data();
+  const Vec2f* texcoords = mesh.texcoords.empty() ? nullptr : mesh.texcoords.data();
+  const asa::EdgePlacement placement = options.rule == ButterflyRule::kProjection
+                                           ? asa::EdgePlacement::kProjection
+                                           : asa::EdgePlacement::kZorin;
+
+  if (options.levels == 0) {
+    result.mesh = mesh;
+    result.face_kind.assign(F, FaceKind::kUntouched);
+    return {};
+  }
+
+  for (int level = 0; level < options.levels; ++level) {
+    const bool last = level + 1 == options.levels;
+    asa::LevelMesh& out = ws.levels[level % 2];
+    asa::SplitInput in;
+    in.mesh = view;
+    in.colors = colors;
+    in.texcoords = texcoords;
+    in.weights = &ws.weights;
+    in.placement = placement;
+    in.want_topology = !last;
+    std::vector<FaceKind>* kinds = last ? &result.face_kind : nullptr;
+    if (options.uniform) {
+      asa::split_uniform(in, ws.scratch, out, kinds);
+      ws.stats.targets.push_back(view.face_count);
+      ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) - view.vertex_count);
+    } else {
+      if (level > 0) asa::compute_face_normals(view, ws.normals);
+      const uint32_t targets = asa::mark_targets(view, ws.normals, options.flatness, ws.target);
+      const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
+      asa::split_adaptive(in, ws.closure, ws.scratch, out, kinds);
+      ws.stats.targets.push_back(targets);
+      ws.stats.split_edges.push_back(split);
+    }
+    if (!last) {
+      if (!options.uniform) {
+        max_faces = std::max(max_faces, [&] {
+          asa::LevelView counted = out.view();
+          return asa::count_vertex_faces(counted, out.valence);
+        }());
+        ws.weights.ensure(max_faces);
+      }
+      view = out.view();
+      colors = out.colors.empty() ? nullptr : out.colors.data();
+      texcoords = out.texcoords.empty() ? nullptr : out.texcoords.data();
+    } else {
+      std::swap(result.mesh.positions, out.positions);
+      std::swap(result.mesh.triangles, out.triangles);
+      std::swap(result.mesh.colors, out.colors);
+      std::swap(result.mesh.texcoords, out.texcoords);
+      if (!mesh.normals.empty()) {
+        result.mesh.normals = compute_vertex_normals(result.mesh);
+      } else {
+        result.mesh.normals.clear();
+      }
+    }
+  }
+  return {};
+}
+
+Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace) {
+  AsaResult result;
+  if (auto ok = subdivide_into(mesh, options, workspace, result); !ok) return tl::unexpected(ok.error());
+  return result;
+}
+
+Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options) {
+  AsaWorkspace workspace;
+  return subdivide(mesh, options, workspace);
+}
+
+}  // namespace meshstream

@@ -1,0 +1,105 @@
+// Shared helpers of the ASA tests: procedural meshes, real-mesh loading and
+// the conformity check every output must pass.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "common/asa/subdivide.h"
+#include "common/mesh/adjacency.h"
+#include "common/mesh/import.h"
+#include "common/mesh/mesh.h"
+#include "tests/test_meshes.h"
+
+namespace meshstream::asa_test {
+
+inline Mesh octahedron() {
+  Mesh m;
+  m.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  return m;
+}
+
+inline Mesh icosahedron() {
+  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
+  Mesh m;
+  m.positions = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  return m;
+}
+
+// A flat n x n grid of squares in z = height(x, y), each square split along
+// its diagonal: interior vertices have valence 6, the border is a boundary.
+template <class Height>
+Mesh grid(int n, Height height) {
+  Mesh m;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const float x = static_cast<float>(i), y = static_cast<float>(j);
+      m.positions.push_back({x, y, height(x, y)});
+    }
+  auto id = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return m;
+}
+inline Mesh flat_grid(int n) {
+  return grid(n, [](float, float) { return 0.0f; });
+}
+
+// Loads a real mesh (tests call MESHSTREAM_REQUIRE_TEST_MESHES() first).
+inline Mesh load(const std::string& name) {
+  auto imported = import_mesh(::meshstream::testing::test_mesh(name));
+  EXPECT_TRUE(imported.has_value()) << name << ": " << (imported ? "" : imported.error().message);
+  return imported ? std::move(imported->mesh) : Mesh{};
+}
+
+// Every output must be a conforming manifold mesh: the corner table builds,
+// a closed input stays closed and an open one gains exactly one boundary edge
+// per new boundary vertex (a T-junction would open a hole of three edges
+// around its hanging vertex), every vertex is used, and the input's vertices
+// are bit-identical.
+inline ::testing::AssertionResult conforming(const Mesh& input, const AsaResult& result) {
+  const Mesh& out = result.mesh;
+  if (result.face_kind.size() != out.triangles.size())
+    return ::testing::AssertionFailure() << "face_kind has " << result.face_kind.size() << " entries for "
+                                         << out.triangles.size() << " faces";
+  if (out.positions.size() < input.positions.size())
+    return ::testing::AssertionFailure() << "lost vertices";
+  if (std::memcmp(out.positions.data(), input.positions.data(), sizeof(Vec3f) * input.positions.size()) != 0)
+    return ::testing::AssertionFailure() << "old vertices moved";
+  auto in_adj = Adjacency::build(input);
+  auto adj = Adjacency::build(out);
+  if (!adj) return ::testing::AssertionFailure() << "output not manifold: " << adj.error().message;
+  uint32_t new_boundary = 0;
+  for (uint32_t v = 0; v < adj->vertex_count(); ++v) {
+    if (adj->is_isolated_vertex(v) && (v >= input.vertex_count() || !in_adj->is_isolated_vertex(v)))
+      return ::testing::AssertionFailure() << "vertex " << v << " is not used by any face";
+    if (v >= input.vertex_count() && adj->is_boundary_vertex(v)) ++new_boundary;
+  }
+  if (adj->boundary_edge_count() != in_adj->boundary_edge_count() + new_boundary)
+    return ::testing::AssertionFailure() << "boundary edges " << adj->boundary_edge_count() << " != "
+                                         << in_adj->boundary_edge_count() << " + " << new_boundary
+                                         << " (a T-junction or crack)";
+  for (const Vec3f& p : out.positions)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      return ::testing::AssertionFailure() << "non-finite position";
+  return ::testing::AssertionSuccess();
+}
+
+inline uint32_t edge_count(const Mesh& m) {
+  auto adj = Adjacency::build(m);
+  return adj ? adj->edge_count() : 0;
+}
+
+}  // namespace meshstream::asa_test
