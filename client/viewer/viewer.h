@@ -1,0 +1,41 @@
+// The streaming viewer: a live window (GLFW, OpenGL 3.3 core, Dear ImGui)
+// that shows the newest display mesh, and the same renderer off-screen for
+// snapshots without any display.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "client/display_frame.h"
+#include "common/base/result.h"
+
+namespace meshstream::client {
+
+struct ViewerOptions {
+  int width = 1280;
+  int height = 800;
+  std::string title = "meshstream";
+  // Close the window after this many frames (0: run until the user closes
+  // it); for tests under Xvfb.
+  uint64_t exit_after_frames = 0;
+};
+
+// Opens the window and runs the render loop on the calling thread until the
+// user closes it (or exit_after_frames). Uploads happen here; decode and ASA
+// stay on the pipeline's threads. kUnsupported when no display can be opened.
+Status run_viewer(const ViewerOptions& options, LatestFrameMailbox& frames, StreamControls& controls);
+
+struct SnapshotOptions {
+  int width = 1024;
+  int height = 768;
+  enum class Coloring { kShaded, kAsaKinds } coloring = Coloring::kShaded;
+  bool wireframe = false;
+};
+
+// Renders `mesh` off-screen (OSMesa) with the viewer's renderer, framing the
+// whole model, and writes a PNG. `face_kind` may be null.
+Status render_snapshot(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
+                       const SnapshotOptions& options, const std::string& png_path);
+
+}  // namespace meshstream::client
