@@ -1,0 +1,178 @@
+// Layered decimation: see decimate.h for the rules and their reasons.
+#include "common/codec/decimate.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshstream {
+namespace {
+
+constexpr double kMinFanCosine = 0.2;
+
+struct Vec3l {
+  int64_t x, y, z;
+};
+Vec3l sub(Vec3i a, Vec3i b) { return {int64_t(a.x) - b.x, int64_t(a.y) - b.y, int64_t(a.z) - b.z}; }
+Vec3l cross_l(Vec3l a, Vec3l b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double dot_d(Vec3l a, Vec3d b) { return double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z; }
+double norm_l(Vec3l a) { return std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z); }
+
+struct Candidate {
+  double cost;
+  uint32_t vertex;
+};
+
+class LayerBuilder {
+ public:
+  explicit LayerBuilder(EditableMesh& mesh) : m_(mesh) {}
+
+  // Importance of removing v (lower first), or a negative value when v
+  // cannot be removed at all.
+  double cost(uint32_t v) {
+    if (m_.is_isolated(v) || m_.is_boundary(v)) return -1;
+    m_.star(v, ring_, corners_);
+    const size_t k = ring_.size();
+    if (k < 3 || k > kMaxRemovalValence) return -1;
+    const auto& p = m_.positions();
+    Vec3d normal{}, centroid{};
+    for (size_t i = 0; i < k; ++i) {
+      Vec3l n = cross_l(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
+      normal += Vec3d{double(n.x), double(n.y), double(n.z)};
+      centroid += Vec3d{double(p[ring_[i]].x), double(p[ring_[i]].y), double(p[ring_[i]].z)};
+    }
+    centroid = centroid / double(k);
+    const Vec3d d = Vec3d{double(p[v].x), double(p[v].y), double(p[v].z)} - centroid;
+    const double nl = length(normal);
+    const double plane = nl > 0 ? std::abs(dot(d, normal)) / nl : length(d);
+    return plane + 0.05 * length(d);
+  }
+
+  // Tries to remove v; returns true and fills `removal` on success.
+  bool try_remove(uint32_t v, Removal& removal) {
+    m_.star(v, ring_, corners_);
+    const uint32_t k = static_cast<uint32_t>(ring_.size());
+    if (m_.is_boundary(v) || k < 3 || k > kMaxRemovalValence || corners_.size() != k) return false;
+    const auto& p = m_.positions();
+    Vec3l star_normal{0, 0, 0};
+    for (uint32_t i = 0; i < k; ++i) {
+      Vec3l n = cross_l(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
+      star_normal = {star_normal.x + n.x, star_normal.y + n.y, star_normal.z + n.z};
+    }
+    const double snl = norm_l(star_normal);
+    if (snl == 0) return false;
+    const Vec3d sn{star_normal.x / snl, star_normal.y / snl, star_normal.z / snl};
+
+    double best_quality = -1;
+    uint32_t best_apex = kNone;
+    for (uint32_t a = 0; a < k; ++a) {
+      const uint32_t apex = ring_[a];
+      m_.star(apex, apex_ring_, apex_corners_);
+      bool ok = true;
+      if (k == 3) {
+        // The single new triangle must not already exist (a tetrahedron's
+        // last vertex): look for a face of the apex holding both others.
+        const uint32_t b = ring_[(a + 1) % 3], c = ring_[(a + 2) % 3];
+        for (uint32_t corner : apex_corners_) {
+          const uint32_t x = m_.vertex(EditableMesh::next(corner));
+          const uint32_t y = m_.vertex(EditableMesh::prev(corner));
+          if ((x == b && y == c) || (x == c && y == b)) ok = false;
+        }
+      } else {
+        for (uint32_t j = 2; j + 2 <= k && ok; ++j) {
+          const uint32_t w = ring_[(a + j) % k];
+          if (std::find(apex_ring_.begin(), apex_ring_.end(), w) != apex_ring_.end()) ok = false;
+        }
+      }
+      if (!ok) continue;
+      double worst = 1e300;
+      for (uint32_t j = 1; j + 1 < k && ok; ++j) {
+        const Vec3i A = p[apex], B = p[ring_[(a + j) % k]], C = p[ring_[(a + j + 1) % k]];
+        const Vec3l n = cross_l(sub(B, A), sub(C, A));
+        const double area2 = norm_l(n);
+        if (area2 == 0) {
+          ok = false;
+          break;
+        }
+        if (dot_d(n, sn) <= kMinFanCosine * area2) {
+          ok = false;
+          break;
+        }
+        const Vec3l e0 = sub(B, A), e1 = sub(C, B), e2 = sub(A, C);
+        const double s = double(e0.x) * e0.x + double(e0.y) * e0.y + double(e0.z) * e0.z +
+                         double(e1.x) * e1.x + double(e1.y) * e1.y + double(e1.z) * e1.z +
+                         double(e2.x) * e2.x + double(e2.y) * e2.y + double(e2.z) * e2.z;
+        worst = std::min(worst, area2 / s);  // 2*sqrt(3)*this = 1 for equilateral
+      }
+      if (!ok) continue;
+      if (worst > best_quality) {
+        best_quality = worst;
+        best_apex = a;
+      }
+    }
+    if (best_apex == kNone) return false;
+    removal.vertex = v;
+    removal.position = p[v];
+    removal.ring.resize(k);
+    for (uint32_t i = 0; i < k; ++i) removal.ring[i] = ring_[(best_apex + i) % k];
+    m_.remove_vertex(v, ring_, corners_, best_apex);
+    return true;
+  }
+
+ private:
+  EditableMesh& m_;
+  std::vector<uint32_t> ring_, corners_, apex_ring_, apex_corners_;
+};
+
+}  // namespace
+
+DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& options) {
+  DecimationResult result;
+  const uint32_t n = mesh.vertex_count();
+  std::vector<uint8_t> alive(n, 1), blocked(n, 0);
+  uint32_t alive_count = n;
+  LayerBuilder builder(mesh);
+  std::vector<Candidate> candidates;
+  std::vector<uint32_t> ring, corners;
+  while (alive_count > options.target_vertices && result.layers.size() < options.max_layers) {
+    candidates.clear();
+    for (uint32_t v = 0; v < n; ++v) {
+      if (!alive[v]) continue;
+      const double c = builder.cost(v);
+      if (c >= 0) candidates.push_back({c, v});
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+      return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
+    });
+    std::fill(blocked.begin(), blocked.end(), 0);
+    std::vector<Removal> layer;
+    for (const Candidate& cand : candidates) {
+      if (alive_count - layer.size() <= options.target_vertices) break;
+      const uint32_t v = cand.vertex;
+      if (blocked[v]) continue;
+      Removal r;
+      if (!builder.try_remove(v, r)) continue;
+      blocked[v] = 1;
+      for (uint32_t u : r.ring) blocked[u] = 1;
+      alive[v] = 0;
+      layer.push_back(std::move(r));
+    }
+    if (layer.empty()) break;
+    alive_count -= static_cast<uint32_t>(layer.size());
+    result.layers.push_back(std::move(layer));
+  }
+  std::vector<uint32_t> new_id(n, kNone);
+  for (uint32_t v = 0; v < n; ++v) {
+    if (alive[v]) {
+      new_id[v] = static_cast<uint32_t>(result.base_vertices.size());
+      result.base_vertices.push_back(v);
+    }
+  }
+  for (uint32_t f = 0; f < mesh.face_slot_count(); ++f) {
+    if (!mesh.face_dead(f)) result.base_faces.push_back(mesh.faces()[f]);
+  }
+  return result;
+}
+
+}  // namespace meshstream

@@ -1,0 +1,254 @@
+// Incremental decoder: see decoder.h. Bytes are buffered only until the
+// record they belong to is complete; each complete record is checked against
+// its CRC, decoded, applied, and its bytes dropped.
+#include "common/codec/decoder.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "common/codec/base_coder.h"
+#include "common/codec/encoder.h"
+#include "common/codec/quantize.h"
+#include "common/codec/refinement_codec.h"
+
+namespace meshstream {
+
+struct IncrementalDecoder::State {
+  std::vector<uint8_t> buffer;  // stream bytes [buffer_start, stream_pos)
+  uint64_t buffer_start = 0;
+  uint64_t stream_pos = 0;
+  std::optional<StreamIndex> index;
+  QuantGrid grid;
+  uint32_t records_done = 0;
+  std::optional<RefinementState> refine;
+  Mesh mesh;
+  std::vector<RecordDelta> deltas;
+  std::optional<Error> error;
+
+  uint64_t consumed_end() const {
+    if (!index) return 0;
+    if (records_done == 0) return index->payload_offset;
+    const RecordEntry& r = index->records[records_done - 1];
+    return r.offset + r.size;
+  }
+
+  Status check_header() {
+    const StreamHeader& h = index->header;
+    if (h.quant_bits < kMinQuantBits || h.quant_bits > kMaxQuantBits) {
+      return make_error(ErrorCode::kCorrupt, "stream header has quantization bits " +
+                                                 std::to_string(h.quant_bits) + " (8..20 allowed)");
+    }
+    if (h.base_coder != kBaseCoderOwn && h.base_coder != kBaseCoderDraco) {
+      return make_error(ErrorCode::kUnsupported, "unknown base mesh coder " + std::to_string(h.base_coder));
+    }
+    if (h.structure_coder != kStructureCoderRange || h.geometry_coder != kGeometryCoderRangeAverage) {
+      return make_error(ErrorCode::kUnsupported, "unknown refinement coder ids");
+    }
+    if (h.extra.empty() || h.extra[0] != kRefinementFormat) {
+      return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
+    }
+    for (float f : {h.bounds.min.x, h.bounds.min.y, h.bounds.min.z, h.bounds.max.x, h.bounds.max.y,
+                    h.bounds.max.z}) {
+      if (!std::isfinite(f)) return make_error(ErrorCode::kCorrupt, "stream bounding box is not finite");
+    }
+    const RecordEntry& r0 = index->records[0];
+    if (r0.vertices != h.base_vertex_count || r0.faces != h.base_face_count) {
+      return make_error(ErrorCode::kCorrupt, "base record counts differ from the header's");
+    }
+    // Every refinement adds a vertex and two faces: counts must follow.
+    for (size_t i = 0; i < index->records.size(); ++i) {
+      const RecordEntry& r = index->records[i];
+      if (uint64_t(r.faces) + 2 * uint64_t(h.base_vertex_count) != uint64_t(h.base_face_count) + 2 * uint64_t(r.vertices)) {
+        return make_error(ErrorCode::kCorrupt, "record " + std::to_string(i) +
+                                                   " counts break faces = base faces + 2 x added vertices");
+      }
+    }
+    grid.bounds = h.bounds;
+    grid.bits = h.quant_bits;
+    return {};
+  }
+
+  Status apply_record(uint32_t i, std::span<const uint8_t> payload) {
+    const RecordEntry& rec = index->records[i];
+    const StreamHeader& h = index->header;
+    auto where = [&](const Error& e) {
+      return make_error(e.code, "record " + std::to_string(i) + " of " +
+                                    std::to_string(index->records.size()) + ": " + e.message);
+    };
+    if (!record_intact(rec, payload)) {
+      return where({ErrorCode::kCorrupt, "checksum mismatch (corrupt or altered bytes)"});
+    }
+    RecordDelta delta;
+    delta.record = i;
+    if (i == 0) {
+      auto base = h.base_coder == kBaseCoderDraco
+                      ? decode_base_draco(payload, rec.vertices, rec.faces, h.quant_bits)
+                      : decode_base_own(payload, rec.vertices, rec.faces, h.quant_bits);
+      if (!base) return where(base.error());
+      auto state = RefinementState::from_base(base->positions, base->faces, h.quant_bits);
+      if (!state) return where(state.error());
+      refine = std::move(*state);
+      mesh = Mesh{};
+      mesh.positions.resize(base->positions.size());
+      for (size_t v = 0; v < base->positions.size(); ++v) mesh.positions[v] = grid.dequantize(base->positions[v]);
+      mesh.triangles = base->faces;
+      delta.full_rebuild = true;
+      delta.added_vertices.resize(mesh.positions.size());
+      for (uint32_t v = 0; v < delta.added_vertices.size(); ++v) delta.added_vertices[v] = v;
+      delta.touched_faces.resize(mesh.triangles.size());
+      for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
+    } else {
+      AppliedRecord applied;
+      if (auto s = apply_refinement_record(*refine, payload, rec.vertices, rec.faces, applied); !s) {
+        return where(s.error());
+      }
+      if (refine->layer > h.layer_count) {
+        return where({ErrorCode::kCorrupt, "more layers than the header's " + std::to_string(h.layer_count)});
+      }
+      const auto& positions = refine->mesh.positions();
+      for (uint32_t v : applied.added_vertices) {
+        if (v >= mesh.positions.size()) mesh.positions.resize(v + 1);
+        mesh.positions[v] = grid.dequantize(positions[v]);
+      }
+      mesh.triangles.resize(refine->mesh.face_slot_count());
+      for (uint32_t f : applied.touched_faces) mesh.triangles[f] = refine->mesh.faces()[f];
+      delta.added_vertices = std::move(applied.added_vertices);
+      delta.touched_faces = std::move(applied.touched_faces);
+    }
+    deltas.push_back(std::move(delta));
+    return {};
+  }
+};
+
+IncrementalDecoder::IncrementalDecoder() : state_(std::make_unique<State>()) {}
+IncrementalDecoder::~IncrementalDecoder() = default;
+IncrementalDecoder::IncrementalDecoder(IncrementalDecoder&&) noexcept = default;
+IncrementalDecoder& IncrementalDecoder::operator=(IncrementalDecoder&&) noexcept = default;
+
+Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
+  State& s = *state_;
+  if (s.error) return tl::unexpected(*s.error);
+  s.deltas.clear();
+  // After resume_at, bytes of records already applied are skipped.
+  const uint64_t done = s.consumed_end();
+  if (s.index && s.stream_pos < done) {
+    const uint64_t skip = std::min<uint64_t>(bytes.size(), done - s.stream_pos);
+    bytes = bytes.subspan(skip);
+    s.stream_pos += skip;
+    if (s.buffer.empty()) s.buffer_start = s.stream_pos;
+  }
+  s.buffer.insert(s.buffer.end(), bytes.begin(), bytes.end());
+  s.stream_pos += bytes.size();
+
+  if (!s.index) {
+    auto index = read_stream_index(s.buffer);
+    if (!index) {
+      if (index.error().code == ErrorCode::kTruncated) return 0u;
+      s.error = index.error();
+      return tl::unexpected(*s.error);
+    }
+    s.index = std::move(*index);
+    if (auto st = s.check_header(); !st) {
+      s.error = st.error();
+      s.index.reset();
+      return tl::unexpected(*s.error);
+    }
+  }
+
+  uint32_t applied = 0;
+  size_t drop = 0;  // buffer bytes before the next record
+  while (s.records_done < s.index->records.size()) {
+    const RecordEntry& rec = s.index->records[s.records_done];
+    if (s.stream_pos < rec.offset + rec.size) break;
+    if (s.buffer_start > rec.offset) {
+      s.error = Error{ErrorCode::kInvalidArgument, "bytes of record " + std::to_string(s.records_done) +
+                                                       " were skipped (resume offset past it)"};
+      return tl::unexpected(*s.error);
+    }
+    const size_t at = static_cast<size_t>(rec.offset - s.buffer_start);
+    std::span<const uint8_t> payload(s.buffer.data() + at, rec.size);
+    if (auto st = s.apply_record(s.records_done, payload); !st) {
+      s.error = st.error();
+      return tl::unexpected(*s.error);
+    }
+    ++s.records_done;
+    ++applied;
+    drop = at + rec.size;
+  }
+  if (drop > 0) {
+    s.buffer.erase(s.buffer.begin(), s.buffer.begin() + drop);
+    s.buffer_start += drop;
+  }
+  return applied;
+}
+
+const StreamIndex* IncrementalDecoder::index() const {
+  return state_->index ? &*state_->index : nullptr;
+}
+uint32_t IncrementalDecoder::records_decoded() const { return state_->records_done; }
+uint64_t IncrementalDecoder::resume_offset() const { return state_->consumed_end(); }
+bool IncrementalDecoder::finished() const {
+  return state_->index && state_->records_done == state_->index->records.size();
+}
+const Mesh& IncrementalDecoder::mesh() const { return state_->mesh; }
+const std::vector<RecordDelta>& IncrementalDecoder::last_deltas() const { return state_->deltas; }
+
+Status IncrementalDecoder::resume_at(uint64_t offset) {
+  State& s = *state_;
+  if (s.error) return tl::unexpected(*s.error);
+  bool boundary = offset == 0;
+  if (s.index) {
+    boundary = boundary || offset == s.index->payload_offset;
+    for (uint32_t i = 0; i < s.records_done && !boundary; ++i) {
+      boundary = offset == s.index->records[i].offset + s.index->records[i].size;
+    }
+  }
+  if (!boundary || offset > s.consumed_end()) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "cannot resume at byte " + std::to_string(offset) +
+                          ": not a record boundary this decoder has reached");
+  }
+  s.buffer.clear();
+  s.buffer_start = offset;
+  s.stream_pos = offset;
+  return {};
+}
+
+Result<Mesh> decode_hcs(std::span<const uint8_t> stream) {
+  IncrementalDecoder decoder;
+  auto fed = decoder.feed(stream);
+  if (!fed) return tl::unexpected(fed.error());
+  if (decoder.records_decoded() == 0) {
+    return make_error(ErrorCode::kTruncated, "stream of " + std::to_string(stream.size()) +
+                                                 " bytes ends before its base mesh is complete");
+  }
+  return decoder.mesh();
+}
+
+uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget) {
+  if (index.records.empty()) return index.payload_offset;
+  auto end_of = [&](size_t i) { return index.records[i].offset + index.records[i].size; };
+  if (budget.kind == DecodeBudget::Kind::kAll) return index.total_bytes();
+  const double total = double(index.total_bytes());
+  size_t best = 0;
+  for (size_t i = 0; i < index.records.size(); ++i) {
+    bool fits = false;
+    switch (budget.kind) {
+      case DecodeBudget::Kind::kBytes: fits = double(end_of(i)) <= budget.value; break;
+      case DecodeBudget::Kind::kVertices: fits = double(index.records[i].vertices) <= budget.value; break;
+      case DecodeBudget::Kind::kPercentVertices:
+        fits = double(index.records[i].vertices) <=
+               budget.value / 100.0 * double(index.header.vertex_count) + 1e-9;
+        break;
+      case DecodeBudget::Kind::kRatio:
+        fits = budget.value > 0 && double(end_of(i)) <= total / budget.value + 1e-9;
+        break;
+      case DecodeBudget::Kind::kAll: fits = true; break;
+    }
+    if (fits) best = i;
+  }
+  return end_of(best);
+}
+
+}  // namespace meshstream

@@ -1,0 +1,221 @@
+// EditableMesh: see editable_mesh.h for the slot and ring conventions.
+#include "common/codec/editable_mesh.h"
+
+#include <algorithm>
+
+namespace meshstream {
+
+Result<EditableMesh> EditableMesh::build(std::vector<Vec3i> positions, std::vector<Triangle> faces) {
+  Mesh plain;
+  plain.positions.resize(positions.size());
+  plain.triangles = faces;
+  auto adj = Adjacency::build(plain);
+  if (!adj) return tl::unexpected(adj.error());
+  EditableMesh m;
+  m.positions_ = std::move(positions);
+  m.faces_ = std::move(faces);
+  m.opposite_.resize(adj->corner_count());
+  for (uint32_t c = 0; c < adj->corner_count(); ++c) m.opposite_[c] = adj->opposite(c);
+  m.vertex_corner_.resize(adj->vertex_count());
+  m.boundary_.resize(adj->vertex_count());
+  for (uint32_t v = 0; v < adj->vertex_count(); ++v) {
+    m.vertex_corner_[v] = adj->vertex_corner(v);
+    m.boundary_[v] = adj->is_boundary_vertex(v) ? 1 : 0;
+  }
+  return m;
+}
+
+void EditableMesh::set_opposite(uint32_t c, uint32_t value) {
+  if (journal_open_ && c < mark_faces_ * 3) journal_.push_back({0, c, {opposite_[c], 0, 0}});
+  opposite_[c] = value;
+}
+void EditableMesh::set_vertex_corner(uint32_t v, uint32_t value) {
+  if (journal_open_ && v < mark_vertices_) journal_.push_back({1, v, {vertex_corner_[v], 0, 0}});
+  vertex_corner_[v] = value;
+}
+void EditableMesh::set_face(uint32_t f, const Triangle& t) {
+  if (journal_open_ && f < mark_faces_) journal_.push_back({2, f, faces_[f]});
+  faces_[f] = t;
+}
+
+void EditableMesh::mark() {
+  journal_.clear();
+  journal_open_ = true;
+  mark_vertices_ = positions_.size();
+  mark_faces_ = faces_.size();
+}
+
+void EditableMesh::rollback() {
+  for (size_t i = journal_.size(); i-- > 0;) {
+    const JournalEntry& e = journal_[i];
+    if (e.kind == 0) opposite_[e.index] = e.old[0];
+    if (e.kind == 1) vertex_corner_[e.index] = e.old[0];
+    if (e.kind == 2) faces_[e.index] = e.old;
+  }
+  journal_.clear();
+  positions_.resize(mark_vertices_);
+  vertex_corner_.resize(mark_vertices_);
+  boundary_.resize(mark_vertices_);
+  faces_.resize(mark_faces_);
+  opposite_.resize(mark_faces_ * 3);
+  if (!dead_.empty()) dead_.resize(mark_faces_);
+  journal_open_ = false;
+}
+
+void EditableMesh::star(uint32_t v, std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) const {
+  ring.clear();
+  corners.clear();
+  const uint32_t start = vertex_corner_[v];
+  if (start == kNone) return;
+  uint32_t c = start;
+  uint32_t last = start;
+  // The cap only guards against a broken table; a valid one ends the loop.
+  const size_t cap = opposite_.size();
+  do {
+    corners.push_back(c);
+    ring.push_back(vertex(next(c)));
+    last = c;
+    c = swing_ccw(c);
+  } while (c != kNone && c != start && corners.size() <= cap);
+  if (boundary_[v]) ring.push_back(vertex(prev(last)));
+}
+
+void EditableMesh::remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
+                                 const std::vector<uint32_t>& corners, uint32_t a) {
+  const uint32_t k = static_cast<uint32_t>(ring.size());
+  auto R = [&](uint32_t i) { return ring[(a + i) % k]; };
+  // o[i]: the corner outside across ring edge (R_a+i, R_a+i+1), i relative to a.
+  uint32_t o_small[32];
+  std::vector<uint32_t> o_big;
+  uint32_t* o = o_small;
+  if (k > 32) {
+    o_big.resize(k);
+    o = o_big.data();
+  }
+  uint32_t slot_small[32];
+  std::vector<uint32_t> slot_big;
+  uint32_t* slot = slot_small;
+  if (k > 32) {
+    slot_big.resize(k);
+    slot = slot_big.data();
+  }
+  for (uint32_t i = 0; i < k; ++i) {
+    const uint32_t c = corners[(a + i) % k];
+    o[i] = opposite_[c];
+    slot[i] = face_of(c);
+  }
+  if (dead_.empty()) dead_.assign(faces_.size(), 0);
+  // T_j goes to the slot of S_a+j (same outer ring edge); S_a and S_a-1 die.
+  for (uint32_t j = 1; j + 1 < k; ++j) {
+    const uint32_t f = slot[j];
+    set_face(f, {R(0), R(j), R(j + 1)});
+    const uint32_t b = 3 * f;
+    set_opposite(b, o[j]);
+    if (o[j] != kNone) set_opposite(o[j], b);
+    if (j == k - 2) {
+      set_opposite(b + 1, o[k - 1]);
+      if (o[k - 1] != kNone) set_opposite(o[k - 1], b + 1);
+    } else {
+      set_opposite(b + 1, 3 * slot[j + 1] + 2);
+    }
+    if (j == 1) {
+      set_opposite(b + 2, o[0]);
+      if (o[0] != kNone) set_opposite(o[0], b + 2);
+    } else {
+      set_opposite(b + 2, 3 * slot[j - 1] + 1);
+    }
+  }
+  for (uint32_t f : {slot[0], slot[k - 1]}) {
+    dead_[f] = 1;
+    for (int i = 0; i < 3; ++i) opposite_[3 * f + i] = kNone;
+  }
+  vertex_corner_[v] = kNone;
+  auto in_star = [&](uint32_t c) {
+    if (c == kNone) return false;
+    const uint32_t f = face_of(c);
+    for (uint32_t i = 0; i < k; ++i)
+      if (slot[i] == f) return true;
+    return false;
+  };
+  // Apex: its corner in T_1; boundary start when ring edge (R_a, R_a+1) is open.
+  if (o[0] == kNone || in_star(vertex_corner_[R(0)])) vertex_corner_[R(0)] = 3 * slot[1];
+  for (uint32_t j = 1; j < k; ++j) {
+    const uint32_t u = R(j);
+    if (j + 1 < k) {
+      if (o[j] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * slot[j] + 1;
+    } else {
+      // R_a-1 sits only in T_k-2 (corner 2); its outgoing ring edge goes to the apex.
+      if (o[k - 1] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * slot[k - 2] + 2;
+    }
+  }
+}
+
+uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
+                                     const std::vector<uint32_t>& fan_corners, Vec3i position,
+                                     std::vector<uint32_t>* touched) {
+  const uint32_t k = static_cast<uint32_t>(ring.size());
+  const uint32_t v = static_cast<uint32_t>(positions_.size());
+  positions_.push_back(position);
+  vertex_corner_.push_back(kNone);
+  boundary_.push_back(0);
+
+  uint32_t o_small[32];
+  std::vector<uint32_t> o_big;
+  uint32_t* o = o_small;
+  uint32_t slot_small[32];
+  std::vector<uint32_t> slot_big;
+  uint32_t* slot = slot_small;
+  if (k > 32) {
+    o_big.resize(k);
+    slot_big.resize(k);
+    o = o_big.data();
+    slot = slot_big.data();
+  }
+  // Outer corners of ring edges e_i = (R_i, R_i+1).
+  for (uint32_t j = 1; j + 1 < k; ++j) {
+    o[j] = opposite_[fan_corners[j - 1]];
+    slot[j] = face_of(fan_corners[j - 1]);
+  }
+  o[0] = opposite_[prev(fan_corners[0])];
+  o[k - 1] = opposite_[next(fan_corners[k - 3])];
+  const uint32_t first_new = static_cast<uint32_t>(faces_.size());
+  slot[0] = first_new;
+  slot[k - 1] = first_new + 1;
+  faces_.resize(first_new + 2);
+  opposite_.resize(3 * (first_new + 2), kNone);
+  if (!dead_.empty()) dead_.resize(first_new + 2, 0);
+
+  for (uint32_t i = 0; i < k; ++i) {
+    const uint32_t f = slot[i];
+    set_face(f, {v, ring[i], ring[(i + 1) % k]});
+    const uint32_t b = 3 * f;
+    set_opposite(b, o[i]);
+    if (o[i] != kNone) set_opposite(o[i], b);
+    set_opposite(b + 1, 3 * slot[(i + 1) % k] + 2);
+    set_opposite(b + 2, 3 * slot[(i + k - 1) % k] + 1);
+    if (touched) touched->push_back(f);
+  }
+  vertex_corner_[v] = 3 * slot[0];
+  auto in_fan = [&](uint32_t c) {
+    if (c == kNone) return false;
+    const uint32_t f = face_of(c);
+    for (uint32_t j = 1; j + 1 < k; ++j)
+      if (slot[j] == f) return true;
+    return false;
+  };
+  for (uint32_t i = 0; i < k; ++i) {
+    const uint32_t u = ring[i];
+    if (o[i] == kNone || in_fan(vertex_corner_[u])) set_vertex_corner(u, 3 * slot[i] + 1);
+  }
+  return v;
+}
+
+std::vector<Triangle> EditableMesh::live_faces() const {
+  std::vector<Triangle> out;
+  out.reserve(faces_.size());
+  for (uint32_t f = 0; f < faces_.size(); ++f)
+    if (!face_dead(f)) out.push_back(faces_[f]);
+  return out;
+}
+
+}  // namespace meshstream

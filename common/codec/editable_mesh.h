@@ -1,0 +1,107 @@
+// A corner table that supports the two local edits of the progressive codec:
+// removing an interior vertex and re-triangulating its hole as a fan
+// (encoder, decimation), and the exact inverse, inserting a vertex into a fan
+// patch (decoder, refinement). Corners, faces and vertices follow
+// adjacency.h (corner c = 3 * face + i); positions are integer grid points.
+//
+// Why our own structure instead of rebuilding Adjacency per record: an edit
+// touches O(valence) entries, so a record of m insertions costs O(m) instead
+// of O(mesh). Encoder and decoder perform the same edits in the same order on
+// this structure, so face slots, vertex corners and ring start corners are
+// identical on both sides: the stream may name patches by positions in a ring
+// without any canonical sorting.
+//
+// Face slots: an insertion rewrites the k-2 fan faces in place (star face S_j
+// goes to the slot of fan face T_j) and appends S_0 and S_{k-1}; a removal
+// reuses k-2 star slots and marks two slots dead (only the encoder removes).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/codec/quantize.h"
+#include "common/mesh/adjacency.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream {
+
+class EditableMesh {
+ public:
+  // Builds from a manifold, consistently oriented mesh (checked through
+  // Adjacency::build: kNonManifold / kInvalidMesh otherwise). O(V + F).
+  static Result<EditableMesh> build(std::vector<Vec3i> positions, std::vector<Triangle> faces);
+
+  static uint32_t face_of(uint32_t c) { return c / 3; }
+  static uint32_t next(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
+  static uint32_t prev(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
+  uint32_t vertex(uint32_t c) const { return faces_[c / 3][c % 3]; }
+  uint32_t opposite(uint32_t c) const { return opposite_[c]; }
+  uint32_t swing_ccw(uint32_t c) const {
+    const uint32_t o = opposite_[next(c)];
+    return o == kNone ? kNone : next(o);
+  }
+
+  uint32_t vertex_count() const { return static_cast<uint32_t>(positions_.size()); }
+  uint32_t face_slot_count() const { return static_cast<uint32_t>(faces_.size()); }
+  bool is_boundary(uint32_t v) const { return boundary_[v] != 0; }
+  bool is_isolated(uint32_t v) const { return vertex_corner_[v] == kNone; }
+  bool face_dead(uint32_t f) const { return !dead_.empty() && dead_[f] != 0; }
+  const std::vector<Vec3i>& positions() const { return positions_; }
+  const std::vector<Triangle>& faces() const { return faces_; }
+
+  // The star of v: `ring` its neighbours counter-clockwise, `corners` the
+  // corners at v of its faces, corners[i] in face (v, ring[i], ring[i+1]).
+  // Interior: |ring| == |corners|; boundary: |ring| == |corners| + 1, from
+  // one boundary neighbour to the other. The start is vertex_corner(v), the
+  // same on encoder and decoder. O(valence).
+  void star(uint32_t v, std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) const;
+
+  // Encoder: removes interior vertex v whose star is (ring, corners), k =
+  // |ring| >= 3, and fills the hole with the fan from ring[apex]:
+  // T_j = (R_a, R_a+j, R_a+j+1), j = 1..k-2. The caller has checked that no
+  // diagonal already exists. O(k).
+  void remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
+                     const std::vector<uint32_t>& corners, uint32_t apex);
+
+  // Decoder: inserts a new vertex at `position` into the fan patch around
+  // ring[0] whose k-2 faces have the corners `fan_corners` at ring[0]
+  // (fan_corners[j-1] in face (R_0, R_j, R_j+1)). Returns the new vertex id;
+  // appends every face slot it wrote to `touched`. The caller has validated
+  // the patch (see resolve in refinement_codec). O(k).
+  uint32_t insert_vertex(const std::vector<uint32_t>& ring, const std::vector<uint32_t>& fan_corners,
+                         Vec3i position, std::vector<uint32_t>* touched);
+
+  // Undo journal (decoder): while a mark is open every change is logged, and
+  // rollback() restores the state of mark() exactly.
+  void mark();
+  void rollback();
+  void commit() { journal_open_ = false; }
+
+  // The live faces as a plain triangle list (dead slots skipped) and the
+  // positions; vertices keep their ids.
+  std::vector<Triangle> live_faces() const;
+
+ private:
+  void set_opposite(uint32_t c, uint32_t value);
+  void set_vertex_corner(uint32_t v, uint32_t value);
+  void set_face(uint32_t f, const Triangle& t);
+
+  std::vector<Vec3i> positions_;
+  std::vector<Triangle> faces_;
+  std::vector<uint32_t> opposite_;
+  std::vector<uint32_t> vertex_corner_;
+  std::vector<uint8_t> boundary_;
+  std::vector<uint8_t> dead_;
+
+  struct JournalEntry {
+    uint8_t kind;  // 0 opposite, 1 vertex corner, 2 face
+    uint32_t index;
+    Triangle old;
+  };
+  bool journal_open_ = false;
+  size_t mark_vertices_ = 0, mark_faces_ = 0;
+  std::vector<JournalEntry> journal_;
+};
+
+}  // namespace meshstream

@@ -1,0 +1,317 @@
+// Encoder: quantize -> layered decimation -> base mesh -> refinement records
+// -> container. See encoder.h, refinement_codec.h and docs/hcs-format.md.
+//
+// The refinement records are written by replaying the decoder: the encoder
+// keeps a RefinementState built from the base exactly as the decoder will
+// decode it, names every patch in that state's terms and applies it with the
+// same function the decoder uses. Encoder and decoder therefore agree on
+// every face slot and ring start by construction.
+#include "common/codec/encoder.h"
+
+#include <algorithm>
+#include <optional>
+#include <string>
+#include <unordered_map>
+
+#include "common/codec/base_coder.h"
+#include "common/codec/container.h"
+#include "common/codec/crc32.h"
+#include "common/codec/decimate.h"
+#include "common/codec/quantize.h"
+#include "common/codec/refinement_codec.h"
+
+namespace meshstream {
+namespace {
+
+uint64_t position_key(Vec3i p) {
+  return uint64_t(uint32_t(p.x)) | uint64_t(uint32_t(p.y)) << 21 | uint64_t(uint32_t(p.z)) << 42;
+}
+
+// Oriented faces as rotation-normalized triples of position keys, sorted:
+// two meshes with equal lists have the same faces up to vertex re-indexing.
+std::vector<std::array<uint64_t, 3>> face_signature(const BaseMesh& m) {
+  std::vector<std::array<uint64_t, 3>> out;
+  out.reserve(m.faces.size());
+  for (const Triangle& t : m.faces) {
+    std::array<uint64_t, 3> k = {position_key(m.positions[t[0]]), position_key(m.positions[t[1]]),
+                                 position_key(m.positions[t[2]])};
+    while (k[0] > k[1] || k[0] > k[2]) std::rotate(k.begin(), k.begin() + 1, k.end());
+    out.push_back(k);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+struct ChosenBase {
+  uint8_t coder = kBaseCoderOwn;
+  std::vector<uint8_t> bytes;
+  BaseMesh decoded;                 // what the decoder will start from
+  std::vector<uint32_t> to_input;   // decoded vertex -> input vertex id
+};
+
+// Own coder, with vertices in order of first use by the faces (a cheap
+// spatially coherent order for the walk).
+ChosenBase code_base_own(const DecimationResult& dec, const std::vector<Vec3i>& q, int bits) {
+  ChosenBase out;
+  std::unordered_map<uint32_t, uint32_t> id;
+  for (const Triangle& t : dec.base_faces) {
+    for (uint32_t v : t) {
+      if (id.emplace(v, static_cast<uint32_t>(out.to_input.size())).second) out.to_input.push_back(v);
+    }
+  }
+  for (uint32_t v : dec.base_vertices) {
+    if (id.emplace(v, static_cast<uint32_t>(out.to_input.size())).second) out.to_input.push_back(v);
+  }
+  BaseMesh base;
+  for (uint32_t v : out.to_input) base.positions.push_back(q[v]);
+  for (const Triangle& t : dec.base_faces) base.faces.push_back({id[t[0]], id[t[1]], id[t[2]]});
+  out.bytes = encode_base_own(base);
+  out.decoded = std::move(base);
+  out.coder = kBaseCoderOwn;
+  return out;
+}
+
+// Draco, accepted only when its decode gives back exactly our base; the
+// decoded order becomes the base order. Empty optional otherwise.
+std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std::vector<Vec3i>& q,
+                                          int bits) {
+  BaseMesh base;
+  std::unordered_map<uint32_t, uint32_t> id;
+  for (uint32_t v : dec.base_vertices) {
+    id.emplace(v, static_cast<uint32_t>(base.positions.size()));
+    base.positions.push_back(q[v]);
+  }
+  for (const Triangle& t : dec.base_faces) base.faces.push_back({id[t[0]], id[t[1]], id[t[2]]});
+  auto bytes = encode_base_draco(base);
+  if (!bytes) return std::nullopt;
+  auto decoded = decode_base_draco(*bytes, static_cast<uint32_t>(base.positions.size()),
+                                   static_cast<uint32_t>(base.faces.size()), bits);
+  if (!decoded) return std::nullopt;
+  // Positions must be unique to map Draco's vertices back to ours.
+  std::unordered_map<uint64_t, uint32_t> by_position;
+  for (uint32_t v = 0; v < base.positions.size(); ++v) {
+    if (!by_position.emplace(position_key(base.positions[v]), dec.base_vertices[v]).second) {
+      return std::nullopt;
+    }
+  }
+  ChosenBase out;
+  for (const Vec3i& p : decoded->positions) {
+    auto it = by_position.find(position_key(p));
+    if (it == by_position.end()) return std::nullopt;
+    out.to_input.push_back(it->second);
+  }
+  std::vector<uint32_t> sorted = out.to_input;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return std::nullopt;
+  if (face_signature(*decoded) != face_signature(base)) return std::nullopt;
+  out.coder = kBaseCoderDraco;
+  out.bytes = std::move(*bytes);
+  out.decoded = std::move(*decoded);
+  return out;
+}
+
+class RecordWriter {
+ public:
+  RecordWriter(RefinementState& state, uint32_t record_bytes) : s_(state), record_bytes_(record_bytes) {}
+
+  struct Finished {
+    std::vector<uint8_t> payload;
+    uint32_t vertices = 0, faces = 0;
+  };
+  std::vector<Finished> records;
+  std::vector<std::pair<uint32_t, uint32_t>> inserted;  // (input id, decoder id)
+
+  // Writes one layer; `removals` are in decoder vertex ids.
+  Status write_layer(const std::vector<Removal>& removals) {
+    const uint32_t n = s_.mesh.vertex_count();
+    first_.assign(n, kNone);
+    next_.assign(removals.size(), kNone);
+    for (uint32_t i = 0; i < removals.size(); ++i) {
+      const uint32_t apex = removals[i].ring[0];
+      next_[i] = first_[apex];
+      first_[apex] = i;
+    }
+    s_.layer += 1;
+    s_.cursor = s_.order_head;
+    size_t remaining = removals.size();
+    begin_record(true);
+    std::vector<uint32_t> star_ring, star_corners, at_apex;
+    std::vector<std::pair<uint32_t, uint32_t>> order;  // (r, removal)
+    std::vector<ResolvedPatch> patches;
+    while (remaining > 0) {
+      while (s_.cursor != kNone && s_.created_layer[s_.cursor] == s_.layer) s_.cursor = s_.order_next[s_.cursor];
+      if (s_.cursor == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: walk ended with patches left");
+      const uint32_t u = s_.cursor;
+      s_.cursor = s_.order_next[u];
+      ++walk_steps_;
+      s_.mesh.star(u, star_ring, star_corners);
+      const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
+      const uint32_t faces = static_cast<uint32_t>(star_corners.size());
+      order.clear();
+      for (uint32_t i = u < n ? first_[u] : kNone; i != kNone; i = next_[i]) {
+        const Removal& r = removals[i];
+        uint32_t pos = kNone;
+        for (uint32_t f = 0; f < faces; ++f) {
+          if (star_ring[f] == r.ring[1] && star_ring[(f + 1) % ring_size] == r.ring[2]) pos = f;
+        }
+        if (pos == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: patch not found at its apex");
+        order.push_back({pos, i});
+      }
+      std::sort(order.begin(), order.end());
+      const uint32_t count = static_cast<uint32_t>(order.size());
+      RefinementModels& m = s_.models;
+      m.patch_count[std::min(ring_size, 12u)].encode(enc_, std::min(count, 3u));
+      if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);
+      patches.resize(count);
+      for (uint32_t j = 0; j < count; ++j) {
+        const Removal& r = removals[order[j].second];
+        const uint32_t k = static_cast<uint32_t>(r.ring.size());
+        if (faces <= 16) {
+          m.first_face[faces].encode(enc_, order[j].first);
+        } else {
+          m.first_face_big.encode(enc_, order[j].first);
+        }
+        m.valence[std::min(ring_size, 12u)].encode(enc_, k - 3);
+        if (!resolve_patch(s_.mesh, u, star_ring, star_corners, order[j].first, k, patches[j]) ||
+            patches[j].ring != r.ring) {
+          return make_error(ErrorCode::kInvalidMesh, "internal: patch does not resolve to its ring");
+        }
+        const Vec3i pred = predict_position(s_.mesh, patches[j].ring);
+        const int ctx = residual_context(s_.mesh, patches[j].ring);
+        for (int a = 0; a < 3; ++a) m.residual[ctx][a].encode(enc_, r.position[a] - pred[a]);
+      }
+      for (uint32_t j = 0; j < count; ++j) {
+        const Removal& r = removals[order[j].second];
+        const uint32_t v = apply_patch(s_, patches[j], r.position, nullptr);
+        inserted.push_back({r.vertex, v});
+      }
+      insertions_ += count;
+      remaining -= count;
+      if (remaining == 0) {
+        end_record();
+      } else if (enc_.bytes_so_far() >= record_bytes_) {
+        end_record();
+        begin_record(false);
+      }
+    }
+    return {};
+  }
+
+ private:
+  void begin_record(bool starts_layer) {
+    enc_ = RangeEncoder();
+    starts_layer_ = starts_layer;
+    walk_steps_ = 0;
+    insertions_ = 0;
+  }
+  void end_record() {
+    Finished f;
+    write_record_header({starts_layer_, walk_steps_, insertions_}, f.payload);
+    std::vector<uint8_t> coded = enc_.finish();
+    f.payload.insert(f.payload.end(), coded.begin(), coded.end());
+    f.vertices = s_.mesh.vertex_count();
+    f.faces = s_.mesh.face_slot_count();
+    records.push_back(std::move(f));
+  }
+
+  RefinementState& s_;
+  uint32_t record_bytes_;
+  RangeEncoder enc_;
+  bool starts_layer_ = false;
+  uint32_t walk_steps_ = 0, insertions_ = 0;
+  std::vector<uint32_t> first_, next_;
+};
+
+}  // namespace
+
+Result<Mesh> quantized_reference(const Mesh& mesh, int quant_bits) {
+  auto grid = make_grid(mesh, quant_bits);
+  if (!grid) return tl::unexpected(grid.error());
+  Mesh out;
+  out.triangles = mesh.triangles;
+  out.positions.resize(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    out.positions[v] = grid->dequantize(grid->quantize(mesh.positions[v]));
+  }
+  return out;
+}
+
+Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
+  auto grid = make_grid(mesh, options.quant_bits);
+  if (!grid) return tl::unexpected(grid.error());
+  if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
+  if (mesh.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "mesh has no triangles");
+  std::vector<Vec3i> q = quantize_positions(mesh, *grid);
+  auto editable = EditableMesh::build(q, mesh.triangles);
+  if (!editable) return tl::unexpected(editable.error());
+
+  DecimateOptions dopt;
+  dopt.target_vertices = options.target_base_vertices;
+  DecimationResult dec = decimate_layers(std::move(*editable), dopt);
+
+  ChosenBase base = code_base_own(dec, q, grid->bits);
+  if (options.allow_draco_base) {
+    if (auto draco = code_base_draco(dec, q, grid->bits); draco && draco->bytes.size() < base.bytes.size()) {
+      base = std::move(*draco);
+    }
+  }
+  auto state = RefinementState::from_base(base.decoded.positions, base.decoded.faces, grid->bits);
+  if (!state) return tl::unexpected(state.error());
+
+  // Input id -> decoder id, growing as the replay inserts vertices.
+  std::vector<uint32_t> to_decoder(mesh.vertex_count(), kNone);
+  for (uint32_t d = 0; d < base.to_input.size(); ++d) to_decoder[base.to_input[d]] = d;
+
+  RecordWriter writer(*state, std::max<uint32_t>(options.record_bytes, 64));
+  std::vector<Removal> layer_dec;
+  for (size_t li = dec.layers.size(); li-- > 0;) {
+    const std::vector<Removal>& layer = dec.layers[li];
+    layer_dec = layer;
+    for (Removal& r : layer_dec) {
+      for (uint32_t& u : r.ring) u = to_decoder[u];
+    }
+    writer.inserted.clear();
+    if (auto s = writer.write_layer(layer_dec); !s) return tl::unexpected(s.error());
+    for (const auto& [input, decoded] : writer.inserted) to_decoder[input] = decoded;
+  }
+
+  StreamHeader header;
+  header.vertex_count = mesh.vertex_count();
+  header.face_count = mesh.face_count();
+  header.base_vertex_count = static_cast<uint32_t>(base.decoded.positions.size());
+  header.base_face_count = static_cast<uint32_t>(base.decoded.faces.size());
+  header.bounds = grid->bounds;
+  header.quant_bits = static_cast<uint8_t>(grid->bits);
+  header.base_coder = base.coder;
+  header.structure_coder = kStructureCoderRange;
+  header.geometry_coder = kGeometryCoderRangeAverage;
+  header.layer_count = static_cast<uint32_t>(dec.layers.size());
+  header.extra = {kRefinementFormat};
+
+  std::vector<RecordEntry> entries;
+  std::vector<const std::vector<uint8_t>*> payloads;
+  RecordEntry e0;
+  e0.size = static_cast<uint32_t>(base.bytes.size());
+  e0.vertices = header.base_vertex_count;
+  e0.faces = header.base_face_count;
+  e0.crc32 = crc32(0, base.bytes.data(), base.bytes.size());
+  entries.push_back(e0);
+  payloads.push_back(&base.bytes);
+  for (const auto& r : writer.records) {
+    RecordEntry e;
+    e.size = static_cast<uint32_t>(r.payload.size());
+    e.vertices = r.vertices;
+    e.faces = r.faces;
+    e.crc32 = crc32(0, r.payload.data(), r.payload.size());
+    entries.push_back(e);
+    payloads.push_back(&r.payload);
+  }
+  if (entries.back().vertices != header.vertex_count || entries.back().faces != header.face_count) {
+    return make_error(ErrorCode::kInvalidMesh, "internal: the records do not rebuild the whole mesh");
+  }
+  std::vector<uint8_t> out = write_container_prefix(header, entries);
+  for (const auto* p : payloads) out.insert(out.end(), p->begin(), p->end());
+  return out;
+}
+
+}  // namespace meshstream

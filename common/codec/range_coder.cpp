@@ -1,0 +1,156 @@
+// Range coder: see range_coder.h. The arithmetic is LZMA's rc (public
+// domain): 32-bit range, 64-bit low with a cache byte for carry propagation,
+// 11-bit probabilities adapted by 1/32 of the error per bit.
+#include "common/codec/range_coder.h"
+
+namespace meshstream {
+namespace {
+
+constexpr uint32_t kTop = 1u << 24;
+constexpr int kModelBits = 11;
+constexpr int kMoveBits = 5;
+
+}  // namespace
+
+void RangeEncoder::shift_low() {
+  if (static_cast<uint32_t>(low_) < 0xFF000000u || (low_ >> 32) != 0) {
+    uint8_t temp = cache_;
+    do {
+      uint8_t byte = static_cast<uint8_t>(temp + static_cast<uint8_t>(low_ >> 32));
+      if (first_) {
+        first_ = false;  // always 0; the decoder starts as if it had read it
+      } else {
+        out_.push_back(byte);
+      }
+      temp = 0xFF;
+    } while (--cache_size_ != 0);
+    cache_ = static_cast<uint8_t>(low_ >> 24);
+  }
+  ++cache_size_;
+  low_ = (low_ & 0x00FFFFFFu) << 8;
+}
+
+void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
+  const uint32_t bound = (range_ >> kModelBits) * model.p;
+  if (bit == 0) {
+    range_ = bound;
+    model.p = static_cast<uint16_t>(model.p + (((1u << kModelBits) - model.p) >> kMoveBits));
+  } else {
+    low_ += bound;
+    range_ -= bound;
+    model.p = static_cast<uint16_t>(model.p - (model.p >> kMoveBits));
+  }
+  while (range_ < kTop) {
+    range_ <<= 8;
+    shift_low();
+  }
+}
+
+void RangeEncoder::encode_direct(uint32_t value, int count) {
+  for (int i = count - 1; i >= 0; --i) {
+    range_ >>= 1;
+    if ((value >> i) & 1u) low_ += range_;
+    while (range_ < kTop) {
+      range_ <<= 8;
+      shift_low();
+    }
+  }
+}
+
+std::vector<uint8_t> RangeEncoder::finish() {
+  for (int i = 0; i < 5; ++i) shift_low();
+  return std::move(out_);
+}
+
+RangeDecoder::RangeDecoder(std::span<const uint8_t> in) : in_(in) {
+  for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
+}
+
+uint32_t RangeDecoder::decode_bit(BitModel& model) {
+  const uint32_t bound = (range_ >> kModelBits) * model.p;
+  uint32_t bit;
+  if (code_ < bound) {
+    range_ = bound;
+    model.p = static_cast<uint16_t>(model.p + (((1u << kModelBits) - model.p) >> kMoveBits));
+    bit = 0;
+  } else {
+    code_ -= bound;
+    range_ -= bound;
+    model.p = static_cast<uint16_t>(model.p - (model.p >> kMoveBits));
+    bit = 1;
+  }
+  while (range_ < kTop) {
+    range_ <<= 8;
+    code_ = (code_ << 8) | next_byte();
+  }
+  return bit;
+}
+
+uint32_t RangeDecoder::decode_direct(int count) {
+  uint32_t value = 0;
+  for (int i = 0; i < count; ++i) {
+    range_ >>= 1;
+    uint32_t bit = 0;
+    if (code_ >= range_) {
+      code_ -= range_;
+      bit = 1;
+    }
+    value = (value << 1) | bit;
+    while (range_ < kTop) {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    }
+  }
+  return value;
+}
+
+void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
+  const uint64_t v = uint64_t(value) + 1;  // >= 1, so it has a leading one
+  int len = 0;
+  while ((v >> len) > 1) ++len;  // v in [2^len, 2^(len+1))
+  length.encode(enc, static_cast<uint32_t>(len));
+  int rest = len;
+  // Up to two bits below the leading one through models: most of the
+  // information about the shape of the distribution lives there.
+  uint32_t ctx = 1;
+  for (int i = 0; i < 2 && rest > 0; ++i) {
+    --rest;
+    uint32_t bit = static_cast<uint32_t>((v >> rest) & 1u);
+    enc.encode_bit(high[len][ctx], bit);
+    ctx = (ctx << 1 | bit) & 3u;
+  }
+  if (rest > 0) enc.encode_direct(static_cast<uint32_t>(v & ((uint64_t(1) << rest) - 1)), rest);
+}
+
+uint32_t AdaptiveUIntModel::decode(RangeDecoder& dec) {
+  uint32_t len = length.decode(dec);
+  if (len > 32) len = 32;  // corrupt input: clamp, the caller range-checks
+  uint64_t v = 1;
+  int rest = static_cast<int>(len);
+  uint32_t ctx = 1;
+  for (int i = 0; i < 2 && rest > 0; ++i) {
+    --rest;
+    uint32_t bit = dec.decode_bit(high[len][ctx]);
+    v = (v << 1) | bit;
+    ctx = (ctx << 1 | bit) & 3u;
+  }
+  if (rest > 0) v = (v << rest) | dec.decode_direct(rest);
+  return static_cast<uint32_t>(v - 1);  // v <= 2^33 - 1 only if corrupt; wraps harmlessly
+}
+
+void AdaptiveIntModel::encode(RangeEncoder& enc, int32_t value) {
+  enc.encode_bit(zero, value == 0 ? 0 : 1);
+  if (value == 0) return;
+  enc.encode_bit(sign, value < 0 ? 1 : 0);
+  const uint32_t mag = value < 0 ? static_cast<uint32_t>(-int64_t(value)) : static_cast<uint32_t>(value);
+  magnitude.encode(enc, mag - 1);
+}
+
+int64_t AdaptiveIntModel::decode(RangeDecoder& dec) {
+  if (dec.decode_bit(zero) == 0) return 0;
+  const bool negative = dec.decode_bit(sign) != 0;
+  const int64_t mag = int64_t(magnitude.decode(dec)) + 1;
+  return negative ? -mag : mag;
+}
+
+}  // namespace meshstream

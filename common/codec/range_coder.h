@@ -1,0 +1,110 @@
+// Adaptive binary range coder (the carry-propagating coder of LZMA, Igor
+// Pavlov, public domain; described in G. N. N. Martin, "Range encoding", 1979)
+// with adaptive bit models, bit trees for small alphabets, and an adaptive
+// Exp-Golomb integer coder built from them.
+//
+// Why this coder: every refinement symbol (patch counts, ring offsets,
+// valences) and every residual is a small integer with a skewed, drifting
+// distribution; adaptive binary models learn it in a few dozen symbols and the
+// coder is fast (one multiply per bit). The decoder never reads outside its
+// span: bytes past the end read as zero and are counted, so a truncated or
+// corrupt record decodes to garbage symbols that the caller range-checks, and
+// `overrun()` reports that the input ran out.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace meshstream {
+
+// Probability of a 0 bit in units of 1/2048 (11 bits, as LZMA).
+struct BitModel {
+  uint16_t p = 1024;
+};
+
+class RangeEncoder {
+ public:
+  void encode_bit(BitModel& model, uint32_t bit);
+  // Equiprobable bits, most significant first (count <= 32).
+  void encode_direct(uint32_t value, int count);
+  // Ends the stream; returns the bytes. The encoder is spent afterwards.
+  std::vector<uint8_t> finish();
+  size_t bytes_so_far() const { return out_.size() + cache_size_; }
+
+ private:
+  void shift_low();
+  uint64_t low_ = 0;
+  uint32_t range_ = 0xFFFFFFFFu;
+  uint8_t cache_ = 0;
+  uint64_t cache_size_ = 1;
+  bool first_ = true;  // the first byte LZMA emits is always 0: we drop it
+  std::vector<uint8_t> out_;
+};
+
+class RangeDecoder {
+ public:
+  explicit RangeDecoder(std::span<const uint8_t> in);
+  uint32_t decode_bit(BitModel& model);
+  uint32_t decode_direct(int count);
+  // Bytes requested past the end of the input (a correct stream needs at
+  // most 4 of them: the encoder's flush is shorter than the decoder's
+  // look-ahead).
+  size_t overrun() const { return overrun_; }
+  bool exhausted_badly() const { return overrun_ > 4; }
+
+ private:
+  uint8_t next_byte() {
+    if (pos_ < in_.size()) return in_[pos_++];
+    ++overrun_;
+    return 0;
+  }
+  std::span<const uint8_t> in_;
+  size_t pos_ = 0;
+  size_t overrun_ = 0;
+  uint32_t range_ = 0xFFFFFFFFu;
+  uint32_t code_ = 0;
+};
+
+// A symbol of `Bits` bits coded MSB first through a binary tree of adaptive
+// models (2^Bits - 1 models): an adaptive model of a 2^Bits alphabet.
+template <int Bits>
+struct BitTreeModel {
+  BitModel nodes[1u << Bits];
+  void encode(RangeEncoder& enc, uint32_t symbol) {
+    uint32_t m = 1;
+    for (int i = Bits - 1; i >= 0; --i) {
+      uint32_t bit = (symbol >> i) & 1u;
+      enc.encode_bit(nodes[m], bit);
+      m = (m << 1) | bit;
+    }
+  }
+  uint32_t decode(RangeDecoder& dec) {
+    uint32_t m = 1;
+    for (int i = 0; i < Bits; ++i) m = (m << 1) | dec.decode_bit(nodes[m]);
+    return m - (1u << Bits);
+  }
+};
+
+// Adaptive Exp-Golomb for unsigned integers up to 2^32 - 1: the bit length
+// (0..32) through a bit tree, then the two bits below the leading one through
+// models indexed by the length, then the rest as equiprobable bits.
+struct AdaptiveUIntModel {
+  BitTreeModel<6> length;
+  BitModel high[33][4];
+  void encode(RangeEncoder& enc, uint32_t value);
+  uint32_t decode(RangeDecoder& dec);
+};
+
+// Signed integers: zero flag, sign, then magnitude - 1 as above.
+struct AdaptiveIntModel {
+  BitModel zero;
+  BitModel sign;
+  AdaptiveUIntModel magnitude;
+  void encode(RangeEncoder& enc, int32_t value);
+  // Decodes a value; the caller range-checks it.
+  int64_t decode(RangeDecoder& dec);
+};
+
+}  // namespace meshstream

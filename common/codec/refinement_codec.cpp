@@ -1,0 +1,236 @@
+// Refinement records: see refinement_codec.h for the layout and why.
+#include "common/codec/refinement_codec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "common/codec/decimate.h"
+
+namespace meshstream {
+namespace {
+
+Status bad(const std::string& what) { return make_error(ErrorCode::kCorrupt, what); }
+
+bool read_varint(std::span<const uint8_t> in, size_t& pos, uint32_t& value) {
+  value = 0;
+  for (int shift = 0; shift < 35; shift += 7) {
+    if (pos >= in.size()) return false;
+    const uint8_t b = in[pos++];
+    if (shift == 28 && (b & 0x70)) return false;  // does not fit 32 bits
+    value |= uint32_t(b & 0x7F) << shift;
+    if (!(b & 0x80)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
+                                                   std::vector<Triangle> faces, int quant_bits) {
+  const uint32_t n = static_cast<uint32_t>(positions.size());
+  auto mesh = EditableMesh::build(std::move(positions), std::move(faces));
+  if (!mesh) return tl::unexpected(mesh.error());
+  RefinementState s;
+  s.mesh = std::move(*mesh);
+  s.order_next.resize(n);
+  for (uint32_t v = 0; v < n; ++v) s.order_next[v] = v + 1 < n ? v + 1 : kNone;
+  s.order_head = n > 0 ? 0 : kNone;
+  s.created_layer.assign(n, 0);
+  s.max_coordinate = (int32_t(1) << quant_bits) - 1;
+  return s;
+}
+
+bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                   const std::vector<uint32_t>& star_corners, uint32_t r, uint32_t k,
+                   ResolvedPatch& out) {
+  const uint32_t faces = static_cast<uint32_t>(star_corners.size());
+  if (k < 3 || k > kMaxRemovalValence || r >= faces) return false;
+  const uint32_t fan = k - 2;
+  if (mesh.is_boundary(apex)) {
+    if (r + fan > faces) return false;  // would cross the boundary
+  } else {
+    if (fan + 1 > faces) return false;  // k-1 ring entries must be distinct
+  }
+  out.ring.resize(k);
+  out.fan_corners.resize(fan);
+  out.ring[0] = apex;
+  for (uint32_t j = 0; j < fan; ++j) {
+    const uint32_t i = (r + j) % faces;
+    out.fan_corners[j] = star_corners[i];
+    out.ring[j + 1] = star_ring[i];
+  }
+  out.ring[k - 1] = star_ring[(r + fan) % star_ring.size()];
+  return true;
+}
+
+Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
+  int64_t s[3] = {0, 0, 0};
+  const auto& p = mesh.positions();
+  for (uint32_t u : ring)
+    for (int a = 0; a < 3; ++a) s[a] += p[u][a];
+  const int64_t k = static_cast<int64_t>(ring.size());
+  Vec3i out;
+  for (int a = 0; a < 3; ++a) out[a] = static_cast<int32_t>((s[a] + k / 2) / k);  // coordinates >= 0
+  return out;
+}
+
+int residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
+  const auto& p = mesh.positions();
+  int64_t total = 0;
+  const size_t k = ring.size();
+  for (size_t i = 0; i < k; ++i) {
+    const Vec3i a = p[ring[i]], b = p[ring[(i + 1) % k]];
+    total += std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
+  }
+  // Twice log2 of the mean L1 edge length: half-octave buckets.
+  const double mean = double(total) / double(k) + 1.0;
+  int ctx = static_cast<int>(2.0 * std::log2(mean));
+  return std::clamp(ctx, 0, kScaleContexts - 1);
+}
+
+uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, Vec3i position,
+                     std::vector<uint32_t>* touched) {
+  const uint32_t v = state.mesh.insert_vertex(patch.ring, patch.fan_corners, position, touched);
+  const uint32_t apex = patch.ring[0];
+  state.order_next.push_back(state.order_next[apex]);
+  state.order_next[apex] = v;
+  state.created_layer.push_back(state.layer);
+  return v;
+}
+
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out) {
+  out.push_back(header.starts_layer ? 1 : 0);
+  for (uint32_t v : {header.walk_steps, header.insertions}) {
+    while (v >= 0x80) {
+      out.push_back(uint8_t(v | 0x80));
+      v >>= 7;
+    }
+    out.push_back(uint8_t(v));
+  }
+}
+
+Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
+                               uint32_t expected_vertices, uint32_t expected_faces,
+                               AppliedRecord& applied) {
+  applied.added_vertices.clear();
+  applied.touched_faces.clear();
+  if (payload.empty()) return bad("empty refinement record");
+  const uint8_t flags = payload[0];
+  if (flags > 1) return bad("unknown refinement record flags " + std::to_string(flags));
+  size_t pos = 1;
+  RecordHeader h;
+  h.starts_layer = flags & 1;
+  if (!read_varint(payload, pos, h.walk_steps) || !read_varint(payload, pos, h.insertions)) {
+    return bad("refinement record header is cut short or malformed");
+  }
+  const uint32_t vertices_before = state.mesh.vertex_count();
+  // Each insertion needs at least one walk step's worth of bits; refuse
+  // counts that could not fit before allocating for them.
+  if (h.walk_steps > vertices_before) {
+    return bad("refinement record walks " + std::to_string(h.walk_steps) + " vertices but the mesh has " +
+               std::to_string(vertices_before));
+  }
+  if (h.insertions > 64 * static_cast<uint64_t>(payload.size())) {
+    return bad("refinement record claims " + std::to_string(h.insertions) +
+               " insertions, more than its size allows");
+  }
+  if (h.starts_layer) {
+    state.layer += 1;
+    state.cursor = state.order_head;
+  } else if (state.layer == 0) {
+    return bad("first refinement record does not start a layer");
+  }
+
+  RangeDecoder dec(payload.subspan(pos));
+  RefinementModels& m = state.models;
+  EditableMesh& mesh = state.mesh;
+  mesh.mark();
+  std::vector<uint32_t> star_ring, star_corners;
+  std::vector<ResolvedPatch> patches;
+  std::vector<Vec3i> positions;
+  std::vector<uint8_t> used_faces;
+  uint32_t inserted = 0;
+  // Links changed in the order list, so a failure can restore them exactly.
+  std::vector<std::pair<uint32_t, uint32_t>> link_journal;
+  auto fail_and_unlink = [&](const std::string& what) -> Status {
+    for (size_t i = link_journal.size(); i-- > 0;) {
+      state.order_next[link_journal[i].first] = link_journal[i].second;
+    }
+    state.order_next.resize(vertices_before);
+    state.created_layer.resize(vertices_before);
+    mesh.rollback();
+    applied.added_vertices.clear();
+    applied.touched_faces.clear();
+    return bad(what);
+  };
+
+  for (uint32_t step = 0; step < h.walk_steps; ++step) {
+    while (state.cursor != kNone && state.created_layer[state.cursor] == state.layer) {
+      state.cursor = state.order_next[state.cursor];
+    }
+    if (state.cursor == kNone) return fail_and_unlink("refinement walk runs past the last vertex");
+    const uint32_t u = state.cursor;
+    state.cursor = state.order_next[u];
+    mesh.star(u, star_ring, star_corners);
+    const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
+    const uint32_t faces = static_cast<uint32_t>(star_corners.size());
+    uint32_t count = m.patch_count[std::min(ring_size, 12u)].decode(dec);
+    if (count == 3) count += m.patch_count_extra.decode(dec);
+    if (count == 0) continue;
+    if (count > faces || inserted + count > h.insertions) {
+      return fail_and_unlink("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
+                             " patches, more than it or the record holds");
+    }
+    patches.resize(count);
+    positions.resize(count);
+    used_faces.assign(faces, 0);
+    for (uint32_t i = 0; i < count; ++i) {
+      uint32_t r = faces <= 16 ? m.first_face[faces].decode(dec) : m.first_face_big.decode(dec);
+      const uint32_t k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
+      if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
+        return fail_and_unlink("patch " + std::to_string(i) + " at vertex " + std::to_string(u) +
+                               " (first face " + std::to_string(r) + ", valence " + std::to_string(k) +
+                               ") does not fit its star of " + std::to_string(faces) + " faces");
+      }
+      for (uint32_t j = 0; j + 2 < k; ++j) {
+        uint8_t& used = used_faces[(r + j) % faces];
+        if (used) return fail_and_unlink("patches at vertex " + std::to_string(u) + " overlap");
+        used = 1;
+      }
+      const Vec3i pred = predict_position(mesh, patches[i].ring);
+      const int ctx = residual_context(mesh, patches[i].ring);
+      for (int a = 0; a < 3; ++a) {
+        const int64_t value = int64_t(pred[a]) + m.residual[ctx][a].decode(dec);
+        if (value < 0 || value > state.max_coordinate) {
+          return fail_and_unlink("vertex position outside the quantization grid at vertex " +
+                                 std::to_string(u));
+        }
+        positions[i][a] = static_cast<int32_t>(value);
+      }
+    }
+    if (dec.exhausted_badly()) return fail_and_unlink("refinement record data ends early");
+    for (uint32_t i = 0; i < count; ++i) {
+      link_journal.push_back({u, state.order_next[u]});
+      const uint32_t v = apply_patch(state, patches[i], positions[i], &applied.touched_faces);
+      applied.added_vertices.push_back(v);
+    }
+    inserted += count;
+  }
+  if (inserted != h.insertions) {
+    return fail_and_unlink("refinement record holds " + std::to_string(inserted) + " insertions, its header says " +
+                           std::to_string(h.insertions));
+  }
+  if (dec.exhausted_badly()) return fail_and_unlink("refinement record data ends early");
+  if (mesh.vertex_count() != expected_vertices || mesh.face_slot_count() != expected_faces) {
+    return fail_and_unlink("refinement record yields " + std::to_string(mesh.vertex_count()) +
+                           " vertices and " + std::to_string(mesh.face_slot_count()) +
+                           " faces, the index says " + std::to_string(expected_vertices) + " and " +
+                           std::to_string(expected_faces));
+  }
+  mesh.commit();
+  return {};
+}
+
+}  // namespace meshstream

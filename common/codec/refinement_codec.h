@@ -1,0 +1,105 @@
+// Refinement records: the state both encoder and decoder keep while layers
+// are restored, the adaptive models of the symbols, and the shared steps
+// (patch resolution, prediction, insertion) so the two sides cannot drift.
+//
+// How a layer is described (HCS's "structure data", our own layout):
+// the decoder walks the coarse vertices in the *order list* (base vertices in
+// base order; every inserted vertex is linked right after the apex of its
+// patch, so list neighbours are surface neighbours and a slice of the list is
+// a spatially coherent batch). At each vertex u present before the layer it
+// reads how many patches have their fan apex at u, and for each: r, the index
+// in u's star (EditableMesh::star order) of the first fan face, and k, the
+// valence of the vertex to insert (the fan has k-2 faces). Then the vertex's
+// position as a residual from the prediction (average of the k ring vertices,
+// HCS's neighbour average), per axis, through models chosen by the ring's
+// size on the grid (bigger rings, bigger residuals).
+//
+// A record covers a run of the walk (a batch); the first record of a layer
+// restarts the walk. Record payload: u8 flags (bit 0: starts a layer),
+// varint walk steps, varint insertions, then one range-coded block.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/codec/editable_mesh.h"
+#include "common/codec/range_coder.h"
+
+namespace meshstream {
+
+inline constexpr int kScaleContexts = 20;
+
+struct RefinementModels {
+  BitTreeModel<2> patch_count[13];   // by min(apex ring size, 12); 3 = escape
+  AdaptiveUIntModel patch_count_extra;
+  BitTreeModel<4> first_face[17];    // by apex face count when <= 16
+  AdaptiveUIntModel first_face_big;
+  BitTreeModel<4> valence[13];       // k - 3 (k <= 18), by min(apex ring size, 12)
+  AdaptiveIntModel residual[kScaleContexts][3];
+};
+
+struct RefinementState {
+  EditableMesh mesh;
+  std::vector<uint32_t> order_next;  // order list; kNone ends it
+  uint32_t order_head = kNone;
+  std::vector<uint32_t> created_layer;  // 0 for base vertices
+  uint32_t layer = 0;                   // layers started so far
+  uint32_t cursor = kNone;              // next vertex of the walk
+  int32_t max_coordinate = 4095;
+  RefinementModels models;
+
+  // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
+  static Result<RefinementState> from_base(std::vector<Vec3i> positions, std::vector<Triangle> faces,
+                                           int quant_bits);
+};
+
+// One patch resolved against the current mesh.
+struct ResolvedPatch {
+  std::vector<uint32_t> ring;         // R_0 = apex, ..., R_k-1
+  std::vector<uint32_t> fan_corners;  // k-2 corners at the apex
+};
+
+// Resolves the patch whose first fan face is star index r and whose vertex
+// has valence k, given the apex's star. False when it does not fit (r or k
+// out of range for the star, a fan crossing the boundary or wrapping onto
+// itself). O(k).
+bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                   const std::vector<uint32_t>& star_corners, uint32_t r, uint32_t k,
+                   ResolvedPatch& out);
+
+// The decoder's prediction of a vertex inserted into `ring`: the rounded
+// average of the ring's positions. Exact integers.
+Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
+// Residual model context for a ring (log2 of its mean edge length on the grid).
+int residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
+
+// Inserts a vertex into a resolved patch and links it after the apex in the
+// order list. Returns its id; appends written face slots to `touched`.
+uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, Vec3i position,
+                     std::vector<uint32_t>* touched);
+
+struct RecordHeader {
+  bool starts_layer = false;
+  uint32_t walk_steps = 0;
+  uint32_t insertions = 0;
+};
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out);
+
+struct AppliedRecord {
+  std::vector<uint32_t> added_vertices;
+  std::vector<uint32_t> touched_faces;
+};
+
+// Decodes one refinement record and applies it to `state`. Every count,
+// index and symbol is range-checked; on error the mesh is rolled back to its
+// state before the record (the models and walk are not: the caller stops
+// decoding after an error). O(record size + touched faces).
+// `expected_vertices`/`expected_faces` are the index's counts after the
+// record; a mismatch is an error (and rolls back) like any other.
+Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
+                               uint32_t expected_vertices, uint32_t expected_faces,
+                               AppliedRecord& applied);
+
+}  // namespace meshstream

@@ -1,0 +1,198 @@
+// Exact round trips, valid prefixes, incremental feeding and budgets on
+// procedural meshes (real meshes: real_mesh_test.cpp).
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "common/codec/decoder.h"
+#include "common/codec/encoder.h"
+#include "common/mesh/adjacency.h"
+#include "tests/codec/codec_test_util.h"
+
+namespace meshstream {
+namespace {
+
+using namespace meshstream::testing;
+
+struct Case {
+  const char* name;
+  Mesh mesh;
+};
+
+std::vector<Case> procedural_cases() {
+  return {
+      {"icosphere3", icosphere(3)},
+      {"bumpy_icosphere4", icosphere(4, 0.2f)},
+      {"torus", torus(40, 24)},
+      {"height_field", height_field(30, 20)},
+      {"tetrahedron", tetrahedron()},
+      {"components", combine({icosphere(2), tetrahedron(), torus(12, 8), height_field(5, 4)})},
+  };
+}
+
+void expect_exact(const Mesh& decoded, const Mesh& reference) {
+  ASSERT_EQ(decoded.vertex_count(), reference.vertex_count());
+  ASSERT_EQ(decoded.face_count(), reference.face_count());
+  EXPECT_EQ(sorted_positions(decoded), sorted_positions(reference));
+  EXPECT_EQ(canonical_faces(decoded), canonical_faces(reference));
+}
+
+void expect_valid(const Mesh& m, const std::string& where) {
+  ASSERT_TRUE(validate_arrays(m)) << where;
+  auto adj = Adjacency::build(m);
+  ASSERT_TRUE(adj) << where << ": " << adj.error().message;
+}
+
+class ProceduralRoundTrip : public ::testing::TestWithParam<int> {};
+
+TEST_P(ProceduralRoundTrip, ExactWithBothBaseCoders) {
+  Case c = procedural_cases()[GetParam()];
+  for (bool draco : {true, false}) {
+    EncodeOptions opt;
+    opt.target_base_vertices = 20;
+    opt.record_bytes = 200;
+    opt.allow_draco_base = draco;
+    auto bytes = encode_hcs(c.mesh, opt);
+    ASSERT_TRUE(bytes) << c.name << ": " << bytes.error().message;
+    auto decoded = decode_hcs(*bytes);
+    ASSERT_TRUE(decoded) << c.name << ": " << decoded.error().message;
+    auto reference = quantized_reference(c.mesh, opt.quant_bits);
+    ASSERT_TRUE(reference);
+    expect_exact(*decoded, *reference);
+  }
+}
+
+TEST_P(ProceduralRoundTrip, EveryRecordBoundaryIsAValidMeshWithIndexCounts) {
+  Case c = procedural_cases()[GetParam()];
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 100;
+  auto bytes = encode_hcs(c.mesh, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  IncrementalDecoder dec;
+  uint64_t fed = 0;
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const uint64_t end = index->records[i].offset + index->records[i].size;
+    auto r = dec.feed(std::span<const uint8_t>(bytes->data() + fed, end - fed));
+    fed = end;
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ(dec.records_decoded(), i + 1);
+    EXPECT_EQ(dec.resume_offset(), end);
+    EXPECT_EQ(dec.mesh().vertex_count(), index->records[i].vertices);
+    EXPECT_EQ(dec.mesh().face_count(), index->records[i].faces);
+    expect_valid(dec.mesh(), std::string(c.name) + " record " + std::to_string(i));
+    ASSERT_EQ(dec.last_deltas().size(), 1u);
+    if (i > 0) {
+      EXPECT_EQ(dec.last_deltas()[0].added_vertices.size(),
+                index->records[i].vertices - index->records[i - 1].vertices);
+    }
+  }
+  EXPECT_TRUE(dec.finished());
+}
+
+TEST_P(ProceduralRoundTrip, ByteByByteFeedingEqualsOneFeed) {
+  Case c = procedural_cases()[GetParam()];
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 150;
+  auto bytes = encode_hcs(c.mesh, opt);
+  ASSERT_TRUE(bytes);
+  auto whole = decode_hcs(*bytes);
+  ASSERT_TRUE(whole);
+  IncrementalDecoder dec;
+  uint32_t applied = 0;
+  for (uint8_t b : *bytes) {
+    auto r = dec.feed(std::span<const uint8_t>(&b, 1));
+    ASSERT_TRUE(r) << r.error().message;
+    applied += *r;
+  }
+  EXPECT_TRUE(dec.finished());
+  EXPECT_EQ(applied, dec.index()->records.size());
+  EXPECT_EQ(dec.mesh().positions, whole->positions);
+  EXPECT_EQ(dec.mesh().triangles, whole->triangles);
+}
+
+INSTANTIATE_TEST_SUITE_P(Meshes, ProceduralRoundTrip, ::testing::Range(0, 6));
+
+TEST(Codec, LayersRemoveAFifthOrMore) {
+  Mesh m = icosphere(5, 0.1f);  // 10242 vertices
+  EncodeOptions opt;
+  auto bytes = encode_hcs(m, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  const StreamHeader& h = index->header;
+  EXPECT_LE(h.base_vertex_count, 2 * opt.target_base_vertices);
+  // log n layers: each keeps at most ~4/5 of the vertices on average.
+  const double per_layer = std::pow(double(h.base_vertex_count) / h.vertex_count, 1.0 / h.layer_count);
+  EXPECT_LT(per_layer, 0.8) << h.layer_count << " layers";
+}
+
+TEST(Codec, ResumeAtRecordBoundary) {
+  Mesh m = icosphere(3, 0.1f);
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 100;
+  auto bytes = encode_hcs(m, opt);
+  ASSERT_TRUE(bytes);
+  IncrementalDecoder dec;
+  const size_t half = bytes->size() / 2;
+  ASSERT_TRUE(dec.feed(std::span<const uint8_t>(bytes->data(), half)));
+  const uint64_t resume = dec.resume_offset();
+  ASSERT_GT(resume, 0u);
+  ASSERT_TRUE(dec.resume_at(resume));
+  ASSERT_TRUE(dec.feed(std::span<const uint8_t>(bytes->data() + resume, bytes->size() - resume)));
+  EXPECT_TRUE(dec.finished());
+  auto whole = decode_hcs(*bytes);
+  EXPECT_EQ(dec.mesh().triangles, whole->triangles);
+  EXPECT_FALSE(dec.resume_at(resume + 1));
+}
+
+TEST(Codec, BudgetsSelectTheRightPrefix) {
+  Mesh m = icosphere(4, 0.1f);
+  EncodeOptions opt;
+  opt.target_base_vertices = 50;
+  opt.record_bytes = 300;
+  auto bytes = encode_hcs(m, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  const auto& rec = index->records;
+  ASSERT_GT(rec.size(), 4u);
+  auto end = [&](size_t i) { return rec[i].offset + rec[i].size; };
+  using K = DecodeBudget::Kind;
+  EXPECT_EQ(prefix_for_budget(*index, {K::kAll, 0}), bytes->size());
+  EXPECT_EQ(prefix_for_budget(*index, {K::kBytes, double(end(3))}), end(3));
+  EXPECT_EQ(prefix_for_budget(*index, {K::kBytes, double(end(3) - 1)}), end(2));
+  EXPECT_EQ(prefix_for_budget(*index, {K::kBytes, 1}), end(0));  // at least the base
+  EXPECT_EQ(prefix_for_budget(*index, {K::kVertices, double(rec[2].vertices)}), end(2));
+  EXPECT_EQ(prefix_for_budget(*index, {K::kVertices, double(rec[2].vertices + 1)}), end(2));
+  const double pct = 100.0 * rec[3].vertices / index->header.vertex_count;
+  EXPECT_EQ(prefix_for_budget(*index, {K::kPercentVertices, pct}), end(3));
+  EXPECT_EQ(prefix_for_budget(*index, {K::kPercentVertices, 100}), bytes->size());
+  // Ratio 20: the largest boundary within 1/20 of the stream.
+  const uint64_t limit = bytes->size() / 20;
+  uint64_t expect = end(0);
+  for (size_t i = 0; i < rec.size(); ++i)
+    if (end(i) <= limit) expect = end(i);
+  EXPECT_EQ(prefix_for_budget(*index, {K::kRatio, 20}), expect);
+  EXPECT_EQ(prefix_for_budget(*index, {K::kRatio, 1}), bytes->size());
+}
+
+TEST(Codec, RefusesBadInput) {
+  Mesh empty;
+  EXPECT_FALSE(encode_hcs(empty));
+  EncodeOptions opt;
+  opt.quant_bits = 7;
+  EXPECT_EQ(encode_hcs(icosphere(1), opt).error().code, ErrorCode::kInvalidArgument);
+  opt.quant_bits = 21;
+  EXPECT_FALSE(encode_hcs(icosphere(1), opt));
+  Mesh bad = icosphere(1);
+  bad.triangles.push_back(bad.triangles[0]);  // an edge with three faces
+  EXPECT_FALSE(encode_hcs(bad));
+}
+
+}  // namespace
+}  // namespace meshstream
