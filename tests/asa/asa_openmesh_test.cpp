@@ -40,24 +40,6 @@ std::vector<Triangle> om_triangles(const OMesh& om) {
   return tris;
 }
 
-// For every vertex >= old_count: its two neighbours below old_count.
-std::vector<std::array<uint32_t, 2>> parents(const std::vector<Triangle>& tris, uint32_t old_count,
-                                             uint32_t count) {
-  std::vector<std::array<uint32_t, 2>> p(count - old_count, {kNone, kNone});
-  for (const Triangle& t : tris)
-    for (int i = 0; i < 3; ++i) {
-      uint32_t a = t[i], b = t[(i + 1) % 3];
-      for (int pass = 0; pass < 2; ++pass, std::swap(a, b)) {
-        if (a >= old_count && b < old_count) {
-          auto& slot = p[a - old_count];
-          if (slot[0] == kNone) slot[0] = b;
-          else if (slot[0] != b) slot[1] = b;
-        }
-      }
-    }
-  return p;
-}
-
 // Compares `levels` uniform levels; returns the largest deviation relative
 // to the bounding-box diagonal.
 double compare_with_openmesh(const Mesh& input, int levels) {
@@ -83,13 +65,13 @@ double compare_with_openmesh(const Mesh& input, int levels) {
     if (mine.vertex_count() != om.n_vertices()) return 1e30;
     const uint32_t count = mine.vertex_count();
     std::map<std::array<uint32_t, 2>, uint32_t> ours_by_parents;
-    auto mine_parents = parents(mine.triangles, old_count, count);
+    auto mine_parents = asa_test::parents(mine.triangles, old_count, count);
     for (uint32_t i = 0; i < mine_parents.size(); ++i) {
       auto key = mine_parents[i];
       if (key[0] > key[1]) std::swap(key[0], key[1]);
       ours_by_parents[key] = old_count + i;
     }
-    auto om_parents = parents(om_triangles(om), old_count, count);
+    auto om_parents = asa_test::parents(om_triangles(om), old_count, count);
     std::vector<uint32_t> next_map(count, kNone);
     for (uint32_t v = 0; v < old_count; ++v) next_map[v] = om_to_ours[v];
     for (uint32_t i = 0; i < om_parents.size(); ++i) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -95,6 +96,25 @@ inline ::testing::AssertionResult conforming(const Mesh& input, const AsaResult&
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       return ::testing::AssertionFailure() << "non-finite position";
   return ::testing::AssertionSuccess();
+}
+
+// For every vertex >= old_count: its two neighbours below old_count (the
+// endpoints of the edge it was made on), kNone where missing.
+inline std::vector<std::array<uint32_t, 2>> parents(const std::vector<Triangle>& tris, uint32_t old_count,
+                                                    uint32_t count) {
+  std::vector<std::array<uint32_t, 2>> p(count - old_count, {kNone, kNone});
+  for (const Triangle& t : tris)
+    for (int i = 0; i < 3; ++i) {
+      uint32_t a = t[i], b = t[(i + 1) % 3];
+      for (int pass = 0; pass < 2; ++pass, std::swap(a, b)) {
+        if (a >= old_count && b < old_count) {
+          auto& slot = p[a - old_count];
+          if (slot[0] == kNone) slot[0] = b;
+          else if (slot[0] != b) slot[1] = b;
+        }
+      }
+    }
+  return p;
 }
 
 inline uint32_t edge_count(const Mesh& m) {
