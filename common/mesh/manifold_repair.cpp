@@ -27,18 +27,85 @@ uint32_t corner_at(const Mesh& mesh, uint32_t f, uint32_t v) {
   return 3 * f + (t[0] == v ? 0 : (t[1] == v ? 1 : 2));
 }
 
-// Union-find over corners: two corners are in one set when their faces share
-// an edge with exactly two faces at that corner's vertex.
-UnionFind fans_through_manifold_edges(const Mesh& mesh, const EdgeGroups& groups) {
+// Two faces kept connected across edge `edge`: uses[a] and uses[b] (indices
+// into EdgeGroups::uses). Joins of two-face edges are `required`; pairings
+// at non-manifold edges are a choice that orientation may overrule.
+struct Join {
+  uint32_t edge;
+  uint32_t a, b;
+  bool required;
+  bool cut = false;
+};
+
+// Corner sets joined across the given joins at each shared endpoint; each
+// set is one fan of faces around one vertex.
+UnionFind fans_through(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
   UnionFind sets(3 * mesh.face_count());
-  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) != 2) continue;
-    const EdgeUse& a = groups.uses[groups.begin[e]];
-    const EdgeUse& b = groups.uses[groups.begin[e] + 1];
-    sets.unite(corner_at(mesh, a.face, groups.lo[e]), corner_at(mesh, b.face, groups.lo[e]));
-    sets.unite(corner_at(mesh, a.face, groups.hi[e]), corner_at(mesh, b.face, groups.hi[e]));
+  for (const Join& j : joins) {
+    if (j.cut) continue;
+    const uint32_t fa = groups.uses[j.a].face, fb = groups.uses[j.b].face;
+    sets.unite(corner_at(mesh, fa, groups.lo[j.edge]), corner_at(mesh, fb, groups.lo[j.edge]));
+    sets.unite(corner_at(mesh, fa, groups.hi[j.edge]), corner_at(mesh, fb, groups.hi[j.edge]));
   }
   return sets;
+}
+
+std::vector<Join> two_face_joins(const EdgeGroups& groups) {
+  std::vector<Join> joins;
+  joins.reserve(groups.edge_count());
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) == 2) joins.push_back({e, groups.begin[e], groups.begin[e] + 1, true});
+  }
+  return joins;
+}
+
+// Step 1 for one non-manifold edge: a greedy matching of consistently
+// oriented pairs (opposite directions), best score first. Score: faces
+// already in one fan at both endpoints (through two-face edges) beat faces
+// in one fan at one endpoint beat the rest; ties go to agreeing normals.
+void match_nonmanifold_edge(const Mesh& mesh, const EdgeGroups& groups, uint32_t e, UnionFind& fans,
+                            std::vector<Join>& joins) {
+  const uint32_t first = groups.begin[e], count = groups.use_count(e);
+  struct Candidate {
+    float score;
+    uint32_t a, b;
+  };
+  std::vector<Candidate> candidates;
+  for (uint32_t i = 0; i < count; ++i) {
+    const EdgeUse& u = groups.uses[first + i];
+    const Vec3f nu = face_normal(mesh, u.face);
+    for (uint32_t k = i + 1; k < count; ++k) {
+      const EdgeUse& w = groups.uses[first + k];
+      if (u.forward == w.forward) continue;
+      const bool at_lo = fans.find(corner_at(mesh, u.face, groups.lo[e])) ==
+                         fans.find(corner_at(mesh, w.face, groups.lo[e]));
+      const bool at_hi = fans.find(corner_at(mesh, u.face, groups.hi[e])) ==
+                         fans.find(corner_at(mesh, w.face, groups.hi[e]));
+      const float score = 4.0f * (at_lo + at_hi) + dot(nu, face_normal(mesh, w.face));
+      candidates.push_back({score, first + i, first + k});
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& x, const Candidate& y) { return x.score > y.score; });
+  std::vector<uint32_t> taken;
+  for (const Candidate& c : candidates) {
+    if (std::find(taken.begin(), taken.end(), c.a) != taken.end() ||
+        std::find(taken.begin(), taken.end(), c.b) != taken.end()) {
+      continue;
+    }
+    taken.push_back(c.a);
+    taken.push_back(c.b);
+    joins.push_back({e, c.a, c.b, false});
+  }
+}
+
+std::vector<Join> choose_joins(const Mesh& mesh, const EdgeGroups& groups) {
+  std::vector<Join> joins = two_face_joins(groups);
+  UnionFind fans = fans_through(mesh, groups, joins);
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) > 2) match_nonmanifold_edge(mesh, groups, e, fans, joins);
+  }
+  return joins;
 }
 
 template <class T>
@@ -54,82 +121,99 @@ uint32_t add_copy(Mesh& mesh, uint32_t v) {
   return mesh.vertex_count() - 1;
 }
 
-// Step 1. Returns the number of flipped faces.
-Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups) {
-  const uint32_t f_count = mesh.face_count();
-  // Links between faces across two-face edges, as CSR; `same` = the two faces
-  // walk the edge in the same direction (one of them must flip).
-  std::vector<uint32_t> offset(f_count + 1, 0);
-  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) != 2) continue;
-    ++offset[groups.uses[groups.begin[e]].face + 1];
-    ++offset[groups.uses[groups.begin[e] + 1].face + 1];
+// Disjoint sets that also track the parity (flip or not) of each element
+// relative to its root: for orienting whole patches against each other.
+class ParityUnionFind {
+ public:
+  explicit ParityUnionFind(uint32_t n) : parent_(n), parity_(n, 0) {
+    for (uint32_t i = 0; i < n; ++i) parent_[i] = i;
   }
-  for (uint32_t f = 0; f < f_count; ++f) offset[f + 1] += offset[f];
-  struct Link {
-    uint32_t face;
-    bool same;
-  };
-  std::vector<Link> links(offset[f_count]);
-  std::vector<uint32_t> fill(offset.begin(), offset.end() - 1);
-  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) != 2) continue;
-    const EdgeUse& a = groups.uses[groups.begin[e]];
-    const EdgeUse& b = groups.uses[groups.begin[e] + 1];
-    const bool same = a.forward == b.forward;
-    links[fill[a.face]++] = {b.face, same};
-    links[fill[b.face]++] = {a.face, same};
+  // Root of x; `parity` = x's flip relative to the root.
+  uint32_t find(uint32_t x, uint8_t& parity) {
+    parity = 0;
+    uint32_t root = x;
+    while (parent_[root] != root) {
+      parity ^= parity_[root];
+      root = parent_[root];
+    }
+    // Path compression with parity fix-up.
+    uint8_t p = parity;
+    while (parent_[x] != root) {
+      const uint32_t next = parent_[x];
+      const uint8_t own = parity_[x];
+      parent_[x] = root;
+      parity_[x] = p;
+      p ^= own;
+      x = next;
+    }
+    return root;
+  }
+  // Requires flip(a) ^ flip(b) == relation; false when that contradicts
+  // what is already known.
+  bool unite(uint32_t a, uint32_t b, uint8_t relation) {
+    uint8_t pa = 0, pb = 0;
+    const uint32_t ra = find(a, pa), rb = find(b, pb);
+    if (ra == rb) return (pa ^ pb) == relation;
+    parent_[rb] = ra;
+    parity_[rb] = pa ^ pb ^ relation;
+    return true;
   }
 
-  std::vector<int8_t> flip(f_count, -1);
-  std::vector<uint32_t> component;
-  std::deque<uint32_t> queue;
-  uint32_t flipped_total = 0;
-  for (uint32_t start = 0; start < f_count; ++start) {
-    if (flip[start] >= 0) continue;
-    component.clear();
-    flip[start] = 0;
-    queue.push_back(start);
-    uint32_t flipped = 0;
-    while (!queue.empty()) {
-      const uint32_t f = queue.front();
-      queue.pop_front();
-      component.push_back(f);
-      for (uint32_t k = offset[f]; k < offset[f + 1]; ++k) {
-        const Link& link = links[k];
-        const int8_t want = static_cast<int8_t>(flip[f] ^ (link.same ? 1 : 0));
-        if (flip[link.face] < 0) {
-          flip[link.face] = want;
-          flipped += want;
-          queue.push_back(link.face);
-        } else if (flip[link.face] != want) {
-          const Triangle& t = mesh.triangles[f];
-          return make_error(ErrorCode::kNonManifold,
-                            "the surface containing face " + std::to_string(f) + " (" +
-                                where(mesh, t[0]) +
-                                ", ...) cannot be oriented consistently (non-orientable, like a "
-                                "Moebius strip)");
-        }
-      }
-    }
-    // Keep the majority's orientation: flip the fewest faces.
-    const bool invert = 2 * flipped > component.size();
-    for (uint32_t f : component) {
-      const bool do_flip = (flip[f] == 1) != invert;
-      if (do_flip) {
-        std::swap(mesh.triangles[f][1], mesh.triangles[f][2]);
-        ++flipped_total;
-      }
+ private:
+  std::vector<uint32_t> parent_;
+  std::vector<uint8_t> parity_;
+};
+
+// Step 2. Orients patches through required joins (a contradiction there is a
+// non-orientable surface: error), then glues patches through optional joins
+// where they agree and cuts the ones that contradict. Returns the number of
+// flipped faces; marks cut joins.
+Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups, std::vector<Join>& joins) {
+  const uint32_t f_count = mesh.face_count();
+  ParityUnionFind faces(f_count);
+  for (const Join& j : joins) {
+    if (!j.required) continue;
+    const EdgeUse& a = groups.uses[j.a];
+    const EdgeUse& b = groups.uses[j.b];
+    if (!faces.unite(a.face, b.face, a.forward == b.forward ? 1 : 0)) {
+      const Triangle& t = mesh.triangles[a.face];
+      return make_error(ErrorCode::kNonManifold,
+                        "the surface containing face " + std::to_string(a.face) + " (" +
+                            where(mesh, t[0]) +
+                            ", ...) cannot be oriented consistently (non-orientable, like a "
+                            "Moebius strip)");
     }
   }
-  return flipped_total;
+  for (Join& j : joins) {
+    if (j.required) continue;
+    const EdgeUse& a = groups.uses[j.a];
+    const EdgeUse& b = groups.uses[j.b];
+    if (!faces.unite(a.face, b.face, a.forward == b.forward ? 1 : 0)) j.cut = true;
+  }
+  // Keep the majority's orientation in every glued set: flip the fewest.
+  std::vector<uint8_t> flip(f_count);
+  std::vector<uint32_t> root(f_count), flipped_in(f_count, 0), size_of(f_count, 0);
+  for (uint32_t f = 0; f < f_count; ++f) {
+    root[f] = faces.find(f, flip[f]);
+    flipped_in[root[f]] += flip[f];
+    ++size_of[root[f]];
+  }
+  uint32_t flipped = 0;
+  for (uint32_t f = 0; f < f_count; ++f) {
+    const bool invert = 2 * flipped_in[root[f]] > size_of[root[f]];
+    if ((flip[f] != 0) != invert) {
+      std::swap(mesh.triangles[f][1], mesh.triangles[f][2]);
+      ++flipped;
+    }
+  }
+  return flipped;
 }
 
-// Step 2. Returns the number of vertex copies made.
-uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups) {
-  UnionFind sets = fans_through_manifold_edges(mesh, groups);
+// Step 3. Returns the number of vertex copies made.
+uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
+  UnionFind sets = fans_through(mesh, groups, joins);
   const uint32_t corner_count = 3 * mesh.face_count();
-  std::vector<uint32_t> owner(mesh.vertex_count(), kNone);  // root keeping the original
+  std::vector<uint32_t> owner(mesh.vertex_count(), kNone);  // fan keeping the original
   std::vector<uint32_t> root_vertex(corner_count, kNone);
   uint32_t copies = 0;
   for (uint32_t c = 0; c < corner_count; ++c) {
@@ -149,27 +233,31 @@ uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups) {
   return copies;
 }
 
-// Step 3. Returns {faces detached, vertex copies made}.
+// Step 4. Returns {faces detached, vertex copies made}.
 std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& groups) {
   std::vector<uint8_t> detach(mesh.face_count(), 0);
   bool any = false;
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    const uint32_t count = groups.use_count(e);
-    if (count <= 2) continue;
-    const EdgeUse* uses = &groups.uses[groups.begin[e]];
-    uint32_t keep_a = 0, keep_b = kNone;
-    for (uint32_t i = 0; i < count && keep_b == kNone; ++i) {
-      for (uint32_t j = i + 1; j < count; ++j) {
-        if (uses[i].forward != uses[j].forward) {
+    if (groups.use_count(e) <= 2) continue;
+    // Best consistently oriented pair by normals (no fans to consult here:
+    // these faces already share both endpoints).
+    const uint32_t first = groups.begin[e], count = groups.use_count(e);
+    uint32_t keep_a = first, keep_b = kNone;
+    float best = -4.0f;
+    for (uint32_t i = first; i < first + count; ++i) {
+      for (uint32_t k = i + 1; k < first + count; ++k) {
+        if (groups.uses[i].forward == groups.uses[k].forward) continue;
+        const float score = dot(face_normal(mesh, groups.uses[i].face), face_normal(mesh, groups.uses[k].face));
+        if (score > best) {
+          best = score;
           keep_a = i;
-          keep_b = j;
-          break;
+          keep_b = k;
         }
       }
     }
-    for (uint32_t i = 0; i < count; ++i) {
+    for (uint32_t i = first; i < first + count; ++i) {
       if (i != keep_a && i != keep_b) {
-        detach[uses[i].face] = 1;
+        detach[groups.uses[i].face] = 1;
         any = true;
       }
     }
@@ -213,7 +301,7 @@ Status check_manifold(const Mesh& mesh) {
                             edge_name(mesh, groups.lo[e], groups.hi[e]) + " in the same direction");
     }
   }
-  UnionFind sets = fans_through_manifold_edges(mesh, groups);
+  UnionFind sets = fans_through(mesh, groups, two_face_joins(groups));
   std::vector<uint32_t> first_root(mesh.vertex_count(), kNone);
   for (uint32_t c = 0; c < 3 * mesh.face_count(); ++c) {
     const uint32_t v = mesh.triangles[c / 3][c % 3];
@@ -222,8 +310,7 @@ Status check_manifold(const Mesh& mesh) {
       first_root[v] = root;
     } else if (first_root[v] != root) {
       return make_error(ErrorCode::kNonManifold,
-                        "non-manifold vertex: " + where(mesh, v) +
-                            " joins several separate fans of faces");
+                        "non-manifold vertex: " + where(mesh, v) + " joins several separate fans of faces");
     }
   }
   return {};
@@ -234,11 +321,13 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
   constexpr int kMaxRounds = 32;
   for (int round = 0; round < kMaxRounds; ++round) {
     EdgeGroups groups = build_edge_groups(mesh);
-    auto flipped = orient(mesh, groups);
+    std::vector<Join> joins = choose_joins(mesh, groups);
+    auto flipped = orient(mesh, groups, joins);
     if (!flipped) return tl::unexpected(flipped.error());
     counts.flipped_faces += *flipped;
-    if (*flipped > 0) groups = build_edge_groups(mesh);
-    const uint32_t split = split_fans(mesh, groups);
+    // Flipping changes no vertex of any face, so groups and joins stay valid
+    // for the fan split (only the directions recorded in them are stale).
+    const uint32_t split = split_fans(mesh, groups, joins);
     counts.split_vertices += split;
     if (split > 0) groups = build_edge_groups(mesh);
     const auto [detached, copies] = detach_extra_faces(mesh, groups);

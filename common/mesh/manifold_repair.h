@@ -25,17 +25,21 @@ Status check_manifold(const Mesh& mesh);
 // Makes the mesh manifold and consistently oriented, in the spirit of
 // Guéziec, Taubin, Lazarus, Horn, "Cutting and stitching: converting sets of
 // polygons to manifold surfaces" (IEEE TVCG 2001), keeping every face:
-//  1. orient each surface by breadth-first search across edges with exactly
-//     two faces, flipping the minority of faces in each component;
-//  2. split every vertex into one copy per fan of faces (fans connected
-//     through two-face edges only), which also cuts edges with more than two
-//     faces apart wherever their faces belong to different fans;
-//  3. where an edge still has more than two faces, keep one consistently
-//     oriented pair and detach the other faces (own vertex copies);
+//  1. decide which faces stay joined across each edge: both faces of a
+//     two-face edge; at an edge with more than two faces, a matching of
+//     consistently oriented pairs, preferring faces already connected around
+//     both endpoints, then faces whose normals agree (the surface continuing
+//     most smoothly; fins and crossing sheets are cut off);
+//  2. orient each surface by breadth-first search across the joins, flipping
+//     the minority of faces; a pairing at a non-manifold edge that would
+//     contradict the orientation is cut instead;
+//  3. split every vertex into one copy per fan of joined faces;
+//  4. where an edge still has more than two faces, keep the best pair and
+//     detach the other faces (own vertex copies);
 //  repeat until nothing changes. Copies keep the position and attributes.
-// Fails with kNonManifold when a component cannot be oriented (Möbius-like).
-// The result always passes Adjacency::build. O((V + F) * rounds), rounds
-// is small (2-3 on real data).
+// Fails with kNonManifold when a surface is non-orientable through its
+// two-face edges alone (Möbius-like). The result always passes
+// Adjacency::build. O((V + F) * rounds); rounds is small (2-3 on real data).
 Result<RepairCounts> make_manifold(Mesh& mesh);
 
 }  // namespace meshstream

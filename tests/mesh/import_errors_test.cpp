@@ -10,6 +10,7 @@
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/import.h"
+#include "common/mesh/topology.h"
 #include "tests/test_meshes.h"
 
 namespace meshstream {
@@ -208,6 +209,34 @@ TEST(ImportErrors, ThreeSheetsOnOneEdgeAreDetached) {
   EXPECT_EQ(imported->report.nonmanifold_edges, 1u);
   EXPECT_EQ(imported->mesh.face_count(), 3u);
   EXPECT_TRUE(Adjacency::build(imported->mesh));
+}
+
+TEST(ImportErrors, TwoSheetsCrossingAlongAnEdgeSeparateCleanly) {
+  // Two flat sheets (one in z = 0, one in y = 0) share the edge (1, 2): four
+  // faces there. The repair pairs each sheet's faces and splits the edge's
+  // vertices instead of cutting faces off.
+  TempFile file("cross.obj",
+                "v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0.5 -1 0\nv 0.5 0 1\nv 0.5 0 -1\n"
+                "f 1 2 3\nf 2 1 4\nf 1 2 5\nf 2 1 6\n");
+  auto imported = import_mesh(file.path());
+  ASSERT_TRUE(imported) << imported.error().message;
+  EXPECT_EQ(imported->report.nonmanifold_edges, 1u);
+  EXPECT_EQ(imported->report.detached_faces, 0u);
+  EXPECT_EQ(imported->report.split_vertices, 2u);
+  const MeshStats stats = compute_stats(imported->mesh);
+  EXPECT_EQ(stats.components, 2u);
+  EXPECT_EQ(stats.boundary_edges, 8u);
+  EXPECT_TRUE(Adjacency::build(imported->mesh));
+}
+
+TEST(ImportErrors, WrapIsSplitIntoItsTwoSheets) {
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  auto imported = import_mesh(testing::test_mesh("non_manifold_wrap.obj"));
+  ASSERT_TRUE(imported) << imported.error().message;
+  EXPECT_EQ(imported->report.detached_faces, 0u);
+  const MeshStats stats = compute_stats(imported->mesh);
+  EXPECT_EQ(stats.components, 2u);
+  EXPECT_EQ(stats.boundary_edges, 8u);  // as in the file: no new cut
 }
 
 }  // namespace
