@@ -31,32 +31,50 @@ class LayerBuilder {
   // Importance of removing v (lower first), or a negative value when v
   // cannot be removed at all.
   double cost(uint32_t v) {
-    if (m_.is_isolated(v) || m_.is_boundary(v)) return -1;
+    if (m_.is_isolated(v)) return -1;
     m_.star(v, ring_, corners_);
     const size_t k = ring_.size();
     if (k < 3 || k > kMaxRemovalValence) return -1;
+    const bool boundary = m_.is_boundary(v);
     const auto& p = m_.positions();
     Vec3d normal{}, centroid{};
-    for (size_t i = 0; i < k; ++i) {
+    for (size_t i = 0; i < corners_.size(); ++i) {
       Vec3l n = cross_l(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
       normal += Vec3d{double(n.x), double(n.y), double(n.z)};
+    }
+    for (size_t i = 0; i < k; ++i) {
       centroid += Vec3d{double(p[ring_[i]].x), double(p[ring_[i]].y), double(p[ring_[i]].z)};
     }
     centroid = centroid / double(k);
-    const Vec3d d = Vec3d{double(p[v].x), double(p[v].y), double(p[v].z)} - centroid;
+    const Vec3d pv{double(p[v].x), double(p[v].y), double(p[v].z)};
+    const Vec3d d = pv - centroid;
     const double nl = length(normal);
     const double plane = nl > 0 ? std::abs(dot(d, normal)) / nl : length(d);
-    return plane + 0.05 * length(d);
+    double line = 0;
+    if (boundary) {
+      const Vec3i a = p[ring_[0]], b = p[ring_[k - 1]];
+      const Vec3d ad{double(a.x), double(a.y), double(a.z)};
+      const Vec3d ab = Vec3d{double(b.x), double(b.y), double(b.z)} - ad;
+      const double abl = length(ab);
+      line = abl > 0 ? length(cross(pv - ad, ab)) / abl : length(pv - ad);
+    }
+    return plane + 0.5 * length(d) + line;
   }
 
   // Tries to remove v; returns true and fills `removal` on success.
   bool try_remove(uint32_t v, Removal& removal) {
     m_.star(v, ring_, corners_);
     const uint32_t k = static_cast<uint32_t>(ring_.size());
-    if (m_.is_boundary(v) || k < 3 || k > kMaxRemovalValence || corners_.size() != k) return false;
+    const bool boundary = m_.is_boundary(v);
+    if (k < 3 || k > kMaxRemovalValence || corners_.size() != (boundary ? k - 1 : k)) return false;
     const auto& p = m_.positions();
+    if (boundary) {
+      // The new boundary edge (ring[k-1], ring[0]) must not exist yet.
+      m_.star(ring_[k - 1], apex_ring_, apex_corners_);
+      if (std::find(apex_ring_.begin(), apex_ring_.end(), ring_[0]) != apex_ring_.end()) return false;
+    }
     Vec3l star_normal{0, 0, 0};
-    for (uint32_t i = 0; i < k; ++i) {
+    for (uint32_t i = 0; i < corners_.size(); ++i) {
       Vec3l n = cross_l(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
       star_normal = {star_normal.x + n.x, star_normal.y + n.y, star_normal.z + n.z};
     }
@@ -70,7 +88,7 @@ class LayerBuilder {
       const uint32_t apex = ring_[a];
       m_.star(apex, apex_ring_, apex_corners_);
       bool ok = true;
-      if (k == 3) {
+      if (k == 3 && !boundary) {
         // The single new triangle must not already exist (a tetrahedron's
         // last vertex): look for a face of the apex holding both others.
         const uint32_t b = ring_[(a + 1) % 3], c = ring_[(a + 2) % 3];
@@ -116,6 +134,7 @@ class LayerBuilder {
     removal.position = p[v];
     removal.ring.resize(k);
     for (uint32_t i = 0; i < k; ++i) removal.ring[i] = ring_[(best_apex + i) % k];
+    removal.open = boundary ? (2 * k - 1 - best_apex) % k : kNone;
     m_.remove_vertex(v, ring_, corners_, best_apex);
     return true;
   }

@@ -4,19 +4,24 @@
 // order; within a layer the patches are disjoint, so any order works.
 //
 // Rules for a removal (checked against the mesh at the time of removal):
-// - v is interior (boundary vertices are kept: the boundary and every
-//   component survive unchanged), valence 3..kMaxRemovalValence;
+// - valence 3..kMaxRemovalValence; a boundary vertex (at least two faces)
+//   is removed along the boundary: the new boundary edge joins its two
+//   boundary neighbours, so boundary loops and components survive (a
+//   component never loses its last face: k-2 >= 1 faces remain);
 // - v is not adjacent to a vertex removed earlier in the layer
 //   (independence: stars are disjoint, so patches never overlap; two
 //   removed vertices may share ring vertices);
-// - the fan's diagonals are not existing edges (no non-manifold edge, genus
-//   kept), and for valence 3 the new triangle is not already a face;
+// - no new edge (the fan's diagonals, and for a boundary vertex the new
+//   boundary edge) already exists (no non-manifold edge; Euler characteristic
+//   and boundary loops kept, so genus is kept), and for an interior valence-3
+//   vertex the new triangle is not already a face;
 // - no fan triangle is degenerate on the grid (zero area, exact integers) or
 //   turns against the star's normal (cosine <= kMinFanCosine).
 // Among valid apexes the one whose worst fan triangle is the best shaped wins.
-// Importance = distance of v from the least-squares plane of its star (area
-// normal through the ring centroid) plus a small share of its distance from
-// the ring average (the decoder's prediction), cheapest first.
+// Importance = distance of v from the plane of its star (area normal
+// through the ring centroid) plus half its distance from the ring average
+// (the decoder's prediction); for a boundary vertex plus its distance from
+// the new boundary edge's line (the boundary's shape). Cheapest first.
 #pragma once
 
 #include <cstdint>
@@ -32,6 +37,9 @@ struct Removal {
   uint32_t vertex = 0;          // id in the input mesh
   std::vector<uint32_t> ring;   // ring[0] is the fan apex; CCW around vertex
   Vec3i position;
+  // kNone for an interior vertex; for a boundary vertex the index i of the
+  // ring edge (ring[i], ring[i+1]) that its removal turned into a boundary edge.
+  uint32_t open = kNone;
 };
 
 struct DecimationResult {

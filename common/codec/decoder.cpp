@@ -56,12 +56,14 @@ struct IncrementalDecoder::State {
     if (r0.vertices != h.base_vertex_count || r0.faces != h.base_face_count) {
       return make_error(ErrorCode::kCorrupt, "base record counts differ from the header's");
     }
-    // Every refinement adds a vertex and two faces: counts must follow.
-    for (size_t i = 0; i < index->records.size(); ++i) {
+    // Every refinement adds vertices, and one or two faces per vertex.
+    for (size_t i = 1; i < index->records.size(); ++i) {
       const RecordEntry& r = index->records[i];
-      if (uint64_t(r.faces) + 2 * uint64_t(h.base_vertex_count) != uint64_t(h.base_face_count) + 2 * uint64_t(r.vertices)) {
+      const RecordEntry& q = index->records[i - 1];
+      const uint64_t added = uint64_t(r.vertices) - q.vertices;
+      if (uint64_t(r.faces) < uint64_t(q.faces) + added || uint64_t(r.faces) > uint64_t(q.faces) + 2 * added) {
         return make_error(ErrorCode::kCorrupt, "record " + std::to_string(i) +
-                                                   " counts break faces = base faces + 2 x added vertices");
+                                                   " counts break 1..2 faces per added vertex");
       }
     }
     grid.bounds = h.bounds;

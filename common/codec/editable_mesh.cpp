@@ -84,30 +84,39 @@ void EditableMesh::remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
                                  const std::vector<uint32_t>& corners, uint32_t a) {
   const uint32_t k = static_cast<uint32_t>(ring.size());
   auto R = [&](uint32_t i) { return ring[(a + i) % k]; };
-  // o[i]: the corner outside across ring edge (R_a+i, R_a+i+1), i relative to a.
-  uint32_t o_small[32];
-  std::vector<uint32_t> o_big;
-  uint32_t* o = o_small;
-  if (k > 32) {
-    o_big.resize(k);
-    o = o_big.data();
-  }
-  uint32_t slot_small[32];
-  std::vector<uint32_t> slot_big;
-  uint32_t* slot = slot_small;
-  if (k > 32) {
-    slot_big.resize(k);
-    slot = slot_big.data();
-  }
+  // Relative to the apex: o[i] is the corner outside ring edge e_i =
+  // (R_a+i, R_a+i+1), slot[i] the face of star face S_a+i; for a boundary
+  // vertex the star misses the face of its open edge (ring[k-1], ring[0]).
+  const uint32_t open = boundary_[v] ? (k - 1 + k - a) % k : kNone;
+  uint32_t o[kMaxPatchValence], slot[kMaxPatchValence];
   for (uint32_t i = 0; i < k; ++i) {
-    const uint32_t c = corners[(a + i) % k];
-    o[i] = opposite_[c];
-    slot[i] = face_of(c);
+    if (i == open) {
+      o[i] = kNone;
+      slot[i] = kNone;
+    } else {
+      const uint32_t c = corners[(a + i) % k];
+      o[i] = opposite_[c];
+      slot[i] = face_of(c);
+    }
   }
   if (dead_.empty()) dead_.assign(faces_.size(), 0);
-  // T_j goes to the slot of S_a+j (same outer ring edge); S_a and S_a-1 die.
+  // T_j takes the slot of S_a+j (same outer ring edge); a missing one takes
+  // a spare from S_a / S_a-1; what is left dies.
+  uint32_t spare[2] = {slot[0], slot[k - 1]};
+  uint32_t fan_slot[kMaxPatchValence];
   for (uint32_t j = 1; j + 1 < k; ++j) {
-    const uint32_t f = slot[j];
+    if (slot[j] != kNone) {
+      fan_slot[j] = slot[j];
+    } else if (spare[0] != kNone) {
+      fan_slot[j] = spare[0];
+      spare[0] = kNone;
+    } else {
+      fan_slot[j] = spare[1];
+      spare[1] = kNone;
+    }
+  }
+  for (uint32_t j = 1; j + 1 < k; ++j) {
+    const uint32_t f = fan_slot[j];
     set_face(f, {R(0), R(j), R(j + 1)});
     const uint32_t b = 3 * f;
     set_opposite(b, o[j]);
@@ -116,16 +125,17 @@ void EditableMesh::remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
       set_opposite(b + 1, o[k - 1]);
       if (o[k - 1] != kNone) set_opposite(o[k - 1], b + 1);
     } else {
-      set_opposite(b + 1, 3 * slot[j + 1] + 2);
+      set_opposite(b + 1, 3 * fan_slot[j + 1] + 2);
     }
     if (j == 1) {
       set_opposite(b + 2, o[0]);
       if (o[0] != kNone) set_opposite(o[0], b + 2);
     } else {
-      set_opposite(b + 2, 3 * slot[j - 1] + 1);
+      set_opposite(b + 2, 3 * fan_slot[j - 1] + 1);
     }
   }
-  for (uint32_t f : {slot[0], slot[k - 1]}) {
+  for (uint32_t f : spare) {
+    if (f == kNone) continue;
     dead_[f] = 1;
     for (int i = 0; i < 3; ++i) opposite_[3 * f + i] = kNone;
   }
@@ -137,40 +147,29 @@ void EditableMesh::remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
       if (slot[i] == f) return true;
     return false;
   };
-  // Apex: its corner in T_1; boundary start when ring edge (R_a, R_a+1) is open.
-  if (o[0] == kNone || in_star(vertex_corner_[R(0)])) vertex_corner_[R(0)] = 3 * slot[1];
+  // A boundary vertex starts at the corner whose outgoing edge is open.
+  if (o[0] == kNone || in_star(vertex_corner_[R(0)])) vertex_corner_[R(0)] = 3 * fan_slot[1];
   for (uint32_t j = 1; j < k; ++j) {
     const uint32_t u = R(j);
     if (j + 1 < k) {
-      if (o[j] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * slot[j] + 1;
+      if (o[j] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * fan_slot[j] + 1;
     } else {
       // R_a-1 sits only in T_k-2 (corner 2); its outgoing ring edge goes to the apex.
-      if (o[k - 1] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * slot[k - 2] + 2;
+      if (o[k - 1] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * fan_slot[k - 2] + 2;
     }
   }
 }
 
 uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
-                                     const std::vector<uint32_t>& fan_corners, Vec3i position,
-                                     std::vector<uint32_t>* touched) {
+                                     const std::vector<uint32_t>& fan_corners, uint32_t open,
+                                     Vec3i position, std::vector<uint32_t>* touched) {
   const uint32_t k = static_cast<uint32_t>(ring.size());
   const uint32_t v = static_cast<uint32_t>(positions_.size());
   positions_.push_back(position);
   vertex_corner_.push_back(kNone);
-  boundary_.push_back(0);
+  boundary_.push_back(open == kNone ? 0 : 1);
 
-  uint32_t o_small[32];
-  std::vector<uint32_t> o_big;
-  uint32_t* o = o_small;
-  uint32_t slot_small[32];
-  std::vector<uint32_t> slot_big;
-  uint32_t* slot = slot_small;
-  if (k > 32) {
-    o_big.resize(k);
-    slot_big.resize(k);
-    o = o_big.data();
-    slot = slot_big.data();
-  }
+  uint32_t o[kMaxPatchValence], slot[kMaxPatchValence];
   // Outer corners of ring edges e_i = (R_i, R_i+1).
   for (uint32_t j = 1; j + 1 < k; ++j) {
     o[j] = opposite_[fan_corners[j - 1]];
@@ -178,34 +177,59 @@ uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
   }
   o[0] = opposite_[prev(fan_corners[0])];
   o[k - 1] = opposite_[next(fan_corners[k - 3])];
-  const uint32_t first_new = static_cast<uint32_t>(faces_.size());
-  slot[0] = first_new;
-  slot[k - 1] = first_new + 1;
-  faces_.resize(first_new + 2);
-  opposite_.resize(3 * (first_new + 2), kNone);
-  if (!dead_.empty()) dead_.resize(first_new + 2, 0);
+  // Star face S_i = (v, R_i, R_i+1) for every i but `open`. S_j reuses fan
+  // slot T_j; S_0 and S_k-1 take the slot freed by the open face, if any,
+  // then new slots at the end.
+  uint32_t first_new = static_cast<uint32_t>(faces_.size());
+  uint32_t appended = 0;
+  uint32_t freed = kNone;
+  if (open != kNone && open >= 1 && open + 1 < k) {
+    freed = slot[open];
+    slot[open] = kNone;
+  }
+  slot[0] = slot[k - 1] = kNone;
+  for (uint32_t i : {0u, k - 1}) {
+    if (i == open) continue;
+    if (freed != kNone) {
+      slot[i] = freed;
+      freed = kNone;
+    } else {
+      slot[i] = first_new + appended++;
+    }
+  }
+  faces_.resize(first_new + appended);
+  opposite_.resize(3 * (first_new + appended), kNone);
+  if (!dead_.empty()) dead_.resize(first_new + appended, 0);
 
   for (uint32_t i = 0; i < k; ++i) {
+    if (i == open) continue;
     const uint32_t f = slot[i];
     set_face(f, {v, ring[i], ring[(i + 1) % k]});
     const uint32_t b = 3 * f;
     set_opposite(b, o[i]);
     if (o[i] != kNone) set_opposite(o[i], b);
-    set_opposite(b + 1, 3 * slot[(i + 1) % k] + 2);
-    set_opposite(b + 2, 3 * slot[(i + k - 1) % k] + 1);
+    const uint32_t after = (i + 1) % k, before = (i + k - 1) % k;
+    set_opposite(b + 1, after == open ? kNone : 3 * slot[after] + 2);
+    set_opposite(b + 2, before == open ? kNone : 3 * slot[before] + 1);
     if (touched) touched->push_back(f);
   }
-  vertex_corner_[v] = 3 * slot[0];
+  // The new vertex starts at the face after its open edge (any face if interior).
+  vertex_corner_[v] = open == kNone ? 3 * slot[0] : 3 * slot[(open + 1) % k];
   auto in_fan = [&](uint32_t c) {
     if (c == kNone) return false;
     const uint32_t f = face_of(c);
-    for (uint32_t j = 1; j + 1 < k; ++j)
-      if (slot[j] == f) return true;
+    for (uint32_t j = 0; j + 2 < k; ++j)
+      if (face_of(fan_corners[j]) == f) return true;
     return false;
   };
   for (uint32_t i = 0; i < k; ++i) {
     const uint32_t u = ring[i];
-    if (o[i] == kNone || in_fan(vertex_corner_[u])) set_vertex_corner(u, 3 * slot[i] + 1);
+    if (i == open) {
+      // Its outgoing boundary edge is now (R_i, v), in S_i-1 at corner 2.
+      set_vertex_corner(u, 3 * slot[(i + k - 1) % k] + 2);
+    } else if (o[i] == kNone || in_fan(vertex_corner_[u])) {
+      set_vertex_corner(u, 3 * slot[i] + 1);
+    }
   }
   return v;
 }

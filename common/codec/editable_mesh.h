@@ -26,6 +26,9 @@
 
 namespace meshstream {
 
+// Largest ring an edit handles (the codec limits removals to far less).
+inline constexpr uint32_t kMaxPatchValence = 64;
+
 class EditableMesh {
  public:
   // Builds from a manifold, consistently oriented mesh (checked through
@@ -57,20 +60,24 @@ class EditableMesh {
   // same on encoder and decoder. O(valence).
   void star(uint32_t v, std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) const;
 
-  // Encoder: removes interior vertex v whose star is (ring, corners), k =
-  // |ring| >= 3, and fills the hole with the fan from ring[apex]:
-  // T_j = (R_a, R_a+j, R_a+j+1), j = 1..k-2. The caller has checked that no
-  // diagonal already exists. O(k).
+  // Encoder: removes vertex v whose star is (ring, corners), 3 <= k =
+  // |ring| <= kMaxPatchValence, and fills the hole with the fan from
+  // ring[apex]: T_j = (R_a, R_a+j, R_a+j+1), j = 1..k-2. A boundary vertex's
+  // hole is closed by the new boundary edge (ring[k-1], ring[0]). The caller
+  // has checked that no new edge already exists. O(k).
   void remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
                      const std::vector<uint32_t>& corners, uint32_t apex);
 
   // Decoder: inserts a new vertex at `position` into the fan patch around
   // ring[0] whose k-2 faces have the corners `fan_corners` at ring[0]
-  // (fan_corners[j-1] in face (R_0, R_j, R_j+1)). Returns the new vertex id;
-  // appends every face slot it wrote to `touched`. The caller has validated
-  // the patch (see resolve in refinement_codec). O(k).
+  // (fan_corners[j-1] in face (R_0, R_j, R_j+1)). `open` = kNone for an
+  // interior vertex (k new faces replace k-2); for a boundary vertex it is
+  // the index i of the boundary ring edge (R_i, R_i+1) that the vertex
+  // re-enters (k-1 faces replace k-2). Returns the new vertex id; appends
+  // every face slot it wrote to `touched`. The caller has validated the
+  // patch (refinement_codec's resolve_patch). O(k).
   uint32_t insert_vertex(const std::vector<uint32_t>& ring, const std::vector<uint32_t>& fan_corners,
-                         Vec3i position, std::vector<uint32_t>* touched);
+                         uint32_t open, Vec3i position, std::vector<uint32_t>* touched);
 
   // Undo journal (decoder): while a mark is open every change is logged, and
   // rollback() restores the state of mark() exactly.

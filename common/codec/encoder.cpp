@@ -176,13 +176,23 @@ class RecordWriter {
             patches[j].ring != r.ring) {
           return make_error(ErrorCode::kInvalidMesh, "internal: patch does not resolve to its ring");
         }
+        patch_boundary_edges(s_.mesh, patches[j], open_edges_);
+        if (!open_edges_.empty()) {
+          uint32_t choice = 0;
+          for (uint32_t e = 0; e < open_edges_.size(); ++e)
+            if (open_edges_[e] == r.open) choice = e + 1;
+          if (r.open != kNone && choice == 0)
+            return make_error(ErrorCode::kInvalidMesh, "internal: open edge of a boundary patch not on the boundary");
+          m.open_edge.encode(enc_, choice);
+        } else if (r.open != kNone) {
+          return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
+        }
         const Vec3i pred = predict_position(s_.mesh, patches[j].ring);
-        const int ctx = residual_context(s_.mesh, patches[j].ring);
-        for (int a = 0; a < 3; ++a) m.residual[ctx][a].encode(enc_, r.position[a] - pred[a]);
+        encode_residual(m, enc_, residual_context(s_.mesh, patches[j].ring), r.position, pred);
       }
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals[order[j].second];
-        const uint32_t v = apply_patch(s_, patches[j], r.position, nullptr);
+        const uint32_t v = apply_patch(s_, patches[j], r.open, r.position, nullptr);
         inserted.push_back({r.vertex, v});
       }
       insertions_ += count;
@@ -219,7 +229,7 @@ class RecordWriter {
   RangeEncoder enc_;
   bool starts_layer_ = false;
   uint32_t walk_steps_ = 0, insertions_ = 0;
-  std::vector<uint32_t> first_, next_;
+  std::vector<uint32_t> first_, next_, open_edges_;
 };
 
 }  // namespace

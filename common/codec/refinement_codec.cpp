@@ -76,23 +76,70 @@ Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ri
   return out;
 }
 
-int residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
+ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
   const auto& p = mesh.positions();
   int64_t total = 0;
+  int64_t n[3] = {0, 0, 0};
   const size_t k = ring.size();
+  const Vec3i o = p[ring[0]];
   for (size_t i = 0; i < k; ++i) {
     const Vec3i a = p[ring[i]], b = p[ring[(i + 1) % k]];
     total += std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
+    const int64_t ax = a.x - o.x, ay = a.y - o.y, az = a.z - o.z;
+    const int64_t bx = b.x - o.x, by = b.y - o.y, bz = b.z - o.z;
+    n[0] += ay * bz - az * by;
+    n[1] += az * bx - ax * bz;
+    n[2] += ax * by - ay * bx;
   }
+  ResidualContext ctx;
   // Twice log2 of the mean L1 edge length: half-octave buckets.
   const double mean = double(total) / double(k) + 1.0;
-  int ctx = static_cast<int>(2.0 * std::log2(mean));
-  return std::clamp(ctx, 0, kScaleContexts - 1);
+  ctx.scale = std::clamp(static_cast<int>(2.0 * std::log2(mean)), 0, kScaleContexts - 1);
+  std::sort(ctx.axis, ctx.axis + 3, [&](int x, int y) {
+    const int64_t ax = std::abs(n[x]), ay = std::abs(n[y]);
+    return ax > ay || (ax == ay && x < y);
+  });
+  ctx.flip = n[ctx.axis[0]] < 0;
+  return ctx;
 }
 
-uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, Vec3i position,
-                     std::vector<uint32_t>* touched) {
-  const uint32_t v = state.mesh.insert_vertex(patch.ring, patch.fan_corners, position, touched);
+void encode_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
+                     Vec3i actual, Vec3i predicted) {
+  for (int role = 0; role < 3; ++role) {
+    const int a = ctx.axis[role];
+    int32_t r = actual[a] - predicted[a];
+    if (role == 0 && ctx.flip) r = -r;
+    models.residual[ctx.scale][role].encode(enc, r);
+  }
+}
+
+bool decode_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
+                     Vec3i predicted, int32_t max_coordinate, Vec3i& out) {
+  for (int role = 0; role < 3; ++role) {
+    const int a = ctx.axis[role];
+    int64_t r = models.residual[ctx.scale][role].decode(dec);
+    if (role == 0 && ctx.flip) r = -r;
+    const int64_t value = int64_t(predicted[a]) + r;
+    if (value < 0 || value > max_coordinate) return false;
+    out[a] = static_cast<int32_t>(value);
+  }
+  return true;
+}
+
+void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
+                          std::vector<uint32_t>& out) {
+  out.clear();
+  const uint32_t k = static_cast<uint32_t>(patch.ring.size());
+  const auto& fc = patch.fan_corners;
+  if (mesh.opposite(EditableMesh::prev(fc[0])) == kNone) out.push_back(0);
+  for (uint32_t j = 1; j + 1 < k; ++j)
+    if (mesh.opposite(fc[j - 1]) == kNone) out.push_back(j);
+  if (mesh.opposite(EditableMesh::next(fc[k - 3])) == kNone) out.push_back(k - 1);
+}
+
+uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
+                     Vec3i position, std::vector<uint32_t>* touched) {
+  const uint32_t v = state.mesh.insert_vertex(patch.ring, patch.fan_corners, open, position, touched);
   const uint32_t apex = patch.ring[0];
   state.order_next.push_back(state.order_next[apex]);
   state.order_next[apex] = v;
@@ -150,6 +197,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   std::vector<uint32_t> star_ring, star_corners;
   std::vector<ResolvedPatch> patches;
   std::vector<Vec3i> positions;
+  std::vector<uint32_t> opens, open_edges;
   std::vector<uint8_t> used_faces;
   uint32_t inserted = 0;
   // Links changed in the order list, so a failure can restore them exactly.
@@ -185,6 +233,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     }
     patches.resize(count);
     positions.resize(count);
+    opens.resize(count);
     used_faces.assign(faces, 0);
     for (uint32_t i = 0; i < count; ++i) {
       uint32_t r = faces <= 16 ? m.first_face[faces].decode(dec) : m.first_face_big.decode(dec);
@@ -199,21 +248,27 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
         if (used) return fail_and_unlink("patches at vertex " + std::to_string(u) + " overlap");
         used = 1;
       }
-      const Vec3i pred = predict_position(mesh, patches[i].ring);
-      const int ctx = residual_context(mesh, patches[i].ring);
-      for (int a = 0; a < 3; ++a) {
-        const int64_t value = int64_t(pred[a]) + m.residual[ctx][a].decode(dec);
-        if (value < 0 || value > state.max_coordinate) {
-          return fail_and_unlink("vertex position outside the quantization grid at vertex " +
-                                 std::to_string(u));
+      opens[i] = kNone;
+      patch_boundary_edges(mesh, patches[i], open_edges);
+      if (!open_edges.empty()) {
+        const uint32_t choice = m.open_edge.decode(dec);
+        if (choice > open_edges.size()) {
+          return fail_and_unlink("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
+                                 std::to_string(choice) + " of " + std::to_string(open_edges.size()));
         }
-        positions[i][a] = static_cast<int32_t>(value);
+        if (choice > 0) opens[i] = open_edges[choice - 1];
+      }
+      const Vec3i pred = predict_position(mesh, patches[i].ring);
+      const ResidualContext ctx = residual_context(mesh, patches[i].ring);
+      if (!decode_residual(m, dec, ctx, pred, state.max_coordinate, positions[i])) {
+        return fail_and_unlink("vertex position outside the quantization grid at vertex " +
+                               std::to_string(u));
       }
     }
     if (dec.exhausted_badly()) return fail_and_unlink("refinement record data ends early");
     for (uint32_t i = 0; i < count; ++i) {
       link_journal.push_back({u, state.order_next[u]});
-      const uint32_t v = apply_patch(state, patches[i], positions[i], &applied.touched_faces);
+      const uint32_t v = apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
       applied.added_vertices.push_back(v);
     }
     inserted += count;

@@ -9,7 +9,9 @@
 // a spatially coherent batch). At each vertex u present before the layer it
 // reads how many patches have their fan apex at u, and for each: r, the index
 // in u's star (EditableMesh::star order) of the first fan face, and k, the
-// valence of the vertex to insert (the fan has k-2 faces). Then the vertex's
+// valence of the vertex to insert (the fan has k-2 faces); when ring edges
+// of the patch lie on the boundary, which of them (if any) the vertex
+// re-enters as a boundary vertex. Then the vertex's
 // position as a residual from the prediction (average of the k ring vertices,
 // HCS's neighbour average), per axis, through models chosen by the ring's
 // size on the grid (bigger rings, bigger residuals).
@@ -38,6 +40,7 @@ struct RefinementModels {
   AdaptiveUIntModel first_face_big;
   BitTreeModel<4> valence[13];       // k - 3 (k <= 18), by min(apex ring size, 12)
   AdaptiveIntModel residual[kScaleContexts][3];
+  AdaptiveUIntModel open_edge;       // 0 interior vertex, i+1: re-enters boundary edge i
 };
 
 struct RefinementState {
@@ -69,16 +72,37 @@ bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<ui
                    const std::vector<uint32_t>& star_corners, uint32_t r, uint32_t k,
                    ResolvedPatch& out);
 
+// Indices i of the patch's ring edges (R_i, R_i+1) that are boundary edges
+// of the current mesh: where a removed boundary vertex may re-enter.
+void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
+                          std::vector<uint32_t>& out);
+
 // The decoder's prediction of a vertex inserted into `ring`: the rounded
 // average of the ring's positions. Exact integers.
 Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
-// Residual model context for a ring (log2 of its mean edge length on the grid).
-int residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
+// How a residual is modelled: `scale` (twice log2 of the ring's mean edge
+// length on the grid) picks the model set; the axes are taken in order of
+// the ring normal's components, largest first (role 0 is the axis closest to
+// the normal: its residual is the curvature offset, the other two are
+// tangential slip), and role 0's sign is flipped when the normal points down
+// that axis so "outward" is always the same symbol. Integer-exact: the
+// normal is a sum of integer cross products.
+struct ResidualContext {
+  int scale = 0;
+  int axis[3] = {0, 1, 2};
+  bool flip = false;
+};
+ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
+void encode_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
+                     Vec3i actual, Vec3i predicted);
+// Returns false when the decoded position leaves the grid [0, max_coordinate].
+bool decode_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
+                     Vec3i predicted, int32_t max_coordinate, Vec3i& out);
 
 // Inserts a vertex into a resolved patch and links it after the apex in the
 // order list. Returns its id; appends written face slots to `touched`.
-uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, Vec3i position,
-                     std::vector<uint32_t>* touched);
+uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
+                     Vec3i position, std::vector<uint32_t>* touched);
 
 struct RecordHeader {
   bool starts_layer = false;
