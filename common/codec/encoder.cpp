@@ -35,8 +35,13 @@ std::vector<std::array<uint64_t, 3>> face_signature(const BaseMesh& m) {
   for (const Triangle& t : m.faces) {
     std::array<uint64_t, 3> k = {position_key(m.positions[t[0]]), position_key(m.positions[t[1]]),
                                  position_key(m.positions[t[2]])};
-    while (k[0] > k[1] || k[0] > k[2]) std::rotate(k.begin(), k.begin() + 1, k.end());
-    out.push_back(k);
+    // The smallest of the three rotations (ties between equal positions too).
+    std::array<uint64_t, 3> best = k;
+    for (int r = 0; r < 2; ++r) {
+      std::rotate(k.begin(), k.begin() + 1, k.end());
+      best = std::min(best, k);
+    }
+    out.push_back(best);
   }
   std::sort(out.begin(), out.end());
   return out;

@@ -116,8 +116,13 @@ inline std::vector<std::array<PositionKey, 3>> canonical_faces(const Mesh& m) {
       const Vec3f p = m.positions[t[i]];
       k[i] = {p.x, p.y, p.z};
     }
-    while (k[0] > k[1] || k[0] > k[2]) std::rotate(k.begin(), k.begin() + 1, k.end());
-    out.push_back(k);
+    // The smallest of the three rotations (ties between equal positions too).
+    std::array<PositionKey, 3> best = k;
+    for (int r = 0; r < 2; ++r) {
+      std::rotate(k.begin(), k.begin() + 1, k.end());
+      best = std::min(best, k);
+    }
+    out.push_back(best);
   }
   std::sort(out.begin(), out.end());
   return out;
