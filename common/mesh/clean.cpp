@@ -228,6 +228,9 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
   report.nonmanifold_edges = found.nonmanifold_edges;
   report.nonmanifold_vertices = found.nonmanifold_vertices;
   if (options.keep_nonmanifold) return report;
+  // Already what the corner table needs (no edge with more than two faces,
+  // so "fans" mean the same to both): nothing to refuse or repair.
+  if (found.manifold && found.orientation_conflicts == 0) return report;
   if (!options.repair_nonmanifold) {
     if (auto status = check_manifold(mesh); !status) return tl::unexpected(status.error());
     return report;
