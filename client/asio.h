@@ -1,0 +1,12 @@
+// The one way the client includes Boost.Asio. GCC 12 in C++20 mode needs
+// <utility> before the Asio headers ("exchange is not a member of std").
+#pragma once
+
+#include <utility>
+
+#include <boost/asio.hpp>
+
+namespace meshstream::client {
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+}  // namespace meshstream::client

@@ -1,0 +1,33 @@
+// meshstream-client: parse options -> stream (network thread, display
+// pipeline thread, viewer or snapshots on this one) -> report -> exit code.
+#include <variant>
+
+#include "client/client_app.h"
+#include "client/client_options.h"
+#include "client/viewer/viewer.h"
+
+using namespace meshstream::client;
+
+int main(int argc, char** argv) {
+  ParsedClientOptions parsed = parse_client_options(argc, argv);
+  if (const int* exit_code = std::get_if<int>(&parsed)) return *exit_code;
+  const ClientOptions& options = std::get<ClientOptions>(parsed);
+
+  ViewerHooks hooks;
+  hooks.run_view = [](const ClientOptions& o, LatestFrameMailbox& frames, StreamControls& controls) {
+    ViewerOptions v;
+    v.width = o.width;
+    v.height = o.height;
+    v.title = "meshstream - " + o.model;
+    v.exit_after_frames = o.exit_after_frames;
+    return run_viewer(v, frames, controls);
+  };
+  hooks.snapshot = [](const meshstream::Mesh& mesh, const std::vector<meshstream::FaceKind>* kinds,
+                      const ClientOptions& o, const std::string& png) {
+    SnapshotOptions s;
+    s.width = o.width;
+    s.height = o.height;
+    return render_snapshot(mesh, kinds, s, png);
+  };
+  return run_client(options, hooks);
+}

@@ -1,0 +1,82 @@
+#include "client/client_options.h"
+
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+namespace meshstream::client {
+
+ParsedClientOptions parse_client_options(int argc, char** argv) {
+  ClientOptions o;
+  CLI::App app{"meshstream-client: stream a model from a meshstream server, decode every refinement "
+               "as it arrives and post-process it with ASA"};
+  std::string address, rule = "zorin", path = "auto";
+  std::optional<uint64_t> bytes;
+  std::optional<uint32_t> vertices;
+  std::optional<double> percent;
+  int reconnect_attempts = o.reconnect.max_attempts;
+  app.add_option("address", address, "server address HOST:PORT")->required();
+  app.add_option("model", o.model, "model name to stream (see --list)");
+  app.add_flag("--list", o.list, "list the server's models and exit");
+  app.add_option("--out", o.out_dir, "write NNNN.ply per display update (NNNN = record index) and final.ply");
+  app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")->check(CLI::Range(0, 8));
+  app.add_option("--flatness", o.asa.flatness, "ASA flatness t: an edge is flat when t < N1.N2")
+      ->check(CLI::Range(-1.0, 1.0));
+  app.add_option("--rule", rule, "Butterfly rule: zorin or projection")
+      ->check(CLI::IsMember({"zorin", "projection"}));
+  app.add_option("--crease", o.asa.crease_degrees, "edges bending more than DEG degrees stay sharp (0 = off)")
+      ->check(CLI::Range(0.0, 180.0));
+  bool no_asa = false;
+  app.add_flag("--no-asa", no_asa, "show the decoded mesh without ASA");
+  app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
+      ->check(CLI::IsMember({"auto", "full", "incremental"}));
+  auto* b = app.add_option("--bytes", bytes, "stop at the last record boundary within N stream bytes");
+  auto* v = app.add_option("--vertices", vertices, "stop after the last record with at most N vertices");
+  auto* p = app.add_option("--percent", percent, "stop at P percent of the stream's bytes (0 < P <= 100)")
+                ->check(CLI::Range(0.0, 100.0));
+  b->excludes(v)->excludes(p);
+  v->excludes(p);
+  app.add_flag("--json", o.json, "print one JSON event per line on stdout");
+  app.add_flag("--view", o.view, "open a window that shows the model as it refines");
+  app.add_option("--snapshot", o.snapshot_png, "render the final (or --snapshot-at) display mesh to a PNG");
+  app.add_option("--width", o.width, "snapshot/window width")->check(CLI::Range(16, 16384));
+  app.add_option("--height", o.height, "snapshot/window height")->check(CLI::Range(16, 16384));
+  app.add_option("--snapshot-at", o.snapshot_at, "snapshot the display mesh after record N (0 = base mesh)");
+  app.add_option("--exit-after", o.exit_after_frames, "close the window after N frames (tests)");
+  app.add_option("--max-chunk-bytes", o.max_chunk_bytes, "largest chunk to ask the server for");
+  app.add_option("--reconnect-attempts", reconnect_attempts, "consecutive reconnects before giving up")
+      ->check(CLI::Range(0, 1000));
+  app.add_flag("--quiet", o.quiet, "no progress line");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) {
+      app.exit(e);
+      return 0;
+    }
+    std::cerr << "meshstream-client: " << e.what() << " (see --help)\n";
+    return 2;
+  }
+  auto usage = [](const std::string& why) {
+    std::cerr << "meshstream-client: " << why << " (see --help)\n";
+    return 2;
+  };
+  auto hp = parse_host_port(address);
+  if (!hp) return usage(hp.error().message);
+  o.host = hp->host;
+  o.port = hp->port;
+  if (!o.list && o.model.empty()) return usage("name a MODEL to stream, or use --list");
+  if (o.list && !o.model.empty()) return usage("--list takes no MODEL");
+  if (percent && (*percent <= 0)) return usage("--percent must be in (0, 100]");
+  if (o.snapshot_at && o.snapshot_png.empty()) return usage("--snapshot-at needs --snapshot FILE.png");
+  o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
+  o.asa_enabled = !no_asa;
+  o.asa_path = path == "full" ? AsaPath::kFull : path == "incremental" ? AsaPath::kIncremental : AsaPath::kAuto;
+  if (bytes) o.budget = {Budget::Kind::kBytes, static_cast<double>(*bytes)};
+  if (vertices) o.budget = {Budget::Kind::kVertices, static_cast<double>(*vertices)};
+  if (percent) o.budget = {Budget::Kind::kPercent, *percent};
+  o.reconnect.max_attempts = reconnect_attempts;
+  return o;
+}
+
+}  // namespace meshstream::client

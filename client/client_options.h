@@ -1,0 +1,47 @@
+// The `meshstream-client` command line (contract in ../shared/DESIGN.md):
+//   meshstream-client HOST:PORT [MODEL] [--list] [--out DIR] [--asa-levels L]
+//     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
+//     [--bytes N | --vertices N | --percent P] [--json] [--view]
+//     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
+//     [--exit-after N]
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include "client/display_builder.h"
+#include "client/stream_client.h"
+#include "common/asa/subdivide.h"
+
+namespace meshstream::client {
+
+struct ClientOptions {
+  std::string host;
+  uint16_t port = 0;
+  std::string model;          // empty with --list
+  bool list = false;
+  std::string out_dir;        // --out: NNNN.ply per display update, final.ply
+  bool asa_enabled = true;    // --no-asa turns it off
+  AsaOptions asa;             // levels, flatness, rule, crease
+  AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)
+  Budget budget;
+  bool json = false;
+  bool view = false;
+  std::string snapshot_png;
+  int width = 1024;
+  int height = 768;
+  std::optional<uint32_t> snapshot_at;  // record index (0 = base mesh)
+  uint64_t exit_after_frames = 0;
+  uint32_t max_chunk_bytes = 0;
+  ReconnectPolicy reconnect;
+  bool quiet = false;         // no progress line
+};
+
+// Options to run with, or the exit code to return now (0 after --help, 2
+// after a usage error, with a one-line reason already printed to stderr).
+using ParsedClientOptions = std::variant<ClientOptions, int>;
+ParsedClientOptions parse_client_options(int argc, char** argv);
+
+}  // namespace meshstream::client

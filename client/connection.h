@@ -1,0 +1,67 @@
+// One TCP connection to a meshstream server, speaking framed protobuf
+// messages (proto/meshstream.proto, proto/framing.h). Blocking calls with
+// deadlines, run on the caller's thread over a private Asio io_context, so
+// the streaming loop reads like the conversation it implements.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "client/asio.h"
+#include "common/base/result.h"
+#include "proto/framing.h"
+
+namespace meshstream::client {
+
+namespace v1 = ::meshstream::v1;
+using Millis = std::chrono::milliseconds;
+
+class Connection {
+ public:
+  // Resolves `host` and connects to `port`; kIo with the address and the
+  // reason when it cannot within `timeout`.
+  static Result<std::unique_ptr<Connection>> open(const std::string& host, uint16_t port, Millis timeout);
+
+  ~Connection();
+  Connection(const Connection&) = delete;
+  Connection& operator=(const Connection&) = delete;
+
+  // Writes one framed message; kIo on a broken connection or timeout.
+  Status send(const v1::ClientMessage& message, Millis timeout);
+
+  // The next server message. kIo when the connection closed or broke, or
+  // nothing arrived for `timeout`, or `cancel` became true (checked every
+  // 20 ms); kLimit / kParse for a frame that breaks the protocol.
+  Result<v1::ServerMessage> receive(Millis timeout, const std::atomic<bool>* cancel = nullptr);
+
+  // Stream bytes read from the socket so far (frames included).
+  uint64_t bytes_read() const { return bytes_read_; }
+  std::string peer() const { return peer_; }
+
+ private:
+  Connection();
+  // Runs the io_context until `done`, the deadline or a cancel; closes the
+  // pending operation on timeout. True when the operation completed.
+  bool run_until(const bool& done, std::chrono::steady_clock::time_point deadline,
+                 const std::atomic<bool>* cancel);
+
+  asio::io_context io_;
+  tcp::socket socket_;
+  proto::ServerFrameReader reader_{proto::kMaxServerFrameBytes};
+  std::vector<uint8_t> buffer_;
+  uint64_t bytes_read_ = 0;
+  std::string peer_;
+};
+
+// Splits "HOST:PORT" ("[::1]:7878" for IPv6). kInvalidArgument otherwise.
+struct HostPort {
+  std::string host;
+  uint16_t port = 0;
+};
+Result<HostPort> parse_host_port(const std::string& text);
+
+}  // namespace meshstream::client

@@ -1,0 +1,163 @@
+#include "client/decoded_stream.h"
+
+#include <algorithm>
+
+namespace meshstream::client {
+
+using Clock = std::chrono::steady_clock;
+
+Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
+  std::unique_lock lock(mutex_);
+  // Decoding runs under the lock: the pipeline only holds it to copy the
+  // (small) changes, never while running ASA.
+  const auto start = Clock::now();
+  auto applied = decoder_.feed(bytes);
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  if (!applied) return applied;
+  if (*applied == 0) return applied;
+  for (const RecordDelta& d : decoder_.last_deltas()) {
+    if (d.full_rebuild) {
+      pending_.full = true;
+      pending_.vertices.clear();
+      pending_.faces.clear();
+    } else if (!pending_.full) {
+      pending_.vertices.insert(pending_.vertices.end(), d.added_vertices.begin(), d.added_vertices.end());
+      pending_.faces.insert(pending_.faces.end(), d.touched_faces.begin(), d.touched_faces.end());
+    }
+  }
+  pending_updates_ += *applied;
+  pending_decode_ms_ += ms;
+  lock.unlock();
+  changed_.notify_all();
+  if (barrier_) {
+    lock.lock();
+    const uint32_t target = *barrier_ + 1;
+    if (decoder_.records_decoded() >= target && taken_records_ < target) {
+      changed_.wait(lock, [&] { return stopped_ || taken_records_ >= target; });
+    }
+  }
+  return applied;
+}
+
+Status DecodedStream::resume_at(uint64_t offset) {
+  std::lock_guard lock(mutex_);
+  bytes_received_ = offset;
+  return decoder_.resume_at(offset);
+}
+
+uint64_t DecodedStream::resume_offset() const {
+  std::lock_guard lock(mutex_);
+  return decoder_.resume_offset();
+}
+
+uint32_t DecodedStream::records_decoded() const {
+  std::lock_guard lock(mutex_);
+  return decoder_.records_decoded();
+}
+
+uint64_t DecodedStream::bytes_received() const {
+  std::lock_guard lock(mutex_);
+  return bytes_received_;
+}
+
+void DecodedStream::set_bytes_received(uint64_t offset) {
+  std::lock_guard lock(mutex_);
+  bytes_received_ = offset;
+}
+
+void DecodedStream::finish(StreamOutcome outcome) {
+  {
+    std::lock_guard lock(mutex_);
+    if (!outcome_) outcome_ = std::move(outcome);
+  }
+  changed_.notify_all();
+}
+
+void DecodedStream::set_barrier(std::optional<uint32_t> record) {
+  std::lock_guard lock(mutex_);
+  barrier_ = record;
+}
+
+bool DecodedStream::wait(uint64_t seen_pokes, bool outcome_seen, std::chrono::milliseconds max_wait) {
+  std::unique_lock lock(mutex_);
+  changed_.wait_for(lock, max_wait, [&] {
+    return stopped_ || pending_updates_ > 0 || (outcome_.has_value() && !outcome_seen) ||
+           pokes_ != seen_pokes;
+  });
+  return !stopped_;
+}
+
+bool DecodedStream::has_pending() const {
+  std::lock_guard lock(mutex_);
+  return pending_updates_ > 0;
+}
+
+TakenUpdate DecodedStream::take(Mesh& mirror, MeshChanges& changes) {
+  TakenUpdate u;
+  {
+    std::lock_guard lock(mutex_);
+    const Mesh& m = decoder_.mesh();
+    if (pending_.full) {
+      mirror.positions = m.positions;
+      mirror.triangles = m.triangles;
+    } else {
+      mirror.positions.resize(m.positions.size());
+      mirror.triangles.resize(m.triangles.size());
+      for (uint32_t v : pending_.vertices) mirror.positions[v] = m.positions[v];
+      for (uint32_t f : pending_.faces) mirror.triangles[f] = m.triangles[f];
+    }
+    if (pending_.full) {
+      changes.full = true;
+      changes.vertices.clear();
+      changes.faces.clear();
+    } else if (!changes.full) {
+      changes.vertices.insert(changes.vertices.end(), pending_.vertices.begin(), pending_.vertices.end());
+      changes.faces.insert(changes.faces.end(), pending_.faces.begin(), pending_.faces.end());
+    }
+    pending_.clear();
+    u.records_decoded = decoder_.records_decoded();
+    u.bytes_decoded = decoder_.resume_offset();
+    u.bytes_received = bytes_received_;
+    u.updates = pending_updates_;
+    u.decode_ms = pending_decode_ms_;
+    u.ended = outcome_.has_value();
+    pending_updates_ = 0;
+    pending_decode_ms_ = 0;
+    taken_records_ = u.records_decoded;
+  }
+  changed_.notify_all();  // releases a network thread waiting at the barrier
+  return u;
+}
+
+std::optional<StreamOutcome> DecodedStream::outcome() const {
+  std::lock_guard lock(mutex_);
+  return outcome_;
+}
+
+void DecodedStream::poke() {
+  {
+    std::lock_guard lock(mutex_);
+    ++pokes_;
+  }
+  changed_.notify_all();
+}
+
+uint64_t DecodedStream::pokes() const {
+  std::lock_guard lock(mutex_);
+  return pokes_;
+}
+
+void DecodedStream::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopped_ = true;
+  }
+  changed_.notify_all();
+}
+
+bool DecodedStream::stopped() const {
+  std::lock_guard lock(mutex_);
+  return stopped_;
+}
+
+}  // namespace meshstream::client

@@ -1,0 +1,56 @@
+// Turns the decoded mesh into the display mesh after each update: ASA
+// (common/asa/subdivide.h) either on the whole mesh, or incrementally on
+// the region the update changed (client/incremental_asa.h), keeping
+// whichever path has been faster for updates of that size. Both paths give
+// the same triangles with the same positions; only the order of vertices
+// and faces may differ.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "client/decoded_stream.h"
+#include "common/asa/subdivide.h"
+#include "common/base/result.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream::client {
+
+enum class AsaPath { kAuto, kFull, kIncremental };
+
+struct BuildReport {
+  double asa_ms = 0;
+  bool incremental = false;      // which path produced this display mesh
+  uint32_t region_faces = 0;     // decoded faces recomputed (incremental path)
+};
+
+struct DisplayMesh {
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const std::vector<FaceKind>> face_kind;  // null without ASA
+};
+
+class DisplayBuilder {
+ public:
+  DisplayBuilder();
+  ~DisplayBuilder();
+  DisplayBuilder(DisplayBuilder&&) noexcept;
+  DisplayBuilder& operator=(DisplayBuilder&&) noexcept;
+
+  void set_path(AsaPath path) { path_ = path; }
+
+  // The display mesh of `decoded`, which differs from the previous call's
+  // input by `changes` (ignored when `options_changed` or on the first
+  // call). `decoded_shared` is returned as is when ASA is off. Errors: those
+  // of subdivide() (a mesh ASA cannot work on).
+  Result<DisplayMesh> build(const std::shared_ptr<const Mesh>& decoded_shared, const MeshChanges& changes,
+                            bool asa_enabled, const AsaOptions& options, bool options_changed,
+                            BuildReport& report);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+  AsaPath path_ = AsaPath::kAuto;
+};
+
+}  // namespace meshstream::client

@@ -1,0 +1,86 @@
+// The display pipeline: its own thread takes the newest decoded mesh from
+// the DecodedStream whenever it is free, runs ASA (DisplayBuilder) and
+// publishes a DisplayFrame into the LatestFrameMailbox. The network thread
+// never waits for it; when ASA falls behind, the updates that arrived
+// meanwhile are merged into the next frame (DisplayFrame::coalesced_updates).
+// It also implements the StreamControls a viewer steers the stream with.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "client/decoded_stream.h"
+#include "client/display_builder.h"
+#include "client/display_frame.h"
+#include "client/stream_client.h"
+
+namespace meshstream::client {
+
+// Why a frame was published.
+struct FrameInfo {
+  bool new_records = false;  // it shows records the previous frame did not
+  bool rerun = false;        // ASA options changed
+  BuildReport build;
+  double elapsed_ms = 0;     // since the pipeline started
+};
+
+using FrameObserver = std::function<void(const DisplayFrame&, const FrameInfo&)>;
+
+struct PipelineSettings {
+  bool asa_enabled = true;
+  AsaOptions asa;
+  AsaPath path = AsaPath::kAuto;
+};
+
+class DisplayPipeline : public StreamControls {
+ public:
+  // `client` may be null (no pause/rate). The observer runs on the
+  // pipeline thread after each publish (events, snapshot files).
+  DisplayPipeline(DecodedStream& decoded, StreamClient* client, LatestFrameMailbox& mailbox,
+                  PipelineSettings settings, FrameObserver observer);
+  ~DisplayPipeline() override;
+
+  void start();
+  // Stops the thread (after the frame in progress) and joins it.
+  void stop();
+  // Blocks until the stream ended and its last state is published (or the
+  // stream failed). The error, if the pipeline (ASA) failed.
+  Status wait_finished();
+  void set_totals(uint64_t bytes_total, uint32_t records_total);
+
+  // StreamControls
+  void set_asa(bool asa_enabled, const AsaOptions& options) override;
+  AsaOptions asa_options() const override;
+  bool asa_enabled() const override;
+  void pause() override;
+  void resume() override;
+  bool paused() const override;
+  double current_rate_bytes_per_s() const override;
+
+ private:
+  void loop();
+  void publish(DisplayFrame frame, const FrameInfo& info);
+  void mark_finished(std::optional<Error> error);
+
+  DecodedStream& decoded_;
+  StreamClient* client_;
+  LatestFrameMailbox& mailbox_;
+  FrameObserver observer_;
+  DisplayBuilder builder_;
+
+  mutable std::mutex mutex_;  // guards settings_, finished_, error_, totals
+  std::condition_variable finished_changed_;
+  PipelineSettings settings_;
+  bool finished_ = false;
+  std::optional<Error> error_;
+  uint64_t bytes_total_ = 0;
+  uint32_t records_total_ = 0;
+  uint64_t sequence_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace meshstream::client

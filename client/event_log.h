@@ -1,0 +1,52 @@
+// What the client tells its user while streaming: JSON event lines on stdout
+// (--json; contract in ../shared/DESIGN.md: header, refinement per display
+// update, done or error), or a progress line on a terminal. Thread-safe:
+// the header comes from the network thread, refinements from the pipeline.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <mutex>
+#include <string>
+
+#include "client/display_frame.h"
+#include "client/display_pipeline.h"
+#include "client/stream_client.h"
+
+namespace meshstream::client {
+
+struct DoneSummary {
+  std::string model;
+  std::string reason;  // complete, budget, cancelled
+  uint32_t records = 0, records_total = 0;
+  uint64_t bytes = 0, bytes_total = 0;
+  uint32_t vertices = 0, faces = 0, display_vertices = 0, display_faces = 0;
+  double elapsed_ms = 0;
+  int reconnects = 0;
+  uint32_t display_updates = 0;
+  uint32_t coalesced = 0;  // decoder updates merged into later frames, in total
+};
+
+class EventLog {
+ public:
+  // json: event lines on stdout; progress: a progress line on stderr
+  // (meant for a terminal).
+  EventLog(bool json, bool progress) : json_(json), progress_(progress) {}
+
+  void header(const StreamFacts& facts, double elapsed_ms);
+  void refinement(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms, double rate);
+  void reconnecting(const Error& error, int attempt);
+  void done(const DoneSummary& summary);
+  void error(const std::string& message);
+  void note(const std::string& line);  // stderr, human readers only
+
+ private:
+  void line(const std::string& text);  // one stdout line, flushed
+  void clear_progress();
+
+  std::mutex mutex_;
+  bool json_, progress_;
+  bool progress_shown_ = false;
+};
+
+}  // namespace meshstream::client

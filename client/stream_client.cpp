@@ -1,0 +1,284 @@
+#include "client/stream_client.h"
+
+#include <algorithm>
+#include <thread>
+
+namespace meshstream::client {
+
+using Clock = std::chrono::steady_clock;
+
+void RateMeter::add(uint64_t bytes) {
+  std::lock_guard lock(mutex_);
+  const auto now = Clock::now();
+  samples_.emplace_back(now, bytes);
+  while (!samples_.empty() && now - samples_.front().first > std::chrono::seconds(1)) samples_.pop_front();
+}
+
+double RateMeter::bytes_per_s() const {
+  std::lock_guard lock(mutex_);
+  if (samples_.empty()) return 0;
+  const auto now = Clock::now();
+  uint64_t sum = 0;
+  for (const auto& [t, b] : samples_) {
+    if (now - t <= std::chrono::seconds(1)) sum += b;
+  }
+  return static_cast<double>(sum);  // bytes within the last second
+}
+
+namespace {
+
+std::string server_error_text(const v1::Error& e) {
+  return "server error " + v1::Error_Code_Name(e.code()) + ": " + e.message();
+}
+
+// Errors after which trying again later may succeed.
+bool transient(v1::Error::Code code) {
+  switch (code) {
+    case v1::Error::BUSY:
+    case v1::Error::SHUTTING_DOWN:
+    case v1::Error::TIMEOUT:
+    case v1::Error::INTERNAL:
+      return true;
+    default:
+      return false;
+  }
+}
+
+v1::Budget to_proto(const Budget& b) {
+  v1::Budget out;
+  switch (b.kind) {
+    case Budget::Kind::kAll: break;
+    case Budget::Kind::kBytes: out.set_bytes(static_cast<uint64_t>(b.value)); break;
+    case Budget::Kind::kVertices: out.set_vertices(static_cast<uint32_t>(b.value)); break;
+    case Budget::Kind::kPercent: out.set_percent(b.value); break;
+  }
+  return out;
+}
+
+StreamFacts facts_from(const v1::StreamHeader& h) {
+  StreamFacts f;
+  f.model = h.model();
+  f.total_bytes = h.total_bytes();
+  f.start_offset = h.start_offset();
+  f.end_offset = h.end_offset();
+  f.payload_offset = h.payload_offset();
+  f.end_record = h.end_record();
+  f.vertices = h.vertices();
+  f.faces = h.faces();
+  f.base_vertices = h.base_vertices();
+  f.base_faces = h.base_faces();
+  f.quant_bits = h.quant_bits();
+  const auto& r = h.records();
+  f.records_total = static_cast<uint32_t>(r.sizes_size());
+  uint64_t at = h.payload_offset();
+  for (int i = 0; i < r.sizes_size(); ++i) {
+    at += r.sizes(i);
+    f.record_end.push_back(at);
+    f.record_vertices.push_back(i < r.vertices_size() ? r.vertices(i) : 0);
+    f.record_faces.push_back(i < r.faces_size() ? r.faces(i) : 0);
+  }
+  return f;
+}
+
+}  // namespace
+
+Status handshake(Connection& connection, Millis timeout) {
+  v1::ClientMessage hello;
+  hello.mutable_hello()->set_protocol_version(proto::kProtocolVersion);
+  hello.mutable_hello()->set_client_name("meshstream-client 0.1");
+  if (auto s = connection.send(hello, timeout); !s) return s;
+  auto reply = connection.receive(timeout);
+  if (!reply) return tl::unexpected(reply.error());
+  if (reply->has_error()) {
+    // kUnsupported marks an answer that retrying will not change.
+    const ErrorCode code = transient(reply->error().code()) ? ErrorCode::kIo : ErrorCode::kUnsupported;
+    return make_error(code, server_error_text(reply->error()));
+  }
+  if (!reply->has_hello()) {
+    return make_error(ErrorCode::kParse, "server " + connection.peer() + " did not answer Hello with ServerHello");
+  }
+  if (reply->hello().protocol_version() != proto::kProtocolVersion) {
+    return make_error(ErrorCode::kUnsupported, "server speaks protocol version " +
+                                                   std::to_string(reply->hello().protocol_version()) +
+                                                   ", this client " + std::to_string(proto::kProtocolVersion));
+  }
+  return {};
+}
+
+Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port, Millis timeout) {
+  auto connection = Connection::open(host, port, timeout);
+  if (!connection) return tl::unexpected(connection.error());
+  if (auto s = handshake(**connection, timeout); !s) return tl::unexpected(s.error());
+  v1::ClientMessage request;
+  request.mutable_list_models();
+  if (auto s = (*connection)->send(request, timeout); !s) return tl::unexpected(s.error());
+  while (true) {
+    auto reply = (*connection)->receive(timeout);
+    if (!reply) return tl::unexpected(reply.error());
+    if (reply->has_error()) return make_error(ErrorCode::kIo, server_error_text(reply->error()));
+    if (reply->has_model_list()) {
+      return std::vector<v1::ModelInfo>(reply->model_list().models().begin(),
+                                        reply->model_list().models().end());
+    }
+  }
+}
+
+void StreamClient::stop() {
+  stop_ = true;
+  pause_changed_.notify_all();
+}
+
+void StreamClient::pause() { paused_ = true; }
+
+void StreamClient::resume() {
+  paused_ = false;
+  pause_changed_.notify_all();
+}
+
+bool StreamClient::wait_while_paused() {
+  std::unique_lock lock(pause_mutex_);
+  pause_changed_.wait(lock, [&] { return stop_.load() || !paused_.load(); });
+  return !stop_.load();
+}
+
+StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
+                                            const std::function<void(const StreamFacts&)>& on_header,
+                                            bool& progressed, Error& error) {
+  const ReconnectPolicy& policy = target_.reconnect;
+  auto connection = Connection::open(target_.host, target_.port, policy.connect_timeout);
+  if (!connection) {
+    error = connection.error();
+    return Attempt::kRetry;
+  }
+  Connection& c = **connection;
+  if (auto s = handshake(c, policy.connect_timeout); !s) {
+    error = s.error();
+    return s.error().code == ErrorCode::kUnsupported ? Attempt::kFatal : Attempt::kRetry;
+  }
+  v1::ClientMessage request;
+  v1::StreamRequest& r = *request.mutable_stream();
+  r.set_model(target_.model);
+  const uint64_t resume = decoded.records_decoded() > 0 ? decoded.resume_offset() : 0;
+  r.set_resume_offset(resume);
+  *r.mutable_budget() = to_proto(target_.budget);
+  r.set_max_chunk_bytes(target_.max_chunk_bytes);
+  if (auto s = c.send(request, policy.connect_timeout); !s) {
+    error = s.error();
+    return Attempt::kRetry;
+  }
+
+  bool have_header = false;
+  uint64_t expected = 0;  // stream offset of the next chunk
+  while (true) {
+    if (paused_ && !wait_while_paused()) break;
+    if (stop_) break;
+    auto message = c.receive(policy.read_timeout, &stop_);
+    if (stop_) break;
+    if (!message) {
+      error = message.error();
+      return Attempt::kRetry;
+    }
+    if (message->has_error()) {
+      error = Error{ErrorCode::kIo, server_error_text(message->error())};
+      return transient(message->error().code()) ? Attempt::kRetry : Attempt::kFatal;
+    }
+    if (message->has_header()) {
+      const v1::StreamHeader& h = message->header();
+      if (facts_ && (h.total_bytes() != facts_->total_bytes ||
+                     static_cast<uint32_t>(h.records().sizes_size()) != facts_->records_total)) {
+        error = Error{ErrorCode::kCorrupt, "model '" + target_.model +
+                                               "' changed on the server between connections"};
+        return Attempt::kFatal;
+      }
+      if (!facts_) {
+        facts_ = facts_from(h);
+        if (on_header) on_header(*facts_);
+      }
+      if (auto s = decoded.resume_at(h.start_offset()); !s) {
+        error = s.error();
+        return Attempt::kFatal;
+      }
+      expected = h.start_offset();
+      have_header = true;
+      continue;
+    }
+    if (message->has_chunk()) {
+      const v1::Chunk& chunk = message->chunk();
+      if (!have_header || chunk.offset() != expected) {
+        error = Error{ErrorCode::kParse, "server sent a chunk at offset " + std::to_string(chunk.offset()) +
+                                             ", expected " + std::to_string(expected)};
+        return Attempt::kRetry;
+      }
+      const std::string& data = chunk.data();
+      rate_.add(data.size());
+      const auto* bytes = reinterpret_cast<const uint8_t*>(data.data());
+      const uint64_t end = expected + data.size();
+      const uint32_t before = decoded.records_decoded();
+      // Feed record by record so each record is its own update.
+      uint64_t at = expected;
+      const auto& ends = facts_->record_end;
+      while (at < end) {
+        auto next = std::upper_bound(ends.begin(), ends.end(), at);
+        const uint64_t stop_at = next == ends.end() ? end : std::min(end, *next);
+        auto fed = decoded.feed(std::span<const uint8_t>(bytes + (at - expected), stop_at - at));
+        if (!fed) {
+          error = fed.error();
+          return Attempt::kFatal;
+        }
+        at = stop_at;
+        decoded.set_bytes_received(at);
+      }
+      expected = end;
+      if (decoded.records_decoded() > before) progressed = true;
+      continue;
+    }
+    if (message->has_end()) {
+      const v1::StreamEnd& e = message->end();
+      if (e.reason() == v1::StreamEnd::CANCELLED) {
+        error = Error{ErrorCode::kIo, "server cancelled the stream"};
+        return Attempt::kRetry;
+      }
+      StreamOutcome outcome;
+      outcome.reason = e.reason() == v1::StreamEnd::BUDGET ? "budget" : "complete";
+      decoded.finish(outcome);
+      return Attempt::kDone;
+    }
+    // ModelList, ServerHello or a case this client does not know: ignore.
+  }
+  StreamOutcome cancelled;
+  cancelled.reason = "cancelled";
+  decoded.finish(cancelled);
+  return Attempt::kDone;
+}
+
+void StreamClient::run(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header) {
+  const ReconnectPolicy& policy = target_.reconnect;
+  int failures = 0;
+  while (!stop_) {
+    bool progressed = false;
+    Error error{ErrorCode::kIo, ""};
+    const Attempt a = attempt(decoded, on_header, progressed, error);
+    if (a == Attempt::kDone) return;
+    if (a == Attempt::kFatal) {
+      decoded.finish(StreamOutcome{false, "error", error});
+      return;
+    }
+    if (progressed) failures = 0;
+    if (++failures > policy.max_attempts) {
+      error.message = "giving up after " + std::to_string(policy.max_attempts) + " attempts: " + error.message;
+      decoded.finish(StreamOutcome{false, "error", error});
+      return;
+    }
+    ++reconnects_;
+    if (on_retry_) on_retry_(error, failures);
+    // Bounded exponential back-off, interruptible by stop().
+    const auto delay = std::min<Millis>(policy.max_delay, policy.first_delay * (1 << std::min(failures - 1, 16)));
+    std::unique_lock lock(pause_mutex_);
+    pause_changed_.wait_for(lock, delay, [&] { return stop_.load(); });
+  }
+  StreamOutcome cancelled;
+  cancelled.reason = "cancelled";
+  decoded.finish(cancelled);
+}
+
+}  // namespace meshstream::client

@@ -1,0 +1,120 @@
+// The network side of a streaming session: connect, Hello, StreamRequest
+// (with the budget, or a resume offset after a lost connection), then the
+// chunks into the DecodedStream. Losing the connection mid-stream reconnects
+// with bounded exponential back-off and resumes from the last complete
+// record (decoder resume offset), so the final mesh is the same as an
+// uninterrupted run's. Also: Hello + ListModels for --list.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "client/connection.h"
+#include "client/decoded_stream.h"
+
+namespace meshstream::client {
+
+struct Budget {
+  enum class Kind { kAll, kBytes, kVertices, kPercent };
+  Kind kind = Kind::kAll;
+  double value = 0;
+};
+
+struct ReconnectPolicy {
+  Millis first_delay{50};
+  Millis max_delay{2000};
+  int max_attempts = 8;          // consecutive failures without progress
+  Millis connect_timeout{5000};
+  Millis read_timeout{15000};    // silence that counts as a lost connection
+};
+
+struct StreamTarget {
+  std::string host;
+  uint16_t port = 0;
+  std::string model;
+  Budget budget;
+  uint32_t max_chunk_bytes = 0;  // 0 = server default
+  ReconnectPolicy reconnect;
+};
+
+// What the header said, kept from the first connection.
+struct StreamFacts {
+  std::string model;
+  uint64_t total_bytes = 0;
+  uint64_t start_offset = 0;
+  uint64_t end_offset = 0;
+  uint64_t payload_offset = 0;
+  uint32_t end_record = 0;
+  uint32_t records_total = 0;
+  uint32_t vertices = 0;
+  uint32_t faces = 0;
+  uint32_t base_vertices = 0;
+  uint32_t base_faces = 0;
+  uint32_t quant_bits = 0;
+  std::vector<uint64_t> record_end;        // stream offset after record i
+  std::vector<uint32_t> record_vertices;   // cumulative, per record
+  std::vector<uint32_t> record_faces;
+};
+
+// Bytes per second over the last second of reads.
+class RateMeter {
+ public:
+  void add(uint64_t bytes);
+  double bytes_per_s() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::deque<std::pair<std::chrono::steady_clock::time_point, uint64_t>> samples_;
+};
+
+class StreamClient {
+ public:
+  explicit StreamClient(StreamTarget target) : target_(std::move(target)) {}
+
+  // Streams into `decoded` until the end, the budget, a fatal error or
+  // stop(); always calls decoded.finish() before returning. `on_header` runs
+  // once, on this thread, when the first header arrives. Blocking: run it on
+  // its own thread.
+  void run(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header);
+
+  void stop();
+  void pause();
+  void resume();
+  bool paused() const { return paused_.load(); }
+  double rate_bytes_per_s() const { return rate_.bytes_per_s(); }
+  int reconnects() const { return reconnects_.load(); }
+  // Called on the network thread before each back-off (for logs).
+  void on_retry(std::function<void(const Error&, int attempt)> f) { on_retry_ = std::move(f); }
+
+ private:
+  enum class Attempt { kDone, kRetry, kFatal };
+  Attempt attempt(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header,
+                  bool& progressed, Error& error);
+  bool wait_while_paused();
+
+  StreamTarget target_;
+  std::optional<StreamFacts> facts_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> paused_{false};
+  std::atomic<int> reconnects_{0};
+  std::mutex pause_mutex_;
+  std::condition_variable pause_changed_;
+  RateMeter rate_;
+  std::function<void(const Error&, int)> on_retry_;
+};
+
+// Hello + ListModels on one connection: the catalog, or the error.
+Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port, Millis timeout);
+
+// Hello/ServerHello exchange on an open connection.
+Status handshake(Connection& connection, Millis timeout);
+
+}  // namespace meshstream::client
