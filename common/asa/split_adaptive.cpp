@@ -10,6 +10,7 @@
 #include <array>
 #include <cstring>
 
+#include "common/asa/butterfly_rules.h"
 #include "common/asa/split.h"
 
 namespace meshstream::asa {
@@ -114,7 +115,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t id = s.edge_vertex[c];
     if (id == kNone || (opp[c] != kNone && opp[c] < c)) continue;
-    out.positions[id] = butterfly_point(m, c, *in.weights, in.placement);
+    out.positions[id] = rules::edge_point(m, c, *in.weights, in.placement);
     const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
     if (colors) {
       const Vec4f ca = in.colors[a], cb = in.colors[b];

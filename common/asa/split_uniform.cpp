@@ -4,6 +4,7 @@
 // is what makes chaining levels cheap.
 #include <cstring>
 
+#include "common/asa/butterfly_rules.h"
 #include "common/asa/split.h"
 
 namespace meshstream::asa {
@@ -15,45 +16,63 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
 
-  // Edge ids: the first corner of an edge (in corner order) names it.
+  // One pass over the corners: the first corner of an edge (in corner
+  // order) names it and computes its point; the other reads the name.
   std::vector<uint32_t>& edge_of = scratch.edge_vertex;
   edge_of.resize(corners);
+  // Edge count first, to size the outputs once.
   uint32_t E = 0;
-  for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t o = opp[c];
-    edge_of[c] = (o == kNone || c < o) ? E++ : edge_of[o];
-  }
-
+  for (uint32_t c = 0; c < corners; ++c) E += (opp[c] == kNone || c < opp[c]);
+  const bool colors = in.colors != nullptr, texcoords = in.texcoords != nullptr;
+  const bool topology = in.want_topology;
   out.positions.resize(static_cast<size_t>(V) + E);
   Vec3f* pos = out.positions.data();
-  if (pos != m.positions) std::memcpy(pos, m.positions, sizeof(Vec3f) * V);
-  const bool colors = in.colors != nullptr, texcoords = in.texcoords != nullptr;
+  std::memcpy(pos, m.positions, sizeof(Vec3f) * V);
   if (colors) {
     out.colors.resize(static_cast<size_t>(V) + E);
-    if (out.colors.data() != in.colors) std::memcpy(out.colors.data(), in.colors, sizeof(Vec4f) * V);
+    std::memcpy(out.colors.data(), in.colors, sizeof(Vec4f) * V);
   } else {
     out.colors.clear();
   }
   if (texcoords) {
     out.texcoords.resize(static_cast<size_t>(V) + E);
-    if (out.texcoords.data() != in.texcoords) std::memcpy(out.texcoords.data(), in.texcoords, sizeof(Vec2f) * V);
+    std::memcpy(out.texcoords.data(), in.texcoords, sizeof(Vec2f) * V);
   } else {
     out.texcoords.clear();
   }
+  if (topology) {
+    // Old vertices keep their face count and features; a new vertex has six
+    // faces (three on a boundary) and two feature edges when its edge was one.
+    out.valence.resize(static_cast<size_t>(V) + E);
+    out.vertex_features.resize(static_cast<size_t>(V) + E);
+    std::memcpy(out.valence.data(), m.valence, sizeof(uint32_t) * V);
+    std::memcpy(out.vertex_features.data(), m.vertex_features, V);
+  }
 
+  uint32_t next_id = V;
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t o = opp[c];
-    if (o != kNone && o < c) continue;
-    const uint32_t id = V + edge_of[c];
-    pos[id] = butterfly_point(m, c, *in.weights, in.placement);
-    const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
-    if (colors) {
-      const Vec4f ca = in.colors[a], cb = in.colors[b];
-      out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f, (ca.w + cb.w) * 0.5f};
+    if (o != kNone && o < c) {
+      edge_of[c] = edge_of[o];
+      continue;
     }
-    if (texcoords) {
-      const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
-      out.texcoords[id] = {(ta.x + tb.x) * 0.5f, (ta.y + tb.y) * 0.5f};
+    const uint32_t id = next_id++;
+    edge_of[c] = id - V;
+    pos[id] = rules::edge_point(m, c, *in.weights, in.placement);
+    if (topology) {
+      out.valence[id] = o == kNone ? 3 : 6;
+      out.vertex_features[id] = m.feature_edge[c] ? 2 : 0;
+    }
+    if (colors | texcoords) {
+      const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
+      if (colors) {
+        const Vec4f ca = in.colors[a], cb = in.colors[b];
+        out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f, (ca.w + cb.w) * 0.5f};
+      }
+      if (texcoords) {
+        const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
+        out.texcoords[id] = {(ta.x + tb.x) * 0.5f, (ta.y + tb.y) * 0.5f};
+      }
     }
   }
 
@@ -99,20 +118,6 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       }
       fe[near_next] = fe[near_prev] = m.feature_edge[c];
     }
-  }
-  // Old vertices keep their faces count and features; a new vertex has six
-  // faces (three on a boundary) and two feature edges when its edge was one.
-  out.valence.resize(static_cast<size_t>(V) + E);
-  out.vertex_features.resize(static_cast<size_t>(V) + E);
-  if (out.valence.data() != m.valence) std::memcpy(out.valence.data(), m.valence, sizeof(uint32_t) * V);
-  if (out.vertex_features.data() != m.vertex_features)
-    std::memcpy(out.vertex_features.data(), m.vertex_features, V);
-  for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t o = opp[c];
-    if (o != kNone && o < c) continue;
-    const uint32_t id = V + edge_of[c];
-    out.valence[id] = o == kNone ? 3 : 6;
-    out.vertex_features[id] = m.feature_edge[c] ? 2 : 0;
   }
   out.green.clear();
 }

@@ -8,10 +8,10 @@
 
 #include "common/asa/butterfly_stencils.h"
 #include "common/asa/closure.h"
+#include "common/asa/corner_table.h"
 #include "common/asa/flatness.h"
 #include "common/asa/level_mesh.h"
 #include "common/asa/split.h"
-#include "common/mesh/adjacency.h"
 
 namespace meshstream {
 
@@ -21,6 +21,7 @@ struct AsaWorkspace::Buffers {
   asa::ButterflyWeights weights;
   asa::ClosureBuffers closure;
   asa::SplitScratch scratch;
+  asa::CornerTableScratch corner_scratch;
   std::vector<Vec3f> normals;
   std::vector<uint8_t> target;
   AsaStats stats;
@@ -58,8 +59,6 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
                       AsaResult& result) {
   if (auto ok = check_options(options); !ok) return ok;
   if (auto ok = validate_arrays(mesh); !ok) return ok;
-  auto adjacency = Adjacency::build(mesh);
-  if (!adjacency) return tl::unexpected(adjacency.error());
   // Levels multiply faces by up to 4 each; refuse what cannot be indexed.
   const double projected = static_cast<double>(mesh.face_count()) * std::pow(4.0, options.levels);
   if (projected > 1.0e9) {
@@ -69,20 +68,22 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   }
 
   AsaWorkspace::Buffers& ws = workspace.buffers();
-  ws.stats = {};
+  ws.stats.targets.clear();
+  ws.stats.split_edges.clear();
   const uint32_t F = mesh.face_count(), V = mesh.vertex_count();
 
   // Level 0: the caller's arrays plus our corner table and feature flags.
   asa::LevelMesh& base = ws.base;
-  base.opposite.resize(3 * static_cast<size_t>(F));
-  for (uint32_t c = 0; c < 3 * F; ++c) base.opposite[c] = adjacency->opposite(c);
+  if (auto built = asa::build_opposites(mesh, base.opposite, ws.corner_scratch); !built) return built;
   asa::LevelView view;
   view.positions = mesh.positions.data();
   view.corner_vertex = F ? mesh.triangles.front().data() : nullptr;
   view.opposite = base.opposite.data();
   view.vertex_count = V;
   view.face_count = F;
-  asa::compute_face_normals(view, ws.normals);
+  // Normals: for crease tagging and flatness (the uniform scheme needs none).
+  const bool need_normals = options.crease_degrees > 0 || !options.uniform;
+  if (need_normals) asa::compute_face_normals(view, ws.normals);
   asa::tag_feature_edges(view, options.crease_degrees, ws.normals, base.feature_edge);
   view.feature_edge = base.feature_edge.data();
   asa::count_vertex_features(view, base.vertex_features);

@@ -1,0 +1,34 @@
+// A fast corner-table builder for the subdivision hot path. Adjacency::build
+// (common/mesh/adjacency.h) answers every query a tool needs; subdivision only
+// needs the opposite corners, rebuilt for every call the client makes, so
+// this builder trades generality for speed: half-edges are bucketed by their
+// smaller vertex with the other end stored inline, so matching touches one
+// small contiguous bucket per edge. Same acceptance rules as
+// Adjacency::build (tested against it).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream::asa {
+
+struct CornerTableScratch {
+  std::vector<uint32_t> offset;
+  std::vector<uint64_t> entries;
+  std::vector<uint32_t> corners_at;
+  std::vector<uint32_t> faces_at;
+  std::vector<uint8_t> visited;
+};
+
+// Fills opposite[c] (kNone on a boundary) for the mesh's 3F corners.
+// Preconditions: indices in range, no repeated vertex in a triangle (as
+// validate_arrays checks). Fails with kNonManifold, naming the edge or
+// vertex, when an edge has more than two faces, two faces use an edge in the
+// same direction, or a vertex's faces form more than one fan.
+// O(V + F) time; no allocation once the scratch has capacity.
+Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, CornerTableScratch& scratch);
+
+}  // namespace meshstream::asa
