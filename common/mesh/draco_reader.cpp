@@ -11,6 +11,8 @@
 //    position *value* a corner maps to (STL: each point, since an STL file
 //    has no shared vertices and the reader merges them itself).
 #include <cstring>
+#include <filesystem>
+#include <string_view>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -46,6 +48,23 @@ Result<std::unique_ptr<draco::Mesh>> decode(const std::string& path, const std::
     return mesh;
   }
   if (ext == "stl") {
+    // Draco trusts the triangle count in the header (a damaged count makes it
+    // allocate gigabytes); a binary STL has exactly 84 + 50 * count bytes.
+    std::ifstream in(path, std::ios::binary);
+    char header[84] = {};
+    in.read(header, sizeof header);
+    uint32_t count = 0;
+    std::memcpy(&count, header + 80, 4);
+    const uint64_t size = std::filesystem::file_size(path);
+    if (in.gcount() < 84 || size != 84 + 50ull * count) {
+      if (std::string_view(header, std::min<size_t>(in.gcount(), 5)) == "solid") {
+        return make_error(ErrorCode::kUnsupported, "ASCII STL");  // read_with_draco hands it on
+      }
+      return make_error(ErrorCode::kParse, "not a binary STL: " + std::to_string(size) +
+                                               " bytes, but the header announces " +
+                                               std::to_string(count) + " triangles (" +
+                                               std::to_string(84 + 50ull * count) + " bytes)");
+    }
     draco::StlDecoder decoder;
     auto result = decoder.DecodeFromFile(path);
     if (!result.ok()) return fail(result.status());
@@ -101,8 +120,18 @@ bool gather(const draco::Mesh& dm, const draco::PointAttribute& attribute,
 
 Result<RawMesh> read_with_draco(const std::string& path) {
   const std::string ext = lower_extension(path);
-  auto decoded = decode(path, ext);
-  if (!decoded) return tl::unexpected(std::move(decoded).error());
+  Result<std::unique_ptr<draco::Mesh>> decoded = make_error(ErrorCode::kParse, "not decoded");
+  try {
+    decoded = decode(path, ext);
+  } catch (const std::exception& e) {
+    // Draco's parsers size vectors from counts in the file; a damaged file
+    // can make that throw. Not a crash: a malformed file.
+    return make_error(ErrorCode::kParse, std::string("Draco could not read it: ") + e.what());
+  }
+  if (!decoded) {
+    if (decoded.error().code == ErrorCode::kUnsupported && ext == "stl") return read_ascii_stl(path);
+    return tl::unexpected(std::move(decoded).error());
+  }
   const draco::Mesh& dm = **decoded;
   const draco::PointAttribute* position = dm.GetNamedAttribute(draco::GeometryAttribute::POSITION);
   if (position == nullptr || position->num_components() != 3) {

@@ -35,7 +35,11 @@ Result<RawMesh> read_off(const std::string& path);
 // and count checks. O(file size).
 Result<RawMesh> read_ply(const std::string& path);
 
-// OBJ, STL and .drc through Draco's io. Positions are read per face
+// ASCII STL: every "vertex x y z" of every facet, three per triangle (not
+// welded here). Draco reads binary STL only. O(file size).
+Result<RawMesh> read_ascii_stl(const std::string& path);
+
+// OBJ, binary STL and .drc through Draco's io. Positions are read per face
 // corner through the point-to-value mapping, so Draco's own de-duplication
 // does not hide what the file holds. Normals, colours and texture
 // coordinates are kept when every vertex has one consistent value.
