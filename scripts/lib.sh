@@ -14,6 +14,8 @@ MESHSTREAM_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev libmeshoptimizer-dev
   gnuplot-nox  # bench: the codec rate-distortion plot
+  libglfw3-dev libimgui-dev libosmesa6-dev libpng-dev  # viewer: window, panel, off-screen, PNG
+  xvfb xauth  # viewer tests: a virtual X display for the window
 )
 
 ms_install_packages() {
