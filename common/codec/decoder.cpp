@@ -91,7 +91,17 @@ struct IncrementalDecoder::State {
       auto state = RefinementState::from_base(base->positions, base->faces, h.quant_bits);
       if (!state) return where(state.error());
       refine = std::move(*state);
+      // The header's totals are checked against the index; cap what a
+      // hostile header can make us reserve.
+      const uint32_t cap = 1u << 26;
+      const uint32_t nv = std::min(h.vertex_count, cap), nf = std::min(h.face_count, cap);
+      refine->mesh.reserve(nv, nf);
+      refine->order_next.reserve(nv);
+      refine->created_layer.reserve(nv);
+      refine->valence.reserve(nv);
       mesh = Mesh{};
+      mesh.positions.reserve(nv);
+      mesh.triangles.reserve(nf);
       mesh.positions.resize(base->positions.size());
       for (size_t v = 0; v < base->positions.size(); ++v) mesh.positions[v] = grid.dequantize(base->positions[v]);
       mesh.triangles = base->faces;

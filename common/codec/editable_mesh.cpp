@@ -25,43 +25,6 @@ Result<EditableMesh> EditableMesh::build(std::vector<Vec3i> positions, std::vect
   return m;
 }
 
-void EditableMesh::set_opposite(uint32_t c, uint32_t value) {
-  if (journal_open_ && c < mark_faces_ * 3) journal_.push_back({0, c, {opposite_[c], 0, 0}});
-  opposite_[c] = value;
-}
-void EditableMesh::set_vertex_corner(uint32_t v, uint32_t value) {
-  if (journal_open_ && v < mark_vertices_) journal_.push_back({1, v, {vertex_corner_[v], 0, 0}});
-  vertex_corner_[v] = value;
-}
-void EditableMesh::set_face(uint32_t f, const Triangle& t) {
-  if (journal_open_ && f < mark_faces_) journal_.push_back({2, f, faces_[f]});
-  faces_[f] = t;
-}
-
-void EditableMesh::mark() {
-  journal_.clear();
-  journal_open_ = true;
-  mark_vertices_ = positions_.size();
-  mark_faces_ = faces_.size();
-}
-
-void EditableMesh::rollback() {
-  for (size_t i = journal_.size(); i-- > 0;) {
-    const JournalEntry& e = journal_[i];
-    if (e.kind == 0) opposite_[e.index] = e.old[0];
-    if (e.kind == 1) vertex_corner_[e.index] = e.old[0];
-    if (e.kind == 2) faces_[e.index] = e.old;
-  }
-  journal_.clear();
-  positions_.resize(mark_vertices_);
-  vertex_corner_.resize(mark_vertices_);
-  boundary_.resize(mark_vertices_);
-  faces_.resize(mark_faces_);
-  opposite_.resize(mark_faces_ * 3);
-  if (!dead_.empty()) dead_.resize(mark_faces_);
-  journal_open_ = false;
-}
-
 void EditableMesh::star(uint32_t v, std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) const {
   ring.clear();
   corners.clear();

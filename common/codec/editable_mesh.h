@@ -79,20 +79,23 @@ class EditableMesh {
   uint32_t insert_vertex(const std::vector<uint32_t>& ring, const std::vector<uint32_t>& fan_corners,
                          uint32_t open, Vec3i position, std::vector<uint32_t>* touched);
 
-  // Undo journal (decoder): while a mark is open every change is logged, and
-  // rollback() restores the state of mark() exactly.
-  void mark();
-  void rollback();
-  void commit() { journal_open_ = false; }
+  // Reserves room for a mesh of this size (avoids regrowth while decoding).
+  void reserve(uint32_t vertices, uint32_t faces) {
+    positions_.reserve(vertices);
+    vertex_corner_.reserve(vertices);
+    boundary_.reserve(vertices);
+    faces_.reserve(faces);
+    opposite_.reserve(3 * size_t(faces));
+  }
 
   // The live faces as a plain triangle list (dead slots skipped) and the
   // positions; vertices keep their ids.
   std::vector<Triangle> live_faces() const;
 
  private:
-  void set_opposite(uint32_t c, uint32_t value);
-  void set_vertex_corner(uint32_t v, uint32_t value);
-  void set_face(uint32_t f, const Triangle& t);
+  void set_opposite(uint32_t c, uint32_t value) { opposite_[c] = value; }
+  void set_vertex_corner(uint32_t v, uint32_t value) { vertex_corner_[v] = value; }
+  void set_face(uint32_t f, const Triangle& t) { faces_[f] = t; }
 
   std::vector<Vec3i> positions_;
   std::vector<Triangle> faces_;
@@ -101,14 +104,6 @@ class EditableMesh {
   std::vector<uint8_t> boundary_;
   std::vector<uint8_t> dead_;
 
-  struct JournalEntry {
-    uint8_t kind;  // 0 opposite, 1 vertex corner, 2 face
-    uint32_t index;
-    Triangle old;
-  };
-  bool journal_open_ = false;
-  size_t mark_vertices_ = 0, mark_faces_ = 0;
-  std::vector<JournalEntry> journal_;
 };
 
 }  // namespace meshstream

@@ -138,6 +138,7 @@ class RecordWriter {
     }
     s_.layer += 1;
     s_.cursor = s_.order_head;
+    s_.last_count = 0;
     size_t remaining = removals.size();
     begin_record(true);
     std::vector<uint32_t> star_ring, star_corners, at_apex;
@@ -165,8 +166,9 @@ class RecordWriter {
       std::sort(order.begin(), order.end());
       const uint32_t count = static_cast<uint32_t>(order.size());
       RefinementModels& m = s_.models;
-      m.patch_count[std::min(ring_size, 12u)].encode(enc_, std::min(count, 3u));
+      m.patch_count[count_context(s_, u)].encode(enc_, std::min(count, 3u));
       if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);
+      s_.last_count = count;
       patches.resize(count);
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals[order[j].second];

@@ -108,7 +108,12 @@ void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
   const uint64_t v = uint64_t(value) + 1;  // >= 1, so it has a leading one
   int len = 0;
   while ((v >> len) > 1) ++len;  // v in [2^len, 2^(len+1))
-  length.encode(enc, static_cast<uint32_t>(len));
+  if (len < 31) {
+    length.encode(enc, static_cast<uint32_t>(len));
+  } else {
+    length.encode(enc, 31);
+    enc.encode_direct(static_cast<uint32_t>(len - 31), 1);
+  }
   int rest = len;
   // Up to two bits below the leading one through models: most of the
   // information about the shape of the distribution lives there.
@@ -124,7 +129,7 @@ void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
 
 uint32_t AdaptiveUIntModel::decode(RangeDecoder& dec) {
   uint32_t len = length.decode(dec);
-  if (len > 32) len = 32;  // corrupt input: clamp, the caller range-checks
+  if (len == 31) len += dec.decode_direct(1);
   uint64_t v = 1;
   int rest = static_cast<int>(len);
   uint32_t ctx = 1;

@@ -88,10 +88,10 @@ struct BitTreeModel {
 };
 
 // Adaptive Exp-Golomb for unsigned integers up to 2^32 - 1: the bit length
-// (0..32) through a bit tree, then the two bits below the leading one through
+// (0..32) through a 5-level bit tree (31 escapes to 31 or 32), then the two bits below the leading one through
 // models indexed by the length, then the rest as equiprobable bits.
 struct AdaptiveUIntModel {
-  BitTreeModel<6> length;
+  BitTreeModel<5> length;
   BitModel high[33][4];
   void encode(RangeEncoder& enc, uint32_t value);
   uint32_t decode(RangeDecoder& dec);

@@ -38,6 +38,12 @@ Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
   for (uint32_t v = 0; v < n; ++v) s.order_next[v] = v + 1 < n ? v + 1 : kNone;
   s.order_head = n > 0 ? 0 : kNone;
   s.created_layer.assign(n, 0);
+  s.valence.resize(n);
+  std::vector<uint32_t> ring, corners;
+  for (uint32_t v = 0; v < n; ++v) {
+    s.mesh.star(v, ring, corners);
+    s.valence[v] = static_cast<uint32_t>(ring.size());
+  }
   s.max_coordinate = (int32_t(1) << quant_bits) - 1;
   return s;
 }
@@ -92,9 +98,12 @@ ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uin
     n[2] += ax * by - ay * bx;
   }
   ResidualContext ctx;
-  // Twice log2 of the mean L1 edge length: half-octave buckets.
-  const double mean = double(total) / double(k) + 1.0;
-  ctx.scale = std::clamp(static_cast<int>(2.0 * std::log2(mean)), 0, kScaleContexts - 1);
+  // Twice log2 of the mean L1 edge length, in integers: half-octave buckets
+  // (bit length, plus one when the bit below the leading one is set).
+  const uint64_t mean = uint64_t(total) / k + 1;
+  const int bits = 63 - __builtin_clzll(mean);
+  const int half = bits > 0 ? int((mean >> (bits - 1)) & 1u) : 0;
+  ctx.scale = std::clamp(2 * bits + half, 0, kScaleContexts - 1);
   std::sort(ctx.axis, ctx.axis + 3, [&](int x, int y) {
     const int64_t ax = std::abs(n[x]), ay = std::abs(n[y]);
     return ax > ay || (ax == ay && x < y);
@@ -144,6 +153,17 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
   state.order_next.push_back(state.order_next[apex]);
   state.order_next[apex] = v;
   state.created_layer.push_back(state.layer);
+  // Valences: the apex trades its k-3 diagonals for v, R_1 and R_k-1 gain v,
+  // and the ends of a re-opened boundary edge lose each other.
+  const uint32_t k = static_cast<uint32_t>(patch.ring.size());
+  state.valence.push_back(k);
+  state.valence[apex] = state.valence[apex] + 4 - k;
+  state.valence[patch.ring[1]] += 1;
+  state.valence[patch.ring[k - 1]] += 1;
+  if (open != kNone) {
+    state.valence[patch.ring[open]] -= 1;
+    state.valence[patch.ring[(open + 1) % k]] -= 1;
+  }
   return v;
 }
 
@@ -186,6 +206,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   if (h.starts_layer) {
     state.layer += 1;
     state.cursor = state.order_head;
+    state.last_count = 0;
   } else if (state.layer == 0) {
     return bad("first refinement record does not start a layer");
   }
@@ -193,42 +214,32 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   RangeDecoder dec(payload.subspan(pos));
   RefinementModels& m = state.models;
   EditableMesh& mesh = state.mesh;
-  mesh.mark();
   std::vector<uint32_t> star_ring, star_corners;
   std::vector<ResolvedPatch> patches;
   std::vector<Vec3i> positions;
   std::vector<uint32_t> opens, open_edges;
   std::vector<uint8_t> used_faces;
   uint32_t inserted = 0;
-  // Links changed in the order list, so a failure can restore them exactly.
-  std::vector<std::pair<uint32_t, uint32_t>> link_journal;
-  auto fail_and_unlink = [&](const std::string& what) -> Status {
-    for (size_t i = link_journal.size(); i-- > 0;) {
-      state.order_next[link_journal[i].first] = link_journal[i].second;
-    }
-    state.order_next.resize(vertices_before);
-    state.created_layer.resize(vertices_before);
-    mesh.rollback();
-    applied.added_vertices.clear();
-    applied.touched_faces.clear();
-    return bad(what);
-  };
+  // On error the state is left half-applied: the caller discards it (the
+  // decoder's output mesh is only updated after a record succeeds).
+  auto fail = [&](const std::string& what) -> Status { return bad(what); };
 
   for (uint32_t step = 0; step < h.walk_steps; ++step) {
     while (state.cursor != kNone && state.created_layer[state.cursor] == state.layer) {
       state.cursor = state.order_next[state.cursor];
     }
-    if (state.cursor == kNone) return fail_and_unlink("refinement walk runs past the last vertex");
+    if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
     const uint32_t u = state.cursor;
     state.cursor = state.order_next[u];
+    uint32_t count = m.patch_count[count_context(state, u)].decode(dec);
+    if (count == 3) count += m.patch_count_extra.decode(dec);
+    state.last_count = count;
+    if (count == 0) continue;
     mesh.star(u, star_ring, star_corners);
     const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
     const uint32_t faces = static_cast<uint32_t>(star_corners.size());
-    uint32_t count = m.patch_count[std::min(ring_size, 12u)].decode(dec);
-    if (count == 3) count += m.patch_count_extra.decode(dec);
-    if (count == 0) continue;
     if (count > faces || inserted + count > h.insertions) {
-      return fail_and_unlink("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
+      return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
                              " patches, more than it or the record holds");
     }
     patches.resize(count);
@@ -239,13 +250,13 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       uint32_t r = faces <= 16 ? m.first_face[faces].decode(dec) : m.first_face_big.decode(dec);
       const uint32_t k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
       if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
-        return fail_and_unlink("patch " + std::to_string(i) + " at vertex " + std::to_string(u) +
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) +
                                " (first face " + std::to_string(r) + ", valence " + std::to_string(k) +
                                ") does not fit its star of " + std::to_string(faces) + " faces");
       }
       for (uint32_t j = 0; j + 2 < k; ++j) {
         uint8_t& used = used_faces[(r + j) % faces];
-        if (used) return fail_and_unlink("patches at vertex " + std::to_string(u) + " overlap");
+        if (used) return fail("patches at vertex " + std::to_string(u) + " overlap");
         used = 1;
       }
       opens[i] = kNone;
@@ -253,7 +264,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       if (!open_edges.empty()) {
         const uint32_t choice = m.open_edge.decode(dec);
         if (choice > open_edges.size()) {
-          return fail_and_unlink("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
+          return fail("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
                                  std::to_string(choice) + " of " + std::to_string(open_edges.size()));
         }
         if (choice > 0) opens[i] = open_edges[choice - 1];
@@ -261,30 +272,28 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       const Vec3i pred = predict_position(mesh, patches[i].ring);
       const ResidualContext ctx = residual_context(mesh, patches[i].ring);
       if (!decode_residual(m, dec, ctx, pred, state.max_coordinate, positions[i])) {
-        return fail_and_unlink("vertex position outside the quantization grid at vertex " +
+        return fail("vertex position outside the quantization grid at vertex " +
                                std::to_string(u));
       }
     }
-    if (dec.exhausted_badly()) return fail_and_unlink("refinement record data ends early");
+    if (dec.exhausted_badly()) return fail("refinement record data ends early");
     for (uint32_t i = 0; i < count; ++i) {
-      link_journal.push_back({u, state.order_next[u]});
       const uint32_t v = apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
       applied.added_vertices.push_back(v);
     }
     inserted += count;
   }
   if (inserted != h.insertions) {
-    return fail_and_unlink("refinement record holds " + std::to_string(inserted) + " insertions, its header says " +
+    return fail("refinement record holds " + std::to_string(inserted) + " insertions, its header says " +
                            std::to_string(h.insertions));
   }
-  if (dec.exhausted_badly()) return fail_and_unlink("refinement record data ends early");
+  if (dec.exhausted_badly()) return fail("refinement record data ends early");
   if (mesh.vertex_count() != expected_vertices || mesh.face_slot_count() != expected_faces) {
-    return fail_and_unlink("refinement record yields " + std::to_string(mesh.vertex_count()) +
+    return fail("refinement record yields " + std::to_string(mesh.vertex_count()) +
                            " vertices and " + std::to_string(mesh.face_slot_count()) +
                            " faces, the index says " + std::to_string(expected_vertices) + " and " +
                            std::to_string(expected_faces));
   }
-  mesh.commit();
   return {};
 }
 

@@ -21,6 +21,7 @@
 // varint walk steps, varint insertions, then one range-coded block.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -34,7 +35,7 @@ namespace meshstream {
 inline constexpr int kScaleContexts = 20;
 
 struct RefinementModels {
-  BitTreeModel<2> patch_count[13];   // by min(apex ring size, 12); 3 = escape
+  BitTreeModel<2> patch_count[26];   // by count_context; 3 = escape
   AdaptiveUIntModel patch_count_extra;
   BitTreeModel<4> first_face[17];    // by apex face count when <= 16
   AdaptiveUIntModel first_face_big;
@@ -51,6 +52,8 @@ struct RefinementState {
   uint32_t layer = 0;                   // layers started so far
   uint32_t cursor = kNone;              // next vertex of the walk
   int32_t max_coordinate = 4095;
+  uint32_t last_count = 0;              // patches at the previous walk vertex
+  std::vector<uint32_t> valence;        // neighbours per vertex, kept by apply_patch
   RefinementModels models;
 
   // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
@@ -63,6 +66,13 @@ struct ResolvedPatch {
   std::vector<uint32_t> ring;         // R_0 = apex, ..., R_k-1
   std::vector<uint32_t> fan_corners;  // k-2 corners at the apex
 };
+
+// Context of the patch count at walk vertex u: its valence (kept up to
+// date by apply_patch, so the decoder swings around u only when it holds
+// patches) and whether the previous walk vertex held patches.
+inline uint32_t count_context(const RefinementState& s, uint32_t u) {
+  return std::min<uint32_t>(s.valence[u], 12) * 2 + (s.last_count > 0 ? 1 : 0);
+}
 
 // Resolves the patch whose first fan face is star index r and whose vertex
 // has valence k, given the apex's star. False when it does not fit (r or k
@@ -117,9 +127,11 @@ struct AppliedRecord {
 };
 
 // Decodes one refinement record and applies it to `state`. Every count,
-// index and symbol is range-checked; on error the mesh is rolled back to its
-// state before the record (the models and walk are not: the caller stops
-// decoding after an error). O(record size + touched faces).
+// index and symbol is range-checked, so bad bytes never read or write out of
+// bounds and never make a non-manifold mesh; on error `state` is left
+// half-applied and must be discarded (IncrementalDecoder keeps its output
+// mesh, updated only after a record succeeds, and stops there).
+// O(record size + touched faces).
 // `expected_vertices`/`expected_faces` are the index's counts after the
 // record; a mismatch is an error (and rolls back) like any other.
 Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
