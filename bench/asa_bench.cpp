@@ -1,0 +1,410 @@
+// ASA benchmark: our uniform modified Butterfly against OpenMesh's
+// ModifiedButterflyT (same process, same input), ASA at t = 0.7/0.8/0.9 as
+// fractions of uniform (the thesis's tables 4.1-4.4), the ratio of our time
+// to the memory-bandwidth floor for writing the output, and the surface
+// distance to the original before and after ASA on simplified meshes.
+// Writes bench/report/asa.md (or DIR/asa.md with --report-dir DIR).
+//
+// Usage: asa_bench [--report-dir DIR] [--quick]
+#include <malloc.h>
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <meshoptimizer.h>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/ModifiedButterFlyT.hh>
+
+#include "common/asa/subdivide.h"
+#include "common/mesh/adjacency.h"
+#include "common/mesh/import.h"
+#include "common/metrics/distance.h"
+#include "tests/test_meshes.h"
+
+// ---- Heap accounting: live and peak bytes of every operator new, so both
+// libraries' peak memory is measured the same way in one process.
+namespace {
+std::atomic<size_t> g_live{0}, g_peak{0};
+void note_alloc(void* p) {
+  if (!p) return;
+  const size_t now = g_live.fetch_add(malloc_usable_size(p)) + malloc_usable_size(p);
+  size_t peak = g_peak.load();
+  while (now > peak && !g_peak.compare_exchange_weak(peak, now)) {
+  }
+}
+void note_free(void* p) {
+  if (p) g_live.fetch_sub(malloc_usable_size(p));
+}
+void* counted_alloc(size_t n) {
+  void* p = std::malloc(n ? n : 1);
+  if (!p) throw std::bad_alloc();
+  note_alloc(p);
+  return p;
+}
+void* counted_aligned(size_t n, std::align_val_t a) {
+  const size_t align = static_cast<size_t>(a);
+  void* p = std::aligned_alloc(align, (n + align - 1) / align * align);
+  if (!p) throw std::bad_alloc();
+  note_alloc(p);
+  return p;
+}
+void counted_free(void* p) {
+  note_free(p);
+  std::free(p);
+}
+}  // namespace
+
+void* operator new(size_t n) { return counted_alloc(n); }
+void* operator new[](size_t n) { return counted_alloc(n); }
+void* operator new(size_t n, std::align_val_t a) { return counted_aligned(n, a); }
+void* operator new[](size_t n, std::align_val_t a) { return counted_aligned(n, a); }
+void operator delete(void* p) noexcept { counted_free(p); }
+void operator delete[](void* p) noexcept { counted_free(p); }
+void operator delete(void* p, size_t) noexcept { counted_free(p); }
+void operator delete[](void* p, size_t) noexcept { counted_free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { counted_free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { counted_free(p); }
+void operator delete(void* p, size_t, std::align_val_t) noexcept { counted_free(p); }
+void operator delete[](void* p, size_t, std::align_val_t) noexcept { counted_free(p); }
+
+namespace meshstream::bench {
+namespace {
+
+struct DoubleTraits : OpenMesh::DefaultTraits {
+  typedef OpenMesh::Vec3d Point;
+};
+// OpenMesh's default float points, as an application would use it.
+using OMesh = OpenMesh::TriMesh_ArrayKernelT<>;
+
+OMesh to_openmesh(const Mesh& m) {
+  OMesh om;
+  std::vector<OMesh::VertexHandle> vh;
+  vh.reserve(m.vertex_count());
+  for (const Vec3f& p : m.positions) vh.push_back(om.add_vertex(OMesh::Point(p.x, p.y, p.z)));
+  for (const Triangle& t : m.triangles) om.add_face(vh[t[0]], vh[t[1]], vh[t[2]]);
+  return om;
+}
+
+// Thread CPU time: the machines are shared (load above the core count is
+// common), and CPU time is what each library actually spent.
+double now_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+}
+
+// Peak heap above what was live before `run`, in bytes.
+size_t peak_of(const std::function<void()>& run) {
+  const size_t base = g_live.load();
+  g_peak.store(base);
+  run();
+  return g_peak.load() - base;
+}
+
+std::string fmt(const char* f, double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, x);
+  return b;
+}
+
+// Write bandwidth (memset) and copy bandwidth (memcpy, bytes copied per
+// second) on a 256 MiB buffer, median of 5: the floor for writing output.
+struct Bandwidth {
+  double write_gbs = 0, copy_gbs = 0;
+};
+Bandwidth measure_bandwidth() {
+  const size_t n = size_t(256) << 20;
+  std::vector<char> a(n, 1), b(n, 2);
+  std::vector<double> w, c;
+  for (int i = 0; i < 5; ++i) {
+    double t0 = now_ms();
+    std::memset(a.data(), i, n);
+    double t1 = now_ms();
+    std::memcpy(b.data(), a.data(), n);
+    double t2 = now_ms();
+    w.push_back(n / ((t1 - t0) * 1e6));
+    c.push_back(n / ((t2 - t1) * 1e6));
+  }
+  volatile char sink = a[n / 2] + b[n / 3];
+  (void)sink;
+  return {median(w), median(c)};
+}
+
+size_t output_bytes(const Mesh& m, size_t faces) {
+  return m.positions.size() * sizeof(Vec3f) + faces * sizeof(Triangle) + faces;  // + face_kind
+}
+
+struct Options {
+  std::string report_dir;
+  bool quick = false;
+};
+
+}  // namespace
+}  // namespace meshstream::bench
+
+int main(int argc, char** argv) {
+  using namespace meshstream;
+  using namespace meshstream::bench;
+  Options opt;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--report-dir" && i + 1 < argc) opt.report_dir = argv[++i];
+    else if (a == "--quick") opt.quick = true;
+    else if (a == "--help" || a == "-h") {
+      std::printf("usage: asa_bench [--report-dir DIR] [--quick]\n");
+      return 0;
+    } else {
+      std::fprintf(stderr, "asa_bench: unknown argument %s\n", a.c_str());
+      return 2;
+    }
+  }
+  if (opt.report_dir.empty()) {
+#ifdef MESHSTREAM_SOURCE_DIR
+    opt.report_dir = std::string(MESHSTREAM_SOURCE_DIR) + "/bench/report";
+#else
+    opt.report_dir = "bench/report";
+#endif
+  }
+  const std::string mesh_dir = testing::test_mesh_dir();
+  if (mesh_dir.empty()) {
+    std::fprintf(stderr, "asa_bench: real meshes not found (set MESHSTREAM_TEST_MESHES)\n");
+    return 1;
+  }
+  std::vector<std::string> names = {"bunny.off", "fandisk.off", "armadillo.obj", "casting.off", "mask.off"};
+  if (opt.quick) names = {"fandisk.off", "bunny.off"};
+  const int max_level = 3;
+  const Bandwidth bw = measure_bandwidth();
+  std::printf("memory bandwidth: write %.1f GB/s, copy %.1f GB/s\n", bw.write_gbs, bw.copy_gbs);
+
+  std::ostringstream uniform_table, asa_table, distance_table, level_table;
+  uniform_table << "| mesh | level | output faces | ours ms | ours M tri/s | OpenMesh ms | OpenMesh M tri/s | "
+                   "speed-up | speed-up incl. OpenMesh's mesh build | ours peak MB | OpenMesh peak MB | write floor ms | ours / floor |\n"
+                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  asa_table << "| mesh | level | t | vertices | faces | vertices / uniform | time ms | time / uniform | "
+               "time share / output share |\n|---|---|---|---|---|---|---|---|---|\n";
+  std::vector<double> speedups, speedups_with_build;
+  for (const std::string& name : names) {
+    auto imported = import_mesh(testing::test_mesh(name));
+    if (!imported) {
+      std::fprintf(stderr, "asa_bench: %s: %s\n", name.c_str(), imported.error().message.c_str());
+      continue;
+    }
+    const Mesh mesh = std::move(imported->mesh);
+    const OMesh om_input = to_openmesh(mesh);
+    for (int level = 1; level <= max_level; ++level) {
+      AsaOptions uo;
+      uo.uniform = true;
+      uo.levels = level;
+      // Ours, warm (workspace and result reused, as the client does).
+      AsaWorkspace ws;
+      AsaResult result;
+      if (!subdivide_into(mesh, uo, ws, result)) return 1;
+      const size_t out_faces = result.mesh.face_count();
+      const int runs = out_faces > 3000000 ? 5 : 9;
+      std::vector<double> ours;
+      for (int r = 0; r < runs; ++r) {
+        double t0 = now_ms();
+        (void)subdivide_into(mesh, uo, ws, result);
+        ours.push_back(now_ms() - t0);
+      }
+      const double ours_ms = median(ours);
+      const size_t ours_peak = peak_of([&] {
+        AsaWorkspace fresh;
+        auto r = subdivide(mesh, uo, fresh);
+      });
+      // OpenMesh on a copy of its own mesh (the copy is not timed). Its mesh
+      // is a half-edge structure built from our arrays first: that build is
+      // timed separately (ours includes building its corner table).
+      std::vector<double> theirs, om_build;
+      for (int r = 0; r < 3; ++r) {
+        double t0 = now_ms();
+        OMesh built = to_openmesh(mesh);
+        om_build.push_back(now_ms() - t0);
+      }
+      const double om_build_ms = median(om_build);
+      size_t om_peak = 0;
+      size_t om_faces = 0;
+      const int om_runs = out_faces > 3000000 ? 1 : 3;
+      for (int r = 0; r < om_runs; ++r) {
+        OMesh om = om_input;
+        OpenMesh::Subdivider::Uniform::ModifiedButterflyT<OMesh, float> butterfly;
+        size_t peak = peak_of([&] {
+          double t0 = now_ms();
+          butterfly(om, static_cast<size_t>(level));
+          theirs.push_back(now_ms() - t0);
+        });
+        om_peak = std::max(om_peak, peak);
+        om_faces = om.n_faces();
+      }
+      const double om_ms = median(theirs);
+      if (om_faces != out_faces) std::fprintf(stderr, "face counts differ: %zu vs %zu\n", om_faces, out_faces);
+      const double floor_ms = output_bytes(result.mesh, out_faces) / (bw.write_gbs * 1e6);
+      speedups.push_back(om_ms / ours_ms);
+      speedups_with_build.push_back((om_ms + om_build_ms) / ours_ms);
+      uniform_table << "| " << name << " | " << level << " | " << out_faces << " | " << fmt("%.2f", ours_ms) << " | "
+                    << fmt("%.1f", out_faces / ours_ms / 1e3) << " | " << fmt("%.1f", om_ms) << " | "
+                    << fmt("%.2f", out_faces / om_ms / 1e3) << " | " << fmt("%.1f", om_ms / ours_ms) << "x | "
+                    << fmt("%.1f", (om_ms + om_build_ms) / ours_ms) << "x | "
+                    << fmt("%.1f", ours_peak / 1048576.0) << " | " << fmt("%.1f", om_peak / 1048576.0) << " | "
+                    << fmt("%.2f", floor_ms) << " | " << fmt("%.1f", ours_ms / floor_ms) << " |\n";
+      std::printf("%s L%d uniform: ours %.2f ms (%.1f M tri/s), OpenMesh %.1f ms (%.2f M tri/s)\n", name.c_str(),
+                  level, ours_ms, out_faces / ours_ms / 1e3, om_ms, out_faces / om_ms / 1e3);
+
+      // ASA at the thesis's t values.
+      const uint32_t uniform_vertices = result.mesh.vertex_count();
+      for (float t : {0.9f, 0.8f, 0.7f}) {
+        AsaOptions ao;
+        ao.levels = level;
+        ao.flatness = t;
+        AsaWorkspace aws;
+        AsaResult ar;
+        if (!subdivide_into(mesh, ao, aws, ar)) return 1;
+        std::vector<double> times;
+        for (int r = 0; r < runs; ++r) {
+          double t0 = now_ms();
+          (void)subdivide_into(mesh, ao, aws, ar);
+          times.push_back(now_ms() - t0);
+        }
+        const double ms = median(times);
+        const double vfrac = double(ar.mesh.vertex_count()) / uniform_vertices;
+        const double ffrac = double(ar.mesh.face_count()) / out_faces;
+        asa_table << "| " << name << " | " << level << " | " << fmt("%.1f", t) << " | " << ar.mesh.vertex_count()
+                  << " | " << ar.mesh.face_count() << " | " << fmt("%.2f", vfrac) << " | " << fmt("%.2f", ms)
+                  << " | " << fmt("%.2f", ms / ours_ms) << " | " << fmt("%.2f", (ms / ours_ms) / ffrac) << " |\n";
+      }
+    }
+  }
+
+  // Surface distance to the original before and after ASA, on meshes
+  // simplified to 1/20 and 1/10 of their triangles (meshoptimizer), standing
+  // in for stream prefixes decoded at compression ratios 20 and 10.
+  distance_table << "| mesh | ratio | faces | variant | output faces | RMS / diag | Hausdorff / diag |\n"
+                    "|---|---|---|---|---|---|---|\n";
+  std::vector<std::string> distance_names = {"bunny.off", "fandisk.off", "armadillo.obj"};
+  if (opt.quick) distance_names = {"fandisk.off"};
+  for (const std::string& name : distance_names) {
+    auto imported = import_mesh(testing::test_mesh(name));
+    if (!imported) continue;
+    const Mesh& original = imported->mesh;
+    for (int ratio : {20, 10}) {
+      std::vector<unsigned> indices(3 * original.triangles.size());
+      std::memcpy(indices.data(), original.triangles.data(), indices.size() * sizeof(unsigned));
+      std::vector<unsigned> simplified(indices.size());
+      const size_t target = indices.size() / ratio / 3 * 3;
+      simplified.resize(meshopt_simplify(simplified.data(), indices.data(), indices.size(),
+                                         &original.positions[0].x, original.positions.size(), sizeof(Vec3f), target,
+                                         1.0f, 0, nullptr));
+      // Compact the vertices the simplified mesh still uses.
+      Mesh coarse;
+      std::vector<uint32_t> remap(original.positions.size(), kNone);
+      for (size_t i = 0; i < simplified.size(); i += 3) {
+        Triangle t{};
+        for (int k = 0; k < 3; ++k) {
+          uint32_t& r = remap[simplified[i + k]];
+          if (r == kNone) {
+            r = coarse.vertex_count();
+            coarse.positions.push_back(original.positions[simplified[i + k]]);
+          }
+          t[k] = r;
+        }
+        coarse.triangles.push_back(t);
+      }
+      struct Variant {
+        std::string label;
+        AsaOptions options;
+      };
+      std::vector<Variant> variants;
+      variants.push_back({"simplified (no ASA)", [] { AsaOptions o; o.levels = 0; return o; }()});
+      for (int levels : {1, 2}) {
+        for (float t : {0.9f, 0.8f}) {
+          AsaOptions o;
+          o.levels = levels;
+          o.flatness = t;
+          variants.push_back({"ASA t=" + fmt("%.1f", t) + " L" + std::to_string(levels), o});
+        }
+        AsaOptions u;
+        u.uniform = true;
+        u.levels = levels;
+        variants.push_back({"uniform L" + std::to_string(levels), u});
+      }
+      if (name == "fandisk.off") {
+        AsaOptions c;
+        c.uniform = true;
+        c.levels = 2;
+        c.crease_degrees = 45;
+        variants.push_back({"uniform L2, crease 45", c});
+        c.uniform = false;
+        c.flatness = 0.8f;
+        variants.push_back({"ASA t=0.8 L2, crease 45", c});
+      }
+      for (const Variant& v : variants) {
+        auto r = subdivide(coarse, v.options);
+        if (!r) {
+          distance_table << "| " << name << " | " << ratio << " | " << coarse.face_count() << " | " << v.label
+                         << " | n/a: " << r.error().message << " | | |\n";
+          continue;
+        }
+        auto d = surface_distance(original, r->mesh);
+        if (!d) continue;
+        distance_table << "| " << name << " | " << ratio << " | " << coarse.face_count() << " | " << v.label << " | "
+                       << r->mesh.face_count() << " | " << fmt("%.3e", d->relative_rms()) << " | "
+                       << fmt("%.3e", d->relative_hausdorff()) << " |\n";
+        std::printf("%s 1/%d %s: rms %.3e hausdorff %.3e\n", name.c_str(), ratio, v.label.c_str(),
+                    d->relative_rms(), d->relative_hausdorff());
+      }
+    }
+  }
+
+  std::filesystem::create_directories(opt.report_dir);
+  const std::string path = opt.report_dir + "/asa.md";
+  std::ofstream out(path);
+  out << "## ASA: adaptive modified Butterfly (bench/asa_bench.cpp)\n\n";
+  out << "One process, single thread, same inputs for both libraries. Times are thread CPU time (the machine is shared), medians (ours: 9 runs, 5 above "
+         "3 M output faces; OpenMesh: 3 runs, 1 above 3 M) of the whole call: input adjacency, every level, "
+         "output arrays. Ours runs warm (workspace and result reused, as the client calls it); peak memory is "
+         "the heap high-water mark above the input of a cold call, counted by the same operator-new hook for "
+         "both. OpenMesh: `ModifiedButterflyT<TriMesh, float>` on its default float mesh. Memory bandwidth "
+         "here: write "
+      << fmt("%.1f", bw.write_gbs) << " GB/s, copy " << fmt("%.1f", bw.copy_gbs)
+      << " GB/s (memset/memcpy of 256 MiB); the write floor is the output's bytes (positions, triangles, "
+         "face kinds) at the write bandwidth.\n\n";
+  out << "### Uniform: ours against OpenMesh\n\n" << uniform_table.str() << "\n";
+  if (!speedups.empty()) {
+    out << "Speed-up over OpenMesh: median " << fmt("%.1f", median(speedups)) << "x, min "
+        << fmt("%.1f", *std::min_element(speedups.begin(), speedups.end())) << "x, max "
+        << fmt("%.1f", *std::max_element(speedups.begin(), speedups.end())) << "x (subdivision only); "
+        << "including the build of OpenMesh's half-edge mesh from the same arrays (what a caller holding "
+        << "arrays pays; our time always includes building our corner table): median "
+        << fmt("%.1f", median(speedups_with_build)) << "x, min "
+        << fmt("%.1f", *std::min_element(speedups_with_build.begin(), speedups_with_build.end())) << "x.\n\n";
+  }
+  out << "### ASA against uniform (the thesis's tables 4.1-4.4)\n\n"
+         "`time share / output share` = (ASA time / uniform time) / (ASA faces / uniform faces): at most 1 "
+         "means ASA costs no more per output triangle than uniform.\n\n"
+      << asa_table.str() << "\n";
+  out << "### Does ASA bring a coarse mesh closer to the original?\n\n"
+         "Coarse meshes are meshoptimizer `meshopt_simplify` results at 1/20 and 1/10 of the triangles (they "
+         "keep a subset of the original vertices, like a decoded stream prefix; the codec's own prefixes can "
+         "replace them once it decodes them). Distances: `surface_distance` (common/metrics), symmetric, "
+         "relative to the original's bounding-box diagonal.\n\n"
+      << distance_table.str() << "\n";
+  std::printf("wrote %s\n", path.c_str());
+  return 0;
+}
