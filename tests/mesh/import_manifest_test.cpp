@@ -1,6 +1,8 @@
 // Every mesh of ../shared/meshes imports with the counts its MANIFEST.md
 // gives (computed there by an independent tool), and the repaired result is
 // a mesh the corner table accepts.
+#include <ostream>
+
 #include <gtest/gtest.h>
 
 #include "common/mesh/adjacency.h"
@@ -57,6 +59,9 @@ const ManifestRow kManifest[] = {
     {"extra_vertex.obj", 9, 10, 3, 0, 0, 9, 3, 0, 0, 3, true, 0},
     {"eof_test.obj", 3, 3, 1, 0, 0, 3, 1, 0, 0, 1, true, 0},
 };
+
+// So failures name the file instead of dumping the struct's bytes.
+void PrintTo(const ManifestRow& row, std::ostream* os) { *os << row.file; }
 
 class ManifestTest : public ::testing::TestWithParam<ManifestRow> {};
 
