@@ -1,0 +1,238 @@
+// Codec benchmark (issue 3): for each real mesh, in one run,
+//   1. Draco's single-rate size at 12 bits (levels 7 and 10) and its decode
+//      speed on its own level-7 file;
+//   2. our full .hcs size, encode and decode speed;
+//   3. the rate-distortion curve of our stream (record boundaries) against
+//      the LOD chain a user would build instead (meshoptimizer + Draco).
+// Writes bench/report/codec.md, codec_rd.csv and codec_rd.png (see report.h).
+//
+//   codec_bench --report-dir DIR [--meshes a.off,b.ply] [--quick]
+//               [--mesh-dir DIR] [--samples N]
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench/codec/measurements.h"
+#include "bench/codec/rate_distortion.h"
+#include "bench/codec/report.h"
+#include "bench/codec/timing.h"
+#include "bench/peers/draco_peer.h"
+#include "common/codec/container.h"
+#include "common/codec/decoder.h"
+#include "common/codec/encoder.h"
+#include "common/mesh/import.h"
+#include "common/metrics/distance.h"
+#include "tests/test_meshes.h"
+
+namespace meshstream::bench {
+namespace {
+
+// The "real models" of ../shared/meshes/MANIFEST.md.
+const std::vector<std::string> kRealMeshes = {
+    "bun_zipper.ply", "bunny.off",       "bunny.stl",       "armadillo.obj", "fandisk.off",
+    "crank.off",      "casting.off",     "mask.off",        "hemisphere.off", "skull.obj",
+    "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"};
+const std::vector<std::string> kQuickMeshes = {"bunny.off", "fandisk.off", "casting.off"};
+
+struct Settings {
+  std::string mesh_dir;
+  int quant_bits = 12;
+  int decode_runs = 7;
+  int encode_runs = 3;
+  int curve_points = 24;
+  uint32_t samples = 50000;
+};
+
+void measure_draco(const Mesh& mesh, const Settings& s, MeshMeasurements& m,
+                   std::vector<uint8_t>& level7) {
+  auto d7 = draco_encode(mesh, s.quant_bits, 7);
+  auto d10 = draco_encode(mesh, s.quant_bits, 10);
+  if (!d7 || !d10) {
+    m.draco_error = (!d7 ? d7.error() : d10.error()).message;
+    return;
+  }
+  level7 = *d7;
+  m.draco7_bytes = d7->size();
+  m.draco10_bytes = d10->size();
+  uint32_t points = 0;
+  const double seconds = median_seconds(s.decode_runs, [&] { points = draco_decode_only(*d7); });
+  if (points == 0) {
+    m.draco_error = "Draco could not decode its own level-7 file";
+    return;
+  }
+  m.draco_decode_vps = points / seconds;
+}
+
+// Returns the stream (empty when the encoder failed; the reason is in
+// m.ours_error).
+std::vector<uint8_t> measure_ours(const Mesh& mesh, const Settings& s, MeshMeasurements& m) {
+  EncodeOptions options;
+  options.quant_bits = s.quant_bits;
+  Result<std::vector<uint8_t>> stream = make_error(ErrorCode::kUnsupported, "not run");
+  std::vector<double> encode_times;
+  for (int r = 0; r < s.encode_runs; ++r) {
+    encode_times.push_back(median_seconds(1, [&] { stream = encode_hcs(mesh, options); }));
+    if (!stream) {
+      m.ours_error = "encode_hcs: " + stream.error().message;
+      return {};
+    }
+  }
+  m.ours_bytes = stream->size();
+  m.ours_encode_vps = m.vertices / median(encode_times);
+  auto index = read_stream_index(*stream);
+  if (!index) {
+    m.ours_error = "read_stream_index: " + index.error().message;
+    return {};
+  }
+  m.ours_records = static_cast<uint32_t>(index->records.size());
+  m.ours_base_bytes = index->records.empty() ? 0 : index->records[0].offset + index->records[0].size;
+  Result<Mesh> decoded = make_error(ErrorCode::kUnsupported, "not run");
+  const double seconds = median_seconds(s.decode_runs, [&] { decoded = decode_hcs(*stream); });
+  if (!decoded) {
+    m.ours_error = "decode_hcs: " + decoded.error().message;
+    return {};
+  }
+  m.ours_decode_vps = decoded->vertex_count() / seconds;
+  m.ours_counts_match =
+      decoded->vertex_count() == mesh.vertex_count() && decoded->face_count() == mesh.face_count();
+  return *stream;
+}
+
+void measure_rate_distortion(const Mesh& mesh, const std::vector<uint8_t>& stream,
+                             const Settings& s, MeshMeasurements& m) {
+  DistanceOptions options;
+  options.samples = s.samples;
+  auto original = PreparedSurface::prepare(mesh, options);
+  if (!original) {
+    m.rd_error = original.error().message;
+    return;
+  }
+  auto chain = lod_chain_curve(mesh, s.quant_bits, *original);
+  if (!chain) {
+    m.rd_error = chain.error().message;
+    return;
+  }
+  m.chain_curve = *chain;
+  if (!stream.empty()) {
+    auto index = read_stream_index(stream);
+    std::vector<uint64_t> budgets;
+    for (const RdPoint& p : *chain) budgets.push_back(p.bytes);
+    auto curve = our_curve(stream, choose_prefixes(*index, s.curve_points, budgets), *original);
+    if (!curve) {
+      m.rd_error = "ours: " + curve.error().message;
+    } else {
+      m.ours_curve = *curve;
+    }
+  }
+  m.at_chain = compare_at_chain(m.chain_curve, m.ours_curve, m.faces);
+}
+
+MeshMeasurements measure_mesh(const std::string& name, const Settings& s) {
+  MeshMeasurements m;
+  m.name = name;
+  auto imported = import_mesh(s.mesh_dir + "/" + name);
+  if (!imported) {
+    m.error = imported.error().message;
+    std::printf("%-16s import failed: %s\n", name.c_str(), m.error.c_str());
+    return m;
+  }
+  const Mesh& mesh = imported->mesh;
+  m.vertices = mesh.vertex_count();
+  m.faces = mesh.face_count();
+
+  std::vector<uint8_t> draco7;
+  measure_draco(mesh, s, m, draco7);
+  std::printf("%-16s V %7u  Draco L7 %6.2f bpv  L10 %6.2f bpv  decode %6.2f Mv/s\n", name.c_str(),
+              m.vertices, m.bpv(m.draco7_bytes), m.bpv(m.draco10_bytes), m.draco_decode_vps / 1e6);
+  std::fflush(stdout);
+
+  const std::vector<uint8_t> stream = measure_ours(mesh, s, m);
+  if (m.ours_error.empty()) {
+    std::printf("%-16s ours %6.2f bpv (%.2f x L7)  encode %6.3f Mv/s  decode %6.2f Mv/s  %u records\n",
+                name.c_str(), m.bpv(m.ours_bytes), double(m.ours_bytes) / m.draco7_bytes,
+                m.ours_encode_vps / 1e6, m.ours_decode_vps / 1e6, m.ours_records);
+  } else {
+    std::printf("%-16s ours n/a: %s\n", name.c_str(), m.ours_error.c_str());
+  }
+  std::fflush(stdout);
+
+  measure_rate_distortion(mesh, stream, s, m);
+  for (const ChainComparison& c : m.at_chain) {
+    std::printf("%-16s chain %-4s %9llu B  rms %.3g  H %.3g", name.c_str(), c.label.c_str(),
+                static_cast<unsigned long long>(c.chain.bytes), c.chain.rel_rms,
+                c.chain.rel_hausdorff);
+    if (c.ours) {
+      std::printf("   ours %9llu B  rms %.3g  H %.3g", static_cast<unsigned long long>(c.ours->bytes),
+                  c.ours->rel_rms, c.ours->rel_hausdorff);
+    }
+    std::printf("\n");
+  }
+  if (!m.rd_error.empty()) std::printf("%-16s rate-distortion: %s\n", name.c_str(), m.rd_error.c_str());
+  std::fflush(stdout);
+  return m;
+}
+
+std::vector<std::string> split_commas(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+}  // namespace
+}  // namespace meshstream::bench
+
+int main(int argc, char** argv) {
+  using namespace meshstream::bench;
+  CLI::App app{"codec benchmark: .hcs vs Draco and a meshoptimizer LOD chain"};
+  std::string report_dir = "bench/report";
+  std::string mesh_list;
+  bool quick = false;
+  Settings settings;
+  settings.mesh_dir = meshstream::testing::test_mesh_dir();
+  app.add_option("--report-dir", report_dir, "where codec.md, codec_rd.csv, codec_rd.png go");
+  app.add_option("--meshes", mesh_list, "comma-separated mesh file names (default: every real mesh)");
+  app.add_flag("--quick", quick, "three meshes, fewer runs and curve points");
+  app.add_option("--mesh-dir", settings.mesh_dir, "folder of the test meshes");
+  app.add_option("--samples", settings.samples, "area samples per direction for distances");
+  CLI11_PARSE(app, argc, argv);
+
+  if (settings.mesh_dir.empty() || !std::filesystem::is_directory(settings.mesh_dir)) {
+    std::fprintf(stderr, "codec_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or --mesh-dir)\n");
+    return 1;
+  }
+  if (quick) {
+    settings.decode_runs = 3;
+    settings.encode_runs = 1;
+    settings.curve_points = 10;
+  }
+  std::vector<std::string> names =
+      mesh_list.empty() ? (quick ? kQuickMeshes : kRealMeshes) : split_commas(mesh_list);
+
+  std::vector<MeshMeasurements> all;
+  for (const std::string& name : names) all.push_back(measure_mesh(name, settings));
+
+  std::filesystem::create_directories(report_dir);
+  const std::filesystem::path dir(report_dir);
+  write_csv(dir / "codec_rd.csv", all);
+  ReportSettings rs;
+  rs.quant_bits = settings.quant_bits;
+  rs.samples = settings.samples;
+  rs.decode_runs = settings.decode_runs;
+  rs.encode_runs = settings.encode_runs;
+  rs.curve_points = settings.curve_points;
+  rs.quick = quick;
+  if (write_plot(dir / "codec_rd.csv", dir / "codec_rd.png", all, rs.plot_note)) {
+    rs.plot_file = "codec_rd.png";
+  }
+  write_markdown(dir / "codec.md", all, rs);
+  std::printf("wrote %s/codec.md, codec_rd.csv%s\n", report_dir.c_str(),
+              rs.plot_file.empty() ? "" : ", codec_rd.png");
+  return 0;
+}
