@@ -1,0 +1,18 @@
+// The one way the server (and its tests and tools) include Boost.Asio.
+// GCC 12 in C++20 mode needs <utility> before <boost/asio/awaitable.hpp>
+// ("exchange is not a member of std"); include only this header.
+#pragma once
+
+#include <utility>
+
+#include <boost/asio.hpp>
+#include <boost/asio/awaitable.hpp>
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/redirect_error.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
+namespace meshstream::net {
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+}  // namespace meshstream::net

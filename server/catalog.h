@@ -1,0 +1,87 @@
+// The models a server offers: immutable after start-up and shared read-only
+// by every session on every thread. Each model is one `.hcs` stream held in
+// memory (mapped or owned) with its parsed record index; the server never
+// decodes geometry.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/codec/container.h"
+#include "server/mapped_file.h"
+
+namespace meshstream::server {
+
+struct CatalogModel {
+  std::string name;    // what clients ask for; never interpreted as a path
+  std::string source;  // "hcs", "mesh" or "demo" (ModelInfo.source)
+  std::string origin;  // file path or demo description, for logs
+  std::shared_ptr<const StreamBytes> bytes;
+  StreamIndex index;
+
+  std::span<const uint8_t> stream() const { return bytes->bytes(); }
+};
+
+// Checks that `bytes` hold one complete, intact `.hcs` stream: the index
+// parses, its total equals the byte count, every record's CRC matches.
+// Errors name `origin`. O(bytes) for the CRCs.
+Result<CatalogModel> make_model(std::string name, std::string source, std::string origin,
+                                std::shared_ptr<const StreamBytes> bytes);
+
+class Catalog {
+ public:
+  // Adds `model` under model.name; kInvalidArgument when the name is taken.
+  Status add(CatalogModel model);
+  bool contains(std::string_view name) const { return models_.find(name) != models_.end(); }
+  // Exact name match; nullptr for unknown names. O(log n).
+  const CatalogModel* find(std::string_view name) const;
+  // Every model, sorted by name.
+  std::vector<const CatalogModel*> models() const;
+  size_t size() const { return models_.size(); }
+
+ private:
+  std::map<std::string, CatalogModel, std::less<>> models_;
+};
+
+// Progress and problems while loading, one line each ("skipped x.ply: ...").
+using CatalogLog = std::function<void(const std::string& line)>;
+
+// One way models enter the catalog: a folder of .hcs files, a folder of mesh
+// files encoded at start-up, the procedural demo models. Sources are loaded
+// in order; a name taken by an earlier source is not overwritten.
+class CatalogSource {
+ public:
+  virtual ~CatalogSource() = default;
+  // Adds what it can; reports every skipped input through `log` and never
+  // fails as a whole because of one bad input.
+  virtual void load(Catalog& catalog, const CatalogLog& log) = 0;
+};
+
+// Every `*.hcs` file directly in `dir`, served as-is (memory-mapped).
+std::unique_ptr<CatalogSource> hcs_folder_source(std::string dir);
+
+struct MeshFolderOptions {
+  std::string dir;
+  // Where encoded streams are cached, keyed by content hash and
+  // kEncoderVersion. Empty: no cache (encode at every start).
+  std::string cache_dir;
+  unsigned threads = 0;  // 0 = one per core
+};
+// Every mesh file (.ply .obj .stl .drc .off) directly in `options.dir`,
+// imported and encoded at start-up on all cores, cached.
+std::unique_ptr<CatalogSource> mesh_folder_source(MeshFolderOptions options);
+
+// The procedural demo models (no folder needed).
+std::unique_ptr<CatalogSource> demo_source();
+
+// Whether this build can import and encode mesh files / make demo models
+// (they need the mesh and codec modules' implementations).
+bool mesh_encoding_available();
+bool demo_models_available();
+
+}  // namespace meshstream::server

@@ -1,0 +1,193 @@
+#include "server/server.h"
+
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "proto/framing.h"
+
+namespace meshstream::server {
+namespace {
+
+namespace asio = net::asio;
+using asio::awaitable;
+using asio::use_awaitable;
+
+std::shared_ptr<const std::vector<uint8_t>> model_list_frame(const Catalog& catalog) {
+  v1::ServerMessage out;
+  v1::ModelList* list = out.mutable_model_list();
+  for (const CatalogModel* model : catalog.models()) {
+    v1::ModelInfo* info = list->add_models();
+    info->set_name(model->name);
+    info->set_vertices(model->index.header.vertex_count);
+    info->set_faces(model->index.header.face_count);
+    info->set_stream_bytes(model->index.total_bytes());
+    info->set_records(static_cast<uint32_t>(model->index.records.size()));
+    info->set_source(model->source);
+  }
+  return std::make_shared<const std::vector<uint8_t>>(proto::encode_frame(out));
+}
+
+std::shared_ptr<const std::vector<uint8_t>> hello_frame(const ServerOptions& options) {
+  v1::ServerMessage out;
+  v1::ServerHello* hello = out.mutable_hello();
+  hello->set_protocol_version(proto::kProtocolVersion);
+  hello->set_server_name("meshstream-server 0.1.0");
+  hello->set_max_client_frame_bytes(options.max_frame_bytes);
+  hello->set_max_server_frame_bytes(proto::kMaxServerFrameBytes);
+  return std::make_shared<const std::vector<uint8_t>>(proto::encode_frame(out));
+}
+
+// Rejecting costs a session too; beyond this many at once we just close.
+constexpr int64_t kMaxRejecting = 256;
+
+}  // namespace
+
+Server::Server(const ServerOptions& options, const Catalog& catalog)
+    : options_(options), catalog_(catalog) {
+  shared_.options = &options_;
+  shared_.catalog = &catalog_;
+  shared_.model_list_frame = model_list_frame(catalog_);
+  shared_.hello_frame = hello_frame(options_);
+  shared_.active_sessions = &active_sessions_;
+  shared_.rejecting_sessions = &rejecting_;
+  unsigned threads = options_.threads ? options_.threads : std::thread::hardware_concurrency();
+  threads = std::max(1u, threads);
+  for (unsigned i = 0; i < threads; ++i) {
+    workers_.push_back(std::make_unique<Worker>());
+  }
+}
+
+Server::~Server() = default;
+
+Status Server::listen() {
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(options_.listen_host, ec);
+  if (ec) {
+    return make_error(ErrorCode::kIo, "--listen: '" + options_.listen_host + "' is not an IP address");
+  }
+  const net::tcp::endpoint endpoint(address, options_.listen_port);
+  auto acceptor = std::make_unique<net::tcp::acceptor>(workers_[0]->io);
+  acceptor->open(endpoint.protocol(), ec);
+  if (!ec) acceptor->set_option(net::tcp::acceptor::reuse_address(true), ec);
+  if (!ec) acceptor->bind(endpoint, ec);
+  if (!ec) acceptor->listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) {
+    return make_error(ErrorCode::kIo, "cannot listen on " + options_.listen_host + ":" +
+                                          std::to_string(options_.listen_port) + ": " + ec.message());
+  }
+  acceptor_ = std::move(acceptor);
+  return {};
+}
+
+net::tcp::endpoint Server::local_endpoint() const {
+  boost::system::error_code ec;
+  return acceptor_ ? acceptor_->local_endpoint(ec) : net::tcp::endpoint();
+}
+
+awaitable<void> Server::accept_loop() {
+  asio::steady_timer backoff(workers_[0]->io);
+  while (!stopping_) {
+    Worker& worker = *workers_[next_worker_];
+    next_worker_ = (next_worker_ + 1) % workers_.size();
+    boost::system::error_code ec;
+    net::tcp::socket socket =
+        co_await acceptor_->async_accept(worker.io, asio::redirect_error(use_awaitable, ec));
+    if (stopping_) break;
+    if (ec) {
+      // Out of descriptors or a connection reset before accept: keep serving.
+      spdlog::warn("accept failed: {}", ec.message());
+      backoff.expires_after(std::chrono::milliseconds(20));
+      co_await backoff.async_wait(asio::redirect_error(use_awaitable, ec));
+      continue;
+    }
+    bool reject = false;
+    if (active_sessions_.fetch_add(1) >= int64_t(options_.max_connections)) {
+      --active_sessions_;
+      reject = true;
+      if (rejecting_ >= kMaxRejecting) continue;  // socket closes here
+      ++rejecting_;
+    }
+    // The session runs on its worker's thread; hand it over there.
+    asio::post(worker.io, [this, &worker, reject, socket = std::move(socket)]() mutable {
+      if (stopping_) {  // the socket closes
+        if (reject) --rejecting_; else --active_sessions_;
+        return;
+      }
+      auto session = std::make_shared<Session>(std::move(socket), shared_, worker.registry, reject,
+                                               !reject);
+      session->start();
+    });
+  }
+}
+
+void Server::stop() {
+  if (stopping_.exchange(true)) return;
+  asio::post(workers_[0]->io, [this] { begin_shutdown(); });
+}
+
+void Server::begin_shutdown() {
+  spdlog::info("shutting down: no new connections, closing {} sessions",
+               active_sessions_.load());
+  boost::system::error_code ec;
+  if (acceptor_) acceptor_->close(ec);
+  if (signals_) signals_->cancel(ec);
+  for (auto& worker : workers_) {
+    asio::post(worker->io, [w = worker.get()] {
+      // Copy: shutdown may end sessions, which erase themselves.
+      std::vector<Session*> sessions(w->registry.sessions.begin(), w->registry.sessions.end());
+      for (Session* s : sessions) {
+        if (w->registry.sessions.count(s)) s->shutdown();
+      }
+      w->guard.reset();  // the io_context returns once its sessions are gone
+    });
+  }
+  std::lock_guard lock(mutex_);
+  stopped_.notify_all();
+}
+
+void Server::run(std::chrono::milliseconds grace) {
+  for (auto& worker : workers_) {
+    worker->guard = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(
+        worker->io.get_executor());
+  }
+  signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);
+  signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
+    if (ec) return;
+    spdlog::info("received signal {}", signal);
+    stop();
+  });
+  asio::co_spawn(workers_[0]->io, accept_loop(), [](std::exception_ptr e) {
+    if (!e) return;
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::exception& x) {
+      spdlog::error("accept loop failed: {}", x.what());
+    }
+  });
+
+  std::atomic<size_t> running{workers_.size()};
+  std::vector<std::thread> threads;
+  for (auto& worker : workers_) {
+    threads.emplace_back([this, w = worker.get(), &running] {
+      w->io.run();
+      --running;
+      std::lock_guard lock(mutex_);
+      stopped_.notify_all();
+    });
+  }
+  {
+    std::unique_lock lock(mutex_);
+    stopped_.wait(lock, [&] { return stopping_.load() || running == 0; });
+    // Sessions get `grace` to send their last frame and close.
+    stopped_.wait_for(lock, grace, [&] { return running == 0; });
+  }
+  if (running != 0) {
+    spdlog::warn("sessions still open after {} ms; stopping anyway", grace.count());
+    for (auto& worker : workers_) worker->io.stop();
+  }
+  for (auto& t : threads) t.join();
+  spdlog::info("server stopped");
+}
+
+}  // namespace meshstream::server

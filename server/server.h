@@ -1,0 +1,65 @@
+// The meshstream server: one io_context per worker thread (a thread per
+// core), an acceptor that deals new connections round-robin to the workers,
+// --max-connections, and a clean stop on SIGINT/SIGTERM (stop accepting,
+// send every session Error{SHUTTING_DOWN}, wait for them to close, exit).
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "common/base/result.h"
+#include "server/asio.h"
+#include "server/catalog.h"
+#include "server/server_options.h"
+#include "server/session.h"
+
+namespace meshstream::server {
+
+class Server {
+ public:
+  // `catalog` must outlive the server.
+  Server(const ServerOptions& options, const Catalog& catalog);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Binds and listens on options.listen_host:listen_port. kIo when the
+  // address is unusable (in use, not local, not an address).
+  Status listen();
+  // The bound address (after listen()); port is the real one for port 0.
+  net::tcp::endpoint local_endpoint() const;
+
+  // Serves until stop() or SIGINT/SIGTERM, then shuts down cleanly (sessions
+  // get up to `grace` to close) and returns. Blocks the calling thread.
+  void run(std::chrono::milliseconds grace = std::chrono::milliseconds(3000));
+  // Thread-safe, idempotent: begins the clean shutdown.
+  void stop();
+
+ private:
+  struct Worker {
+    SessionRegistry registry;  // destroyed after the io_context and its sessions
+    net::asio::io_context io{1};
+    std::unique_ptr<net::asio::executor_work_guard<net::asio::io_context::executor_type>> guard;
+  };
+
+  net::asio::awaitable<void> accept_loop();
+  void begin_shutdown();  // on worker 0
+
+  const ServerOptions& options_;
+  const Catalog& catalog_;
+  ServerShared shared_;
+  std::atomic<int64_t> active_sessions_{0};
+  std::atomic<int64_t> rejecting_{0};
+  std::vector<std::unique_ptr<Worker>> workers_;
+  std::unique_ptr<net::tcp::acceptor> acceptor_;
+  std::unique_ptr<net::asio::signal_set> signals_;
+  std::atomic<bool> stopping_{false};
+  std::mutex mutex_;
+  std::condition_variable stopped_;
+  size_t next_worker_ = 0;
+};
+
+}  // namespace meshstream::server

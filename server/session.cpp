@@ -1,0 +1,432 @@
+#include "server/session.h"
+
+#include <algorithm>
+
+#include <spdlog/spdlog.h>
+
+namespace meshstream::server {
+namespace {
+
+namespace asio = net::asio;
+using asio::awaitable;
+using asio::use_awaitable;
+
+// Control frames queued beyond this stop the reader until the writer has
+// sent some (a client that pipelines requests but does not read replies
+// costs at most this much).
+constexpr size_t kMaxQueuedBytes = 256 * 1024;
+// After our closing frame: how long we keep draining the client's bytes so
+// the close is a FIN, not a reset that could destroy the error frame.
+constexpr auto kLinger = std::chrono::milliseconds(1000);
+constexpr size_t kMinChunkBytes = 1024;
+constexpr size_t kMaxChunkBytes = 1 << 20;
+constexpr size_t kReadBufferBytes = 2048;
+
+std::string describe(const asio::ip::tcp::socket& socket) {
+  boost::system::error_code ec;
+  auto endpoint = socket.remote_endpoint(ec);
+  if (ec) return "?";
+  return endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
+}
+
+void log_exception(std::exception_ptr e) {
+  if (!e) return;
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    spdlog::error("session coroutine failed: {}", x.what());
+  }
+}
+
+}  // namespace
+
+Session::Session(net::tcp::socket socket, const ServerShared& shared, SessionRegistry& registry,
+                 bool reject, bool counted)
+    : socket_(std::move(socket)),
+      shared_(shared),
+      registry_(registry),
+      reject_(reject),
+      counted_(counted),
+      reader_(shared.options->max_frame_bytes),
+      writer_wake_(socket_.get_executor()),
+      reader_wake_(socket_.get_executor()),
+      pacing_timer_(socket_.get_executor()),
+      watchdog_timer_(socket_.get_executor()),
+      started_(Clock::now()),
+      last_activity_(started_) {
+  peer_ = describe(socket_);
+}
+
+Session::~Session() {
+  registry_.sessions.erase(this);
+  if (counted_) --*shared_.active_sessions;
+  if (reject_) --*shared_.rejecting_sessions;
+  const double seconds = std::chrono::duration<double>(Clock::now() - started_).count();
+  if (reject_) {
+    spdlog::info("session {}: rejected (busy)", peer_);
+    return;
+  }
+  spdlog::info("session {}: models [{}], {} streams, {} bytes, {:.3f} s, ended: {}", peer_,
+               models_, streams_, bytes_total_, seconds,
+               end_reason_.empty() ? "closed" : end_reason_);
+}
+
+void Session::start() {
+  registry_.sessions.insert(this);
+  boost::system::error_code ec;
+  socket_.set_option(net::tcp::no_delay(true), ec);
+  auto executor = socket_.get_executor();
+  asio::co_spawn(executor, read_loop(shared_from_this()), log_exception);
+  asio::co_spawn(executor, write_loop(shared_from_this()), log_exception);
+  asio::co_spawn(executor, watchdog(shared_from_this()), log_exception);
+  if (reject_) {
+    fail(v1::Error::BUSY,
+         "server busy: it serves " + std::to_string(shared_.options->max_connections) +
+             " connections already; retry later",
+         "busy");
+  }
+}
+
+void Session::shutdown() {
+  if (closed_ || closing_) return;
+  fail(v1::Error::SHUTTING_DOWN, "server is shutting down", "server shutdown");
+}
+
+void Session::set_end_reason(const std::string& reason) {
+  if (end_reason_.empty()) end_reason_ = reason;
+}
+
+void Session::close_now(const std::string& reason) {
+  set_end_reason(reason);
+  if (closed_) return;
+  closed_ = true;
+  closing_ = true;
+  boost::system::error_code ec;
+  socket_.close(ec);
+  writer_wake_.cancel();
+  reader_wake_.cancel();
+  pacing_timer_.cancel();
+  watchdog_timer_.cancel();
+}
+
+void Session::push(Item item, size_t bytes) {
+  queue_.push_back(std::move(item));
+  queued_bytes_ += bytes;
+  wake(writer_wake_);
+}
+
+void Session::send(const google::protobuf::MessageLite& message, bool closing) {
+  auto bytes = std::make_shared<const std::vector<uint8_t>>(proto::encode_frame(message));
+  const size_t size = bytes->size();
+  push(Frame{std::move(bytes), closing}, size);
+}
+
+void Session::send_error(int code, const std::string& message, bool closing) {
+  v1::ServerMessage out;
+  v1::Error* error = out.mutable_error();
+  error->set_code(static_cast<v1::Error::Code>(code));
+  error->set_message(message);
+  error->set_closing(closing);
+  send(out, closing);
+}
+
+void Session::fail(int code, const std::string& message, const std::string& log_reason) {
+  if (closing_) return;
+  closing_ = true;
+  set_end_reason(log_reason);
+  send_error(code, message, true);
+}
+
+// ------------------------------------------------------------------ reader
+
+awaitable<void> Session::read_loop(std::shared_ptr<Session> self) {
+  std::array<uint8_t, kReadBufferBytes> buffer;
+  while (!closed_) {
+    while (queued_bytes_ > kMaxQueuedBytes && !closed_) {
+      reader_wake_.expires_at(Clock::time_point::max());
+      boost::system::error_code ignored;
+      co_await reader_wake_.async_wait(asio::redirect_error(use_awaitable, ignored));
+    }
+    if (closed_) break;
+    boost::system::error_code ec;
+    const size_t n = co_await socket_.async_read_some(asio::buffer(buffer),
+                                                      asio::redirect_error(use_awaitable, ec));
+    if (ec) {
+      close_now(ec == asio::error::eof ? "client closed" : "read failed: " + ec.message());
+      break;
+    }
+    if (closing_) continue;  // draining until the client closes or the linger ends
+    last_activity_ = Clock::now();
+    reader_.feed(std::span<const uint8_t>(buffer.data(), n));
+    while (!closing_) {
+      auto message = reader_.next();
+      if (!message) {
+        const bool too_large = message.error().code == ErrorCode::kLimit;
+        fail(too_large ? v1::Error::FRAME_TOO_LARGE : v1::Error::MALFORMED_FRAME,
+             message.error().message,
+             (too_large ? "frame too large: " : "malformed frame: ") + message.error().message);
+        break;
+      }
+      if (!*message) break;
+      handle(**message);
+    }
+  }
+}
+
+void Session::handle(const v1::ClientMessage& message) {
+  if (!hello_done_) {
+    if (message.body_case() != v1::ClientMessage::kHello) {
+      fail(v1::Error::PROTOCOL_VIOLATION, "the first frame must be Hello", "no hello");
+      return;
+    }
+    const uint32_t version = message.hello().protocol_version();
+    if (version != proto::kProtocolVersion) {
+      fail(v1::Error::VERSION_MISMATCH,
+           "protocol version " + std::to_string(version) + " is not supported; this server speaks " +
+               std::to_string(proto::kProtocolVersion),
+           "wrong protocol version " + std::to_string(version));
+      return;
+    }
+    hello_done_ = true;
+    push(Frame{shared_.hello_frame}, shared_.hello_frame->size());
+    return;
+  }
+  switch (message.body_case()) {
+    case v1::ClientMessage::kHello:
+      fail(v1::Error::PROTOCOL_VIOLATION, "Hello was already sent", "second hello");
+      return;
+    case v1::ClientMessage::kListModels:
+      push(Frame{shared_.model_list_frame}, shared_.model_list_frame->size());
+      return;
+    case v1::ClientMessage::kStream:
+      handle_stream(message.stream());
+      return;
+    case v1::ClientMessage::kCancel:
+      push(CancelStream{}, 0);
+      return;
+    default:
+      send_error(v1::Error::INVALID_REQUEST, "empty or unknown request kind", false);
+      return;
+  }
+}
+
+void Session::handle_stream(const v1::StreamRequest& request) {
+  const CatalogModel* model = shared_.catalog->find(request.model());
+  if (!model) {
+    std::string shown = request.model().substr(0, 128);
+    send_error(v1::Error::UNKNOWN_MODEL, "unknown model '" + shown + "'", false);
+    return;
+  }
+  Budget budget;
+  if (request.has_budget()) {
+    const v1::Budget& b = request.budget();
+    switch (b.limit_case()) {
+      case v1::Budget::kBytes: budget = ByteBudget{b.bytes()}; break;
+      case v1::Budget::kVertices: budget = VertexBudget{b.vertices()}; break;
+      case v1::Budget::kPercent: budget = PercentBudget{b.percent()}; break;
+      default: break;
+    }
+  }
+  auto plan = plan_stream(model->index, request.resume_offset(), budget);
+  if (!plan) {
+    send_error(v1::Error::INVALID_REQUEST, plan.error().message, false);
+    return;
+  }
+  size_t chunk = request.max_chunk_bytes() ? request.max_chunk_bytes()
+                                           : shared_.options->max_chunk_bytes;
+  chunk = std::clamp(chunk, kMinChunkBytes, kMaxChunkBytes);
+  if (shared_.options->rate_bytes_per_s > 0) {
+    // About 20 chunks a second, so paced arrival is visibly progressive.
+    chunk = std::min<size_t>(chunk, std::max<uint64_t>(kMinChunkBytes,
+                                                       shared_.options->rate_bytes_per_s / 20));
+  }
+  push(StartStream{model, *plan, chunk}, 0);
+}
+
+// ------------------------------------------------------------------ writer
+
+template <class Buffers>
+awaitable<bool> Session::write(const Buffers& buffers) {
+  write_in_flight_ = true;
+  write_started_ = Clock::now();
+  boost::system::error_code ec;
+  co_await asio::async_write(socket_, buffers, asio::redirect_error(use_awaitable, ec));
+  write_in_flight_ = false;
+  if (ec) {
+    close_now(closed_ ? std::string() : "write failed: " + ec.message());
+    co_return false;
+  }
+  co_return true;
+}
+
+awaitable<bool> Session::write_end(int reason) {
+  v1::ServerMessage out;
+  v1::StreamEnd* end = out.mutable_end();
+  end->set_reason(static_cast<v1::StreamEnd::Reason>(reason));
+  end->set_bytes_sent(stream_->bytes_sent);
+  end->set_end_offset(stream_->position);
+  end->set_records_complete(stream_->records_complete);
+  stream_.reset();
+  last_activity_ = Clock::now();
+  const std::vector<uint8_t> bytes = proto::encode_frame(out);
+  co_return co_await write(asio::buffer(bytes));
+}
+
+namespace {
+
+std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& plan,
+                                  size_t chunk_bytes) {
+  const StreamIndex& index = model.index;
+  const StreamHeader& h = index.header;
+  v1::ServerMessage out;
+  v1::StreamHeader* header = out.mutable_header();
+  header->set_model(model.name);
+  header->set_total_bytes(index.total_bytes());
+  header->set_start_offset(plan.start);
+  header->set_end_offset(plan.end);
+  header->set_payload_offset(index.payload_offset);
+  header->set_first_record(plan.first_record);
+  header->set_end_record(plan.end_record);
+  header->set_vertices(h.vertex_count);
+  header->set_faces(h.face_count);
+  header->set_base_vertices(h.base_vertex_count);
+  header->set_base_faces(h.base_face_count);
+  header->set_quant_bits(h.quant_bits);
+  v1::Bounds* bounds = header->mutable_bounds();
+  bounds->set_min_x(h.bounds.min.x);
+  bounds->set_min_y(h.bounds.min.y);
+  bounds->set_min_z(h.bounds.min.z);
+  bounds->set_max_x(h.bounds.max.x);
+  bounds->set_max_y(h.bounds.max.y);
+  bounds->set_max_z(h.bounds.max.z);
+  header->set_container_version(kContainerVersion);
+  header->set_max_chunk_bytes(static_cast<uint32_t>(chunk_bytes));
+  v1::RecordIndex* records = header->mutable_records();
+  const int n = static_cast<int>(index.records.size());
+  records->mutable_sizes()->Reserve(n);
+  records->mutable_vertices()->Reserve(n);
+  records->mutable_faces()->Reserve(n);
+  records->mutable_crc32()->Reserve(n);
+  for (const RecordEntry& r : index.records) {
+    records->add_sizes(r.size);
+    records->add_vertices(r.vertices);
+    records->add_faces(r.faces);
+    records->add_crc32(r.crc32);
+  }
+  return proto::encode_frame(out);
+}
+
+}  // namespace
+
+awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
+  while (!closed_) {
+    if (!queue_.empty()) {
+      Item item = std::move(queue_.front());
+      queue_.pop_front();
+      if (auto* frame = std::get_if<Frame>(&item)) {
+        queued_bytes_ -= frame->bytes->size();
+        wake(reader_wake_);
+        if (!co_await write(asio::buffer(*frame->bytes))) break;
+        if (frame->closing) {
+          // Graceful close: FIN after our last frame, then drain what the
+          // client still sends until it closes or the linger ends.
+          boost::system::error_code ec;
+          socket_.shutdown(net::tcp::socket::shutdown_send, ec);
+          linger_deadline_ = Clock::now() + kLinger;
+          wake(watchdog_timer_);
+          break;
+        }
+      } else if (auto* start = std::get_if<StartStream>(&item)) {
+        if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
+        const CatalogModel& model = *start->model;
+        stream_.emplace(ActiveStream{
+            &model, model.bytes, start->plan, start->chunk_bytes, start->plan.start, 0,
+            records_complete_at(model.index, start->plan.start),
+            TokenBucket(double(shared_.options->rate_bytes_per_s), double(start->chunk_bytes),
+                        Clock::now())});
+        ++streams_;
+        if (models_.find(model.name) == std::string::npos) {
+          models_ += models_.empty() ? model.name : "," + model.name;
+        }
+        const std::vector<uint8_t> header = header_frame(model, start->plan, start->chunk_bytes);
+        if (!co_await write(asio::buffer(header))) break;
+      } else {  // CancelStream
+        if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
+      }
+      continue;
+    }
+    if (stream_) {
+      ActiveStream& s = *stream_;
+      if (s.position >= s.plan.end) {
+        if (!co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET)) break;
+        continue;
+      }
+      const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, s.chunk_bytes);
+      const size_t size = static_cast<size_t>(cut.end - s.position);
+      const auto delay = s.bucket.take(size, Clock::now());
+      if (delay > Clock::duration::zero()) {
+        pacing_timer_.expires_after(delay);
+        boost::system::error_code ignored;
+        co_await pacing_timer_.async_wait(asio::redirect_error(use_awaitable, ignored));
+        if (closed_) break;
+      }
+      const proto::ChunkFrameHead head =
+          proto::encode_chunk_frame_head(s.position, cut.records_complete, size);
+      const std::array<asio::const_buffer, 2> buffers{
+          asio::buffer(head.bytes, head.size),
+          asio::buffer(s.model->stream().data() + s.position, size)};
+      if (!co_await write(buffers)) break;
+      // The stream may have been replaced while we waited? No: only this
+      // coroutine changes stream_, so `s` is still the stream we wrote.
+      s.position = cut.end;
+      s.bytes_sent += size;
+      s.records_complete = cut.records_complete;
+      bytes_total_ += size;
+      continue;
+    }
+    writer_wake_.expires_at(Clock::time_point::max());
+    boost::system::error_code ignored;
+    co_await writer_wake_.async_wait(asio::redirect_error(use_awaitable, ignored));
+  }
+}
+
+// ---------------------------------------------------------------- watchdog
+
+awaitable<void> Session::watchdog(std::shared_ptr<Session> self) {
+  const ServerOptions& o = *shared_.options;
+  // Re-check at least this often: state changes (a write starting) do not
+  // wake the watchdog, so a wait never lasts longer than this.
+  const auto check = std::max<Clock::duration>(
+      std::chrono::milliseconds(5),
+      std::min({o.handshake_timeout, o.idle_timeout, o.stall_timeout}) / 4);
+  while (!closed_) {
+    const auto now = Clock::now();
+    if (now >= linger_deadline_) {
+      close_now("");
+      break;
+    }
+    if (write_in_flight_ && now - write_started_ >= o.stall_timeout) {
+      close_now("stalled: client did not read for " + std::to_string(o.stall_timeout.count()) +
+                " ms");
+      break;
+    }
+    if (!closing_) {
+      if (!hello_done_ && now - started_ >= o.handshake_timeout) {
+        fail(v1::Error::TIMEOUT,
+             "no Hello within " + std::to_string(o.handshake_timeout.count()) + " ms",
+             "handshake timeout");
+      } else if (hello_done_ && !stream_ && queue_.empty() && !write_in_flight_ &&
+                 now - last_activity_ >= o.idle_timeout) {
+        fail(v1::Error::TIMEOUT,
+             "idle for " + std::to_string(o.idle_timeout.count()) + " ms", "idle timeout");
+      }
+    }
+    auto next = now + check;
+    if (linger_deadline_ < next) next = linger_deadline_;
+    watchdog_timer_.expires_at(next);
+    boost::system::error_code ignored;
+    co_await watchdog_timer_.async_wait(asio::redirect_error(use_awaitable, ignored));
+  }
+}
+
+}  // namespace meshstream::server

@@ -1,0 +1,140 @@
+// One client connection: three coroutines on the io_context of one worker
+// thread (so no locks): a reader that parses frames and handles requests, a
+// writer that owns the socket's only write in flight (control frames first,
+// then the running stream's chunks, paced), and a watchdog that enforces the
+// handshake, idle, stall and linger deadlines. The session lives as long as
+// any of them runs; closing the socket ends all three. Errors of one session
+// never leave it. Protocol rules: proto/meshstream.proto.
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_set>
+#include <variant>
+#include <vector>
+
+#include "proto/framing.h"
+#include "server/asio.h"
+#include "server/catalog.h"
+#include "server/server_options.h"
+#include "server/stream_plan.h"
+#include "server/token_bucket.h"
+
+namespace meshstream::server {
+
+class Session;
+
+// Shared, immutable for the server's lifetime (read from every thread).
+struct ServerShared {
+  const ServerOptions* options = nullptr;
+  const Catalog* catalog = nullptr;
+  std::shared_ptr<const std::vector<uint8_t>> model_list_frame;  // ModelList, pre-encoded
+  std::shared_ptr<const std::vector<uint8_t>> hello_frame;       // ServerHello, pre-encoded
+  std::atomic<int64_t>* active_sessions = nullptr;     // counted toward --max-connections
+  std::atomic<int64_t>* rejecting_sessions = nullptr;  // busy sessions still closing
+};
+
+// The sessions of one worker thread, touched only from that thread.
+struct SessionRegistry {
+  std::unordered_set<Session*> sessions;
+};
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  // `reject` = the server is full: the session only sends Error{BUSY} and
+  // closes. `counted` = it holds one of --max-connections (released when it
+  // ends).
+  Session(net::tcp::socket socket, const ServerShared& shared, SessionRegistry& registry,
+          bool reject, bool counted);
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  // Registers and starts the coroutines. Call on the socket's executor.
+  void start();
+  // Server stopping: send Error{SHUTTING_DOWN} after the chunk in flight,
+  // then close. Call on the socket's executor.
+  void shutdown();
+
+ private:
+  struct Frame {
+    std::shared_ptr<const std::vector<uint8_t>> bytes;
+    bool closing = false;  // close gracefully after writing it
+  };
+  struct StartStream {
+    const CatalogModel* model;
+    StreamPlan plan;
+    size_t chunk_bytes;
+  };
+  struct CancelStream {};
+  using Item = std::variant<Frame, StartStream, CancelStream>;
+
+  struct ActiveStream {
+    const CatalogModel* model;
+    std::shared_ptr<const StreamBytes> keep_alive;
+    StreamPlan plan;
+    size_t chunk_bytes;
+    uint64_t position;
+    uint64_t bytes_sent = 0;
+    uint32_t records_complete;
+    TokenBucket bucket;
+  };
+
+  net::asio::awaitable<void> read_loop(std::shared_ptr<Session> self);
+  net::asio::awaitable<void> write_loop(std::shared_ptr<Session> self);
+  net::asio::awaitable<void> watchdog(std::shared_ptr<Session> self);
+  // Writes `buffers` as the one write in flight; false (and closed) on failure.
+  template <class Buffers>
+  net::asio::awaitable<bool> write(const Buffers& buffers);
+  net::asio::awaitable<bool> write_end(int reason);
+
+  void handle(const v1::ClientMessage& message);
+  void handle_stream(const v1::StreamRequest& request);
+  void push(Item item, size_t bytes);
+  void send(const google::protobuf::MessageLite& message, bool closing = false);
+  void send_error(int code, const std::string& message, bool closing);
+  // Fatal for the connection: error frame, then graceful close.
+  void fail(int code, const std::string& message, const std::string& log_reason);
+  void close_now(const std::string& reason);
+  void set_end_reason(const std::string& reason);
+  void wake(net::asio::steady_timer& timer) { timer.cancel(); }
+
+  net::tcp::socket socket_;
+  const ServerShared& shared_;
+  SessionRegistry& registry_;
+  const bool reject_;
+  const bool counted_;
+  std::string peer_;
+
+  proto::ClientFrameReader reader_;
+  std::deque<Item> queue_;
+  size_t queued_bytes_ = 0;
+  std::optional<ActiveStream> stream_;
+
+  net::asio::steady_timer writer_wake_;
+  net::asio::steady_timer reader_wake_;  // queue has room again
+  net::asio::steady_timer pacing_timer_;
+  net::asio::steady_timer watchdog_timer_;
+
+  bool hello_done_ = false;
+  bool closing_ = false;  // fatal error or shutdown: no more requests handled
+  bool closed_ = false;
+  bool write_in_flight_ = false;
+  Clock::time_point started_;
+  Clock::time_point last_activity_;
+  Clock::time_point write_started_;
+  Clock::time_point linger_deadline_ = Clock::time_point::max();
+
+  // For the one log line per session.
+  std::string models_;
+  uint64_t bytes_total_ = 0;
+  uint32_t streams_ = 0;
+  std::string end_reason_;
+};
+
+}  // namespace meshstream::server

@@ -1,0 +1,137 @@
+// Stream planning on a synthetic index: budgets and resume land on record
+// boundaries, chunks tile the range exactly and respect the size limit.
+#include <gtest/gtest.h>
+
+#include "server/stream_plan.h"
+#include "server/synthetic_stream.h"
+#include "server/token_bucket.h"
+
+namespace meshstream::server {
+namespace {
+
+StreamIndex make_index(uint32_t records, uint64_t payload, uint32_t base_bytes = 5000) {
+  SyntheticStreamOptions o;
+  o.records = records;
+  o.payload_bytes = payload;
+  o.base_bytes = base_bytes;
+  const std::vector<uint8_t> bytes = make_synthetic_hcs(o);
+  auto index = read_stream_index(bytes);
+  EXPECT_TRUE(index.has_value());
+  EXPECT_EQ(index->total_bytes(), bytes.size());
+  return *index;
+}
+
+uint64_t end_of(const StreamIndex& index, uint32_t record) {
+  return index.records[record].offset + index.records[record].size;
+}
+
+TEST(StreamPlan, WholeStream) {
+  const StreamIndex index = make_index(50, 400000);
+  auto plan = plan_stream(index, 0, std::monostate{});
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->start, 0u);
+  EXPECT_EQ(plan->end, index.total_bytes());
+  EXPECT_EQ(plan->first_record, 0u);
+  EXPECT_EQ(plan->end_record, 50u);
+  EXPECT_TRUE(plan->complete);
+}
+
+TEST(StreamPlan, ByteBudgetEndsAtLastBoundaryWithin) {
+  const StreamIndex index = make_index(50, 400000);
+  for (uint32_t r = 0; r < 49; ++r) {
+    // Exactly at a boundary, and one byte short of the next.
+    auto at = plan_stream(index, 0, ByteBudget{end_of(index, r)});
+    ASSERT_TRUE(at);
+    EXPECT_EQ(at->end, end_of(index, r));
+    EXPECT_EQ(at->end_record, r + 1);
+    auto short_of = plan_stream(index, 0, ByteBudget{end_of(index, r + 1) - 1});
+    EXPECT_EQ(short_of->end, end_of(index, r));
+    EXPECT_FALSE(short_of->complete);
+  }
+  // Less than the base mesh still gives the base mesh.
+  EXPECT_EQ(plan_stream(index, 0, ByteBudget{10})->end, end_of(index, 0));
+  EXPECT_TRUE(plan_stream(index, 0, ByteBudget{1ull << 40})->complete);
+}
+
+TEST(StreamPlan, VertexAndPercentBudgets) {
+  const StreamIndex index = make_index(50, 400000);
+  const uint32_t v = index.records[20].vertices;
+  auto plan = plan_stream(index, 0, VertexBudget{v});
+  EXPECT_EQ(plan->end_record, 21u);
+  EXPECT_EQ(plan_stream(index, 0, VertexBudget{v - 1})->end_record, 20u);
+  EXPECT_EQ(plan_stream(index, 0, VertexBudget{0})->end_record, 1u);
+
+  auto half = plan_stream(index, 0, PercentBudget{50});
+  ASSERT_TRUE(half);
+  EXPECT_LE(half->end, index.total_bytes() / 2);
+  EXPECT_GT(end_of(index, half->end_record), index.total_bytes() / 2);
+  EXPECT_TRUE(plan_stream(index, 0, PercentBudget{100})->complete);
+  EXPECT_FALSE(plan_stream(index, 0, PercentBudget{0}).has_value());
+  EXPECT_FALSE(plan_stream(index, 0, PercentBudget{100.5}).has_value());
+  EXPECT_FALSE(plan_stream(index, 0, PercentBudget{std::nan("")}).has_value());
+}
+
+TEST(StreamPlan, ResumeRealignsDown) {
+  const StreamIndex index = make_index(50, 400000);
+  EXPECT_EQ(plan_stream(index, index.payload_offset - 1, {})->start, 0u);
+  for (uint32_t r = 0; r < 50; ++r) {
+    const uint64_t at = index.records[r].offset;
+    auto exact = plan_stream(index, at, {});
+    EXPECT_EQ(exact->start, at);
+    EXPECT_EQ(exact->first_record, r);
+    auto inside = plan_stream(index, at + index.records[r].size / 2, {});
+    EXPECT_EQ(inside->start, at);
+  }
+  auto past = plan_stream(index, index.total_bytes() + 5, {});
+  EXPECT_EQ(past->start, index.total_bytes());
+  EXPECT_EQ(past->end, index.total_bytes());
+  // Resumed beyond the budget: nothing to send.
+  auto beyond = plan_stream(index, index.records[30].offset, ByteBudget{end_of(index, 10)});
+  EXPECT_EQ(beyond->start, beyond->end);
+}
+
+TEST(StreamPlan, ChunksTileTheRangeOnBoundaries) {
+  // Large records (some above the chunk limit) and a big prefix.
+  const StreamIndex index = make_index(300, 3000000, 100000);
+  for (size_t max_chunk : {1024u, 4096u, 65536u}) {
+    auto plan = plan_stream(index, 0, {});
+    uint64_t position = plan->start;
+    size_t chunks = 0;
+    while (position < plan->end) {
+      const ChunkCut cut = next_chunk(index, *plan, position, max_chunk);
+      ASSERT_GT(cut.end, position);
+      ASSERT_LE(cut.end - position, max_chunk);
+      EXPECT_EQ(cut.records_complete, records_complete_at(index, cut.end));
+      const bool boundary = cut.end == index.payload_offset ||
+                            records_complete_at(index, cut.end) > 0 &&
+                                end_of(index, records_complete_at(index, cut.end) - 1) == cut.end;
+      if (!boundary) {
+        // Only inside a unit larger than the limit.
+        const uint32_t r = records_complete_at(index, cut.end);
+        const uint64_t unit = cut.end < index.payload_offset ? index.payload_offset
+                                                             : index.records[r].size;
+        EXPECT_GT(unit, max_chunk);
+      }
+      position = cut.end;
+      ++chunks;
+    }
+    EXPECT_EQ(position, plan->end);
+    EXPECT_GT(chunks, 1u);
+  }
+}
+
+TEST(TokenBucket, PacesToTheRate) {
+  using Clock = TokenBucket::Clock;
+  auto now = Clock::now();
+  TokenBucket bucket(1000.0, 100.0, now);
+  EXPECT_EQ(bucket.take(100, now), Clock::duration::zero());  // starts full
+  const auto wait = bucket.take(500, now);                     // 500 in debt
+  EXPECT_NEAR(std::chrono::duration<double>(wait).count(), 0.5, 1e-6);
+  now += std::chrono::seconds(10);  // refill caps at the burst
+  EXPECT_EQ(bucket.take(100, now), Clock::duration::zero());
+  TokenBucket unlimited(0, 0, now);
+  EXPECT_EQ(unlimited.take(1 << 30, now), Clock::duration::zero());
+}
+
+}  // namespace
+}  // namespace meshstream::server
