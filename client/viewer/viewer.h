@@ -19,6 +19,10 @@ struct ViewerOptions {
   // Close the window after this many frames (0: run until the user closes
   // it); for tests under Xvfb.
   uint64_t exit_after_frames = 0;
+  // When not empty: the last drawn frame (model only, no panel) is written
+  // to this PNG as the window closes; for tests and scripted captures.
+  std::string exit_screenshot;
+  bool exit_screenshot_with_panel = false;  // include the ImGui panel in it
 };
 
 // Opens the window and runs the render loop on the calling thread until the

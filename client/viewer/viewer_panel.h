@@ -1,0 +1,52 @@
+// The Dear ImGui panel of the viewer window: stream statistics, display
+// settings and the controls that steer the stream (ASA, pause).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "client/display_frame.h"
+#include "client/viewer/mesh_renderer.h"
+
+namespace meshstream::client {
+
+// Everything the panel shows or edits that outlives a frame.
+struct PanelState {
+  // display
+  ColorMode coloring = ColorMode::kShaded;
+  bool wireframe = false;
+  bool distance_auto = true;          // ramp maximum = largest distance found
+  float distance_max_percent = 0.5f;  // else this % of the final mesh's diagonal
+  float distance_max_found = 0;
+  float reference_diagonal = 0;
+  bool distance_reference_known = false;
+  bool distance_ready = false;
+  int history_index = -1;  // -1: live; else index into the frame history
+  size_t history_size = 0;
+  // ASA (mirrors StreamControls until the user edits)
+  bool asa_enabled = true;
+  AsaOptions asa;
+  // stream and renderer facts
+  bool has_frame = false;
+  bool paused = false;
+  double rate_bytes_per_s = 0;
+  double upload_ms = 0;
+  float fps = 0;
+  bool screenshot_requested = false;
+  std::string message;  // last screenshot result
+};
+
+struct PanelActions {
+  bool asa_changed = false;
+  bool toggle_pause = false;
+  bool frame_model = false;
+  bool history_changed = false;
+};
+
+// Draws the panel for this ImGui frame. `latest` is the newest frame
+// received, `shown` the one on screen (they differ while scrubbing history).
+PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const DisplayFrame& shown,
+                        uint32_t shown_vertices, uint32_t shown_triangles);
+
+}  // namespace meshstream::client

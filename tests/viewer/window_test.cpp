@@ -1,0 +1,175 @@
+// The live window under a virtual X display: it opens, draws frames while
+// another thread publishes a refining stream, shows the newest mesh and
+// closes cleanly after exit_after_frames. Skips visibly without Xvfb.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include "client/viewer/window.h"
+#include "common/asa/subdivide.h"
+#include "common/mesh/procedural.h"
+#include "tests/viewer/image_checks.h"
+#include "tests/viewer/xvfb_display.h"
+
+namespace meshstream::client {
+namespace {
+
+// Records what the viewer asked of the stream.
+class FakeControls : public StreamControls {
+ public:
+  void set_asa(bool enabled, const AsaOptions& options) override {
+    std::lock_guard lock(mutex_);
+    enabled_ = enabled;
+    options_ = options;
+    ++set_asa_calls;
+  }
+  AsaOptions asa_options() const override {
+    std::lock_guard lock(mutex_);
+    return options_;
+  }
+  bool asa_enabled() const override {
+    std::lock_guard lock(mutex_);
+    return enabled_;
+  }
+  void pause() override { paused_ = true; }
+  void resume() override { paused_ = false; }
+  bool paused() const override { return paused_; }
+  double current_rate_bytes_per_s() const override { return 12345.0; }
+
+  std::atomic<int> set_asa_calls{0};
+
+ private:
+  mutable std::mutex mutex_;
+  bool enabled_ = true;
+  AsaOptions options_;
+  std::atomic<bool> paused_{false};
+};
+
+class WindowTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (testing::XvfbDisplay::find_xvfb().empty()) {
+      GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb): window tests skipped";
+    }
+    std::string display = xvfb_.start();
+    ASSERT_FALSE(display.empty()) << "Xvfb is installed but did not start";
+    const char* old = std::getenv("DISPLAY");
+    old_display_ = old ? old : "";
+    had_display_ = old != nullptr;
+    ::setenv("DISPLAY", display.c_str(), 1);
+    ::unsetenv("WAYLAND_DISPLAY");
+  }
+  void TearDown() override {
+    if (had_display_) {
+      ::setenv("DISPLAY", old_display_.c_str(), 1);
+    } else {
+      ::unsetenv("DISPLAY");
+    }
+    xvfb_.stop();
+  }
+
+  testing::XvfbDisplay xvfb_;
+  std::string old_display_;
+  bool had_display_ = false;
+};
+
+// A stream of ever finer spheres with ASA labels, like the client publishes.
+DisplayFrame make_frame(uint64_t sequence, uint32_t subdivisions, bool final) {
+  DisplayFrame frame;
+  frame.sequence = sequence;
+  frame.records_decoded = static_cast<uint32_t>(sequence);
+  frame.records_total = 4;
+  frame.bytes_total = 4000;
+  frame.bytes_received = 1000 * sequence;
+  auto decoded = std::make_shared<Mesh>(make_icosphere(subdivisions));
+  auto asa = subdivide(*decoded, AsaOptions{});
+  if (asa) {
+    frame.display = std::make_shared<Mesh>(std::move(asa->mesh));
+    frame.face_kind = std::make_shared<std::vector<FaceKind>>(std::move(asa->face_kind));
+  } else {
+    frame.display = decoded;
+  }
+  frame.decoded = decoded;
+  frame.final = final;
+  return frame;
+}
+
+TEST_F(WindowTest, DrawsFramesWhileAStreamArrivesAndExitsCleanly) {
+  LatestFrameMailbox mailbox;
+  FakeControls controls;
+  std::atomic<bool> published_all{false};
+  std::thread publisher([&] {
+    for (uint32_t i = 1; i <= 4; ++i) {
+      mailbox.publish(make_frame(i, i, i == 4));
+      std::this_thread::sleep_for(std::chrono::milliseconds(40));
+    }
+    published_all = true;
+  });
+  ViewerOptions options;
+  options.width = 480;
+  options.height = 360;
+  options.exit_after_frames = 40;
+  options.exit_screenshot =
+      (std::filesystem::temp_directory_path() / "meshstream_viewer_window_exit.png").string();
+  auto report = run_viewer_with_report(options, mailbox, controls);
+  bool stream_ended_before_exit = published_all;
+  publisher.join();
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  EXPECT_EQ(report->frames_drawn, 40u);
+  EXPECT_GE(report->meshes_uploaded, 1u);
+  EXPECT_LE(report->last_sequence_shown, 4u);
+  if (stream_ended_before_exit) EXPECT_EQ(report->last_sequence_shown, 4u) << "the final frame was missed";
+  EXPECT_EQ(controls.set_asa_calls, 0) << "no one touched the panel";
+
+  // The window really showed a mesh: its last frame is not blank.
+  auto image = read_png(options.exit_screenshot);
+  ASSERT_TRUE(image.has_value()) << image.error().message;
+  testing::keep_for_inspection(*image, "window_exit");
+  auto coverage = testing::foreground_coverage(*image);
+  EXPECT_GT(coverage.foreground, static_cast<size_t>(image->width) * image->height / 10);
+  std::filesystem::remove(options.exit_screenshot);
+}
+
+TEST_F(WindowTest, ShowsTheNewestFrameOnceTheStreamEnds) {
+  LatestFrameMailbox mailbox;
+  FakeControls controls;
+  for (uint32_t i = 1; i <= 3; ++i) mailbox.publish(make_frame(i, i, i == 3));
+  ViewerOptions options;
+  options.width = 320;
+  options.height = 240;
+  options.exit_after_frames = 5;
+  options.exit_screenshot =
+      (std::filesystem::temp_directory_path() / "meshstream_viewer_window_panel.png").string();
+  options.exit_screenshot_with_panel = true;
+  auto report = run_viewer_with_report(options, mailbox, controls);
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  // Latest wins: the older frames were never uploaded.
+  EXPECT_EQ(report->meshes_uploaded, 1u);
+  EXPECT_EQ(report->last_sequence_shown, 3u);
+  auto image = read_png(options.exit_screenshot);
+  ASSERT_TRUE(image.has_value()) << image.error().message;
+  testing::keep_for_inspection(*image, "window_panel");
+  std::filesystem::remove(options.exit_screenshot);
+}
+
+TEST(WindowWithoutDisplay, IsUnsupportedNotACrash) {
+  const char* old = std::getenv("DISPLAY");
+  std::string saved = old ? old : "";
+  ::unsetenv("DISPLAY");
+  ::unsetenv("WAYLAND_DISPLAY");
+  LatestFrameMailbox mailbox;
+  FakeControls controls;
+  Status status = run_viewer(ViewerOptions{}, mailbox, controls);
+  if (old) ::setenv("DISPLAY", saved.c_str(), 1);
+  ASSERT_FALSE(status.has_value());
+  EXPECT_EQ(status.error().code, ErrorCode::kUnsupported);
+  EXPECT_NE(status.error().message.find("display"), std::string::npos) << status.error().message;
+}
+
+}  // namespace
+}  // namespace meshstream::client
