@@ -1,6 +1,8 @@
-// Reading mesh files: OBJ, PLY, STL and Draco .drc through Draco's io, OFF
-// through our own reader (Draco has none). Import cleans the mesh into what
-// the codec and ASA need and reports every change it made.
+// Reading mesh files: OBJ, binary STL and Draco .drc through Draco's io;
+// OFF, PLY and ASCII STL through our own readers (Draco has no OFF or ASCII
+// STL reader, and its PLY reader merges equal positions and drops texture
+// coordinates — see mesh_readers.h). Import cleans the mesh into what the
+// codec and ASA need and reports every change it made.
 #pragma once
 
 #include <cstdint>
@@ -57,6 +59,14 @@ struct ImportedMesh {
 // file (kIo), unknown format or malformed content (kParse), NaN/Inf
 // coordinates, out-of-range indices or no usable triangle (kInvalidMesh),
 // non-manifold when repair is off (kNonManifold). Never crashes on bad input.
+// Cleaning, in this order (clean_mesh): weld bit-identical positions; drop
+// faces with a repeated vertex; drop duplicate faces (same vertex set, first
+// kept); drop unreferenced vertices; then, unless the mesh already is one,
+// make it a consistently oriented manifold (manifold_repair.h: faces are never
+// dropped — vertices are split, faces that cannot stay on an edge are
+// detached, faces are flipped). Vertex order is the file's, minus what was
+// dropped, plus repair copies appended at the end. Cost: O(V log V + F log F)
+// plus parsing; about 0.25 s for the 200k-triangle dragon_res2.ply.
 Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& options = {});
 
 // The cleaning step alone, on a mesh already in memory (same rules as import).
