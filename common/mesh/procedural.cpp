@@ -85,12 +85,12 @@ Frame frame_at(double t) {
 double tube_radius(double t, double a, Vec3d p) {
   const double base = 0.16;
   // Broad: three bulges along the knot.
-  const double broad = 0.22 * std::sin(3 * t + 0.5) + 0.10 * std::cos(5 * t);
-  // Medium: sharp ridges every ~1/40 of the length, twisting around the tube.
+  const double broad = 0.35 * std::sin(3 * t + 0.5) + 0.12 * std::cos(5 * t);
+  // Medium: ridges every 1/40 of the length, twisting around the tube.
   const double phase = 40 * t + 2 * a;
-  const double ridge = std::pow(std::abs(std::sin(phase)), 12.0) * 0.10;
+  const double ridge = std::pow(std::abs(std::sin(phase)), 6.0) * 0.10;
   // Fine: two octaves of gradient noise on the surface.
-  const double fine = 0.05 * noise(p * 9.0) + 0.025 * noise(p * 23.0 + Vec3d{5.2, 1.3, 7.7});
+  const double fine = 0.08 * noise(p * 9.0) + 0.04 * noise(p * 23.0 + Vec3d{5.2, 1.3, 7.7});
   return base * (1 + broad + ridge + fine);
 }
 
