@@ -47,6 +47,7 @@ struct LevelMesh {
   std::vector<uint8_t> green;
   std::vector<Vec4f> colors;
   std::vector<Vec2f> texcoords;
+  std::vector<uint32_t> source;  // per face: the input face it descends from (when tracked)
 
   LevelView view() const {
     LevelView v;

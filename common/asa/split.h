@@ -20,6 +20,7 @@ struct SplitInput {
   const ButterflyWeights* weights = nullptr;
   EdgePlacement placement = EdgePlacement::kZorin;
   bool want_topology = true;  // fill opposite/feature/valence data for another level
+  const uint32_t* source = nullptr;  // per face: input face it descends from; null = untracked
 };
 
 struct SplitScratch {

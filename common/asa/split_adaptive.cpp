@@ -20,11 +20,14 @@ struct Emitter {
   LevelMesh& out;
   std::vector<FaceKind>* face_kind;
   bool topology;
+  bool track_source = false;
+  uint32_t source = 0;  // input face of the parent being split
 
   uint32_t emit(uint32_t a, uint32_t b, uint32_t c, uint8_t green, FaceKind kind) {
     const uint32_t f = static_cast<uint32_t>(out.triangles.size());
     out.triangles.push_back({a, b, c});
     if (face_kind) face_kind->push_back(kind);
+    if (track_source) out.source.push_back(source);
     if (topology) {
       for (int i = 0; i < 3; ++i) {
         out.opposite.push_back(kNone);
@@ -145,6 +148,9 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     s.slot_b.resize(corners);
   }
   Emitter e{out, face_kind, topo};
+  e.track_source = in.source != nullptr;
+  out.source.clear();
+  if (e.track_source) out.source.reserve(4 * static_cast<size_t>(F));
   const uint8_t* fe = m.feature_edge;
   auto set_slot = [&](uint32_t parent, uint32_t a, uint32_t b) {
     s.slot_a[parent] = a;
@@ -155,6 +161,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
 
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t v[3] = {cv[3 * f], cv[3 * f + 1], cv[3 * f + 2]};
+    if (e.track_source) e.source = in.source[f];
     switch (closure.action[f]) {
       case kKeep: {
         const uint32_t g = e.emit(v[0], v[1], v[2], m.green ? m.green[f] : static_cast<uint8_t>(kNotGreen), FaceKind::kUntouched);

@@ -88,6 +88,13 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
     q[9] = m0; q[10] = m1; q[11] = m2;
   }
   if (face_kind) face_kind->assign(4 * static_cast<size_t>(F), FaceKind::kTarget);
+  if (in.source) {
+    out.source.resize(4 * static_cast<size_t>(F));
+    for (uint32_t f = 0; f < F; ++f)
+      for (uint32_t i = 0; i < 4; ++i) out.source[4 * f + i] = in.source[f];
+  } else {
+    out.source.clear();
+  }
 
   if (!in.want_topology) return;
   out.opposite.resize(12 * static_cast<size_t>(F));

@@ -24,6 +24,7 @@ struct AsaWorkspace::Buffers {
   asa::CornerTableScratch corner_scratch;
   std::vector<Vec3f> normals;
   std::vector<uint8_t> target;
+  std::vector<uint32_t> identity;  // level-0 source faces
   AsaStats stats;
 };
 
@@ -99,9 +100,17 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
                                            ? asa::EdgePlacement::kProjection
                                            : asa::EdgePlacement::kZorin;
 
+  const uint32_t* source = nullptr;
+  if (options.track_source_faces) {
+    ws.identity.resize(F);
+    for (uint32_t f = 0; f < F; ++f) ws.identity[f] = f;
+    source = ws.identity.data();
+  }
   if (options.levels == 0) {
     result.mesh = mesh;
     result.face_kind.assign(F, FaceKind::kUntouched);
+    if (options.track_source_faces) result.source_face = ws.identity;
+    else result.source_face.clear();
     return {};
   }
 
@@ -115,6 +124,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     in.weights = &ws.weights;
     in.placement = placement;
     in.want_topology = !last;
+    in.source = source;
     std::vector<FaceKind>* kinds = last ? &result.face_kind : nullptr;
     if (options.uniform) {
       asa::split_uniform(in, ws.scratch, out, kinds);
@@ -137,6 +147,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
         ws.weights.ensure(max_faces);
       }
       view = out.view();
+      if (source) source = out.source.data();
       colors = out.colors.empty() ? nullptr : out.colors.data();
       texcoords = out.texcoords.empty() ? nullptr : out.texcoords.data();
     } else {
@@ -144,6 +155,8 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
       std::swap(result.mesh.triangles, out.triangles);
       std::swap(result.mesh.colors, out.colors);
       std::swap(result.mesh.texcoords, out.texcoords);
+      if (source) std::swap(result.source_face, out.source);
+      else result.source_face.clear();
       if (!mesh.normals.empty()) {
         result.mesh.normals = compute_vertex_normals(result.mesh);
       } else {

@@ -24,6 +24,7 @@ struct AsaOptions {
   ButterflyRule rule = ButterflyRule::kZorin;
   float tension = 0.0f;     // omega of the ten-point stencil
   float crease_degrees = 0; // > 0: edges bending more than this stay sharp
+  bool track_source_faces = false;  // fill AsaResult::source_face
 };
 
 // Per-face label of the last level, for viewers: what ASA did to it.
@@ -32,6 +33,10 @@ enum class FaceKind : uint8_t { kUntouched = 0, kTarget = 1, kBisected = 2 };
 struct AsaResult {
   Mesh mesh;
   std::vector<FaceKind> face_kind;  // one per output face
+  // With AsaOptions::track_source_faces: per output face, the input face it
+  // descends from. Each input face's descendants are contiguous and in input
+  // face order (the incremental update relies on it).
+  std::vector<uint32_t> source_face;
 };
 
 // What the last call did, per level (for tests, benchmarks and viewers).

@@ -1,0 +1,119 @@
+// Incremental updates equal a full subdivision face for face, after records
+// that move vertices and insert vertices (as the decoder's refinements do).
+#include "tests/asa/asa_test_support.h"
+
+#include <random>
+
+#include "common/asa/incremental.h"
+
+namespace meshstream {
+namespace {
+
+// Same faces in the same order with bit-identical corner positions, same
+// vertex count, same face kinds.
+::testing::AssertionResult same_output(const AsaResult& a, const AsaResult& b) {
+  if (a.mesh.face_count() != b.mesh.face_count())
+    return ::testing::AssertionFailure() << "faces " << a.mesh.face_count() << " vs " << b.mesh.face_count();
+  if (a.mesh.vertex_count() != b.mesh.vertex_count())
+    return ::testing::AssertionFailure() << "vertices " << a.mesh.vertex_count() << " vs " << b.mesh.vertex_count();
+  for (uint32_t f = 0; f < a.mesh.face_count(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      const Vec3f p = a.mesh.positions[a.mesh.triangles[f][i]], q = b.mesh.positions[b.mesh.triangles[f][i]];
+      if (std::memcmp(&p, &q, sizeof p) != 0) return ::testing::AssertionFailure() << "face " << f << " corner " << i;
+    }
+    if (a.face_kind[f] != b.face_kind[f]) return ::testing::AssertionFailure() << "face kind of " << f;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// A decoder-like refinement: a new vertex inside face f, lifted off the
+// plane; f is replaced in place and two faces are appended.
+void insert_vertex(Mesh& m, uint32_t f, float lift) {
+  const Triangle t = m.triangles[f];
+  const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+  const Vec3f n = normalized(cross(b - a, c - a));
+  const float size = length(b - a);
+  const uint32_t v = m.vertex_count();
+  m.positions.push_back((a + b + c) / 3.0f + n * (lift * size));
+  if (!m.colors.empty()) m.colors.push_back({0.5f, 0.5f, 0.5f, 1});
+  m.triangles[f] = {t[0], t[1], v};
+  m.triangles.push_back({t[1], t[2], v});
+  m.triangles.push_back({t[2], t[0], v});
+}
+
+void run_records(const Mesh& start, const AsaOptions& options, int records, const char* what,
+                 bool expect_partial = true) {
+  IncrementalSubdivider inc(options);
+  ASSERT_TRUE(inc.update(start).has_value());
+  EXPECT_TRUE(inc.last_update().full);
+  Mesh m = start;
+  std::mt19937 rng(7);
+  int partial = 0;
+  for (int r = 0; r < records; ++r) {
+    if (r % 3 == 2) {
+      const uint32_t v = rng() % m.vertex_count();
+      m.positions[v] = m.positions[v] * 1.01f;  // a moved vertex
+    } else {
+      insert_vertex(m, rng() % m.face_count(), (r % 2 ? 0.2f : -0.1f));
+    }
+    ASSERT_TRUE(inc.update(m).has_value()) << what;
+    partial += !inc.last_update().full;
+    auto full = subdivide(m, options);
+    ASSERT_TRUE(full.has_value());
+    EXPECT_TRUE(same_output(inc.result(), *full)) << what << " after record " << r;
+    EXPECT_TRUE(asa_test::conforming(m, inc.result())) << what << " after record " << r;
+  }
+  if (expect_partial) EXPECT_GT(partial, records / 2) << what << ": most updates should be partial";
+}
+
+TEST(AsaIncremental, UniformMatchesFullSubdivision) {
+  AsaOptions o;
+  o.uniform = true;
+  o.levels = 2;
+  run_records(asa_test::icosahedron(), o, 4, "icosahedron", false);  // tiny: full updates
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  run_records(asa_test::load("sphere_low.off"), o, 12, "sphere_low uniform");
+  o.levels = 3;
+  run_records(asa_test::load("hemisphere.off"), o, 8, "hemisphere uniform L3");
+}
+
+TEST(AsaIncremental, AdaptiveAndCreasesMatchFullSubdivision) {
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  AsaOptions o;
+  o.levels = 2;
+  o.flatness = 0.8f;
+  run_records(asa_test::load("fandisk.off"), o, 12, "fandisk ASA");
+  o.crease_degrees = 45;
+  run_records(asa_test::load("fandisk.off"), o, 8, "fandisk ASA crease");
+  o = {};
+  o.levels = 3;
+  o.flatness = 0.9f;
+  run_records(asa_test::load("bunny.off"), o, 6, "bunny ASA L3");
+}
+
+TEST(AsaIncremental, ColorsFollowAndNothingChangedIsFree) {
+  Mesh m = asa_test::grid(20, [](float x, float y) { return 0.3f * std::sin(x) * std::cos(y); });
+  for (uint32_t v = 0; v < m.vertex_count(); ++v) m.colors.push_back({v / 441.0f, 0, 1, 1});
+  AsaOptions o;
+  o.levels = 2;
+  o.flatness = 0.95f;
+  IncrementalSubdivider inc(o);
+  ASSERT_TRUE(inc.update(m).has_value());
+  ASSERT_TRUE(inc.update(m).has_value());
+  EXPECT_FALSE(inc.last_update().full);
+  EXPECT_EQ(inc.last_update().changed_vertices, 0u);
+  insert_vertex(m, 300, 0.3f);
+  ASSERT_TRUE(inc.update(m).has_value());
+  auto full = subdivide(m, o);
+  EXPECT_TRUE(same_output(inc.result(), *full));
+  ASSERT_EQ(inc.result().mesh.colors.size(), inc.result().mesh.positions.size());
+  // Bad input after good: an error, and the next good update is full.
+  Mesh bad = m;
+  bad.positions[0].x = NAN;
+  EXPECT_FALSE(inc.update(bad).has_value());
+  ASSERT_TRUE(inc.update(m).has_value());
+  EXPECT_TRUE(inc.last_update().full);
+}
+
+}  // namespace
+}  // namespace meshstream
