@@ -170,15 +170,16 @@ class RecordWriter {
       if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);
       s_.last_count = count;
       patches.resize(count);
+      used_.assign(faces, 0);
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals[order[j].second];
         const uint32_t k = static_cast<uint32_t>(r.ring.size());
-        if (faces <= 16) {
-          m.first_face[faces].encode(enc_, order[j].first);
-        } else {
-          m.first_face_big.encode(enc_, order[j].first);
-        }
         m.valence[std::min(ring_size, 12u)].encode(enc_, k - 3);
+        rank_patch_starts(s_.mesh, u, star_ring, used_, k, candidates_);
+        const auto it = std::find(candidates_.begin(), candidates_.end(), order[j].first);
+        if (it == candidates_.end()) return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
+        encode_start_rank(m, enc_, k, static_cast<uint32_t>(it - candidates_.begin()));
+        for (uint32_t f = 0; f + 2 < k; ++f) used_[(order[j].first + f) % faces] = 1;
         if (!resolve_patch(s_.mesh, u, star_ring, star_corners, order[j].first, k, patches[j]) ||
             patches[j].ring != r.ring) {
           return make_error(ErrorCode::kInvalidMesh, "internal: patch does not resolve to its ring");
@@ -236,7 +237,8 @@ class RecordWriter {
   RangeEncoder enc_;
   bool starts_layer_ = false;
   uint32_t walk_steps_ = 0, insertions_ = 0;
-  std::vector<uint32_t> first_, next_, open_edges_;
+  std::vector<uint32_t> first_, next_, open_edges_, candidates_;
+  std::vector<uint8_t> used_;
 };
 
 }  // namespace

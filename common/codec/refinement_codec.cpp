@@ -135,6 +135,41 @@ bool decode_residual(RefinementModels& models, RangeDecoder& dec, const Residual
   return true;
 }
 
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out) {
+  out.clear();
+  const uint32_t faces = static_cast<uint32_t>(used.size());
+  const uint32_t fan = k - 2;
+  const bool boundary = mesh.is_boundary(apex);
+  if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return;
+  const auto& p = mesh.positions();
+  auto l1 = [&](uint32_t a, uint32_t b) {
+    return int64_t(std::abs(int64_t(p[a].x) - p[b].x)) + std::abs(int64_t(p[a].y) - p[b].y) +
+           std::abs(int64_t(p[a].z) - p[b].z);
+  };
+  auto l2 = [&](uint32_t a, uint32_t b) {
+    const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y, dz = int64_t(p[a].z) - p[b].z;
+    return dx * dx + dy * dy + dz * dz;
+  };
+  thread_local std::vector<std::pair<int64_t, uint32_t>> scored;
+  scored.clear();
+  const uint32_t last_start = boundary ? faces - fan : faces - 1;
+  for (uint32_t r = 0; r <= last_start; ++r) {
+    bool free = true;
+    for (uint32_t j = 0; j < fan && free; ++j) free = !used[(r + j) % faces];
+    if (!free) continue;
+    int64_t score = 0;
+    if (k == 3) {
+      score = l2(star_ring[r], star_ring[(r + 1) % star_ring.size()]);
+    } else {
+      for (uint32_t j = 1; j < fan; ++j) score += l2(apex, star_ring[(r + j) % faces]);
+    }
+    scored.push_back({-score, r});
+  }
+  std::sort(scored.begin(), scored.end());
+  for (const auto& e : scored) out.push_back(e.second);
+}
+
 void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
                           std::vector<uint32_t>& out) {
   out.clear();
@@ -144,6 +179,21 @@ void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
   for (uint32_t j = 1; j + 1 < k; ++j)
     if (mesh.opposite(fc[j - 1]) == kNone) out.push_back(j);
   if (mesh.opposite(EditableMesh::next(fc[k - 3])) == kNone) out.push_back(k - 1);
+}
+
+void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint32_t rank) {
+  BitTreeModel<4>& tree = m.start_rank[std::min(k - 3, 5u)];
+  if (rank < 15) {
+    tree.encode(enc, rank);
+  } else {
+    tree.encode(enc, 15);
+    m.start_rank_big.encode(enc, rank - 15);
+  }
+}
+
+uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k) {
+  const uint32_t rank = m.start_rank[std::min(k - 3, 5u)].decode(dec);
+  return rank < 15 ? rank : 15 + m.start_rank_big.decode(dec);
 }
 
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
@@ -217,7 +267,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   std::vector<uint32_t> star_ring, star_corners;
   std::vector<ResolvedPatch> patches;
   std::vector<Vec3i> positions;
-  std::vector<uint32_t> opens, open_edges;
+  std::vector<uint32_t> opens, open_edges, candidates;
   std::vector<uint8_t> used_faces;
   uint32_t inserted = 0;
   // On error the state is left half-applied: the caller discards it (the
@@ -247,18 +297,19 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     opens.resize(count);
     used_faces.assign(faces, 0);
     for (uint32_t i = 0; i < count; ++i) {
-      uint32_t r = faces <= 16 ? m.first_face[faces].decode(dec) : m.first_face_big.decode(dec);
       const uint32_t k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
+      rank_patch_starts(mesh, u, star_ring, used_faces, k, candidates);
+      const uint32_t rank = decode_start_rank(m, dec, k);
+      if (rank >= candidates.size()) {
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
+                    std::to_string(k) + ", start rank " + std::to_string(rank) + ") does not fit its star of " +
+                    std::to_string(faces) + " faces");
+      }
+      const uint32_t r = candidates[rank];
       if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
-        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) +
-                               " (first face " + std::to_string(r) + ", valence " + std::to_string(k) +
-                               ") does not fit its star of " + std::to_string(faces) + " faces");
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " does not fit");
       }
-      for (uint32_t j = 0; j + 2 < k; ++j) {
-        uint8_t& used = used_faces[(r + j) % faces];
-        if (used) return fail("patches at vertex " + std::to_string(u) + " overlap");
-        used = 1;
-      }
+      for (uint32_t j = 0; j + 2 < k; ++j) used_faces[(r + j) % faces] = 1;
       opens[i] = kNone;
       patch_boundary_edges(mesh, patches[i], open_edges);
       if (!open_edges.empty()) {

@@ -7,9 +7,12 @@
 // base order; every inserted vertex is linked right after the apex of its
 // patch, so list neighbours are surface neighbours and a slice of the list is
 // a spatially coherent batch). At each vertex u present before the layer it
-// reads how many patches have their fan apex at u, and for each: r, the index
-// in u's star (EditableMesh::star order) of the first fan face, and k, the
-// valence of the vertex to insert (the fan has k-2 faces); when ring edges
+// reads how many patches have their fan apex at u, and for each: k, the
+// valence of the vertex to insert (the fan has k-2 faces), and which run of
+// k-2 faces of u's star is the fan, as a rank among the runs that fit,
+// ordered by how much they look like a fan (longest diagonals first: a fan
+// over a removed vertex's hole has long edges from the apex; this saves a
+// third of the bits of a plain star index); when ring edges
 // of the patch lie on the boundary, which of them (if any) the vertex
 // re-enters as a boundary vertex. Then the vertex's
 // position as a residual from the prediction (average of the k ring vertices,
@@ -37,8 +40,8 @@ inline constexpr int kScaleContexts = 20;
 struct RefinementModels {
   BitTreeModel<2> patch_count[26];   // by count_context; 3 = escape
   AdaptiveUIntModel patch_count_extra;
-  BitTreeModel<4> first_face[17];    // by apex face count when <= 16
-  AdaptiveUIntModel first_face_big;
+  BitTreeModel<4> start_rank[6];     // by min(k - 3, 5); 15 = escape
+  AdaptiveUIntModel start_rank_big;
   BitTreeModel<4> valence[13];       // k - 3 (k <= 18), by min(apex ring size, 12)
   AdaptiveIntModel residual[kScaleContexts][3];
   AdaptiveUIntModel open_edge;       // 0 interior vertex, i+1: re-enters boundary edge i
@@ -87,6 +90,14 @@ bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<ui
 void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
                           std::vector<uint32_t>& out);
 
+// The first-face indices r (into the apex's star) where a fan of k-2 faces
+// fits and overlaps no face marked in `used`, best candidate first: by the
+// sum of the squared lengths of the fan's diagonals (k >= 4) or of the
+// edge opposite the apex (k = 3), larger first, ties by r. Integer-exact.
+// O(faces * k).
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out);
+
 // The decoder's prediction of a vertex inserted into `ring`: the rounded
 // average of the ring's positions. Exact integers.
 Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
@@ -111,6 +122,10 @@ bool decode_residual(RefinementModels& models, RangeDecoder& dec, const Residual
 
 // Inserts a vertex into a resolved patch and links it after the apex in the
 // order list. Returns its id; appends written face slots to `touched`.
+// The rank of a patch's start among rank_patch_starts' candidates.
+void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint32_t rank);
+uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k);
+
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
                      Vec3i position, std::vector<uint32_t>* touched);
 
