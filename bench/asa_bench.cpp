@@ -27,6 +27,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/ModifiedButterFlyT.hh>
 
+#include "common/asa/incremental.h"
 #include "common/asa/subdivide.h"
 #include "common/mesh/adjacency.h"
 #include "common/mesh/import.h"
@@ -145,6 +146,19 @@ Bandwidth measure_bandwidth() {
   volatile char sink = a[n / 2] + b[n / 3];
   (void)sink;
   return {median(w), median(c)};
+}
+
+// A decoder-like refinement record: a new vertex inside face f, lifted off
+// the plane; f is replaced in place and two faces are appended.
+void insert_vertex(Mesh& m, uint32_t f, float lift) {
+  const Triangle t = m.triangles[f];
+  const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+  const Vec3f n = normalized(cross(b - a, c - a));
+  const uint32_t v = m.vertex_count();
+  m.positions.push_back((a + b + c) / 3.0f + n * (lift * length(b - a)));
+  m.triangles[f] = {t[0], t[1], v};
+  m.triangles.push_back({t[1], t[2], v});
+  m.triangles.push_back({t[2], t[0], v});
 }
 
 size_t output_bytes(const Mesh& m, size_t faces) {
@@ -292,6 +306,56 @@ int main(int argc, char** argv) {
     }
   }
 
+  // Incremental updates after decoder-like records against a full run.
+  std::ostringstream incremental_table;
+  incremental_table << "| mesh | mode | output faces | full ms | incremental ms per record | speed-up | "
+                       "dirty faces | region faces | full fallbacks |\n|---|---|---|---|---|---|---|---|---|\n";
+  std::vector<std::string> incremental_names = {"bunny.off", "armadillo.obj"};
+  if (opt.quick) incremental_names = {"bunny.off"};
+  for (const std::string& name : incremental_names) {
+    auto imported = import_mesh(testing::test_mesh(name));
+    if (!imported) continue;
+    for (bool uniform_mode : {false, true}) {
+      AsaOptions o;
+      o.levels = 2;
+      o.flatness = 0.8f;
+      o.uniform = uniform_mode;
+      Mesh m = imported->mesh;
+      IncrementalSubdivider inc(o);
+      if (!inc.update(m)) continue;
+      AsaWorkspace fws;
+      AsaResult fres;
+      std::vector<double> inc_ms, full_ms;
+      double dirty = 0, region = 0;
+      int fallbacks = 0;
+      const int records = opt.quick ? 10 : 30;
+      uint32_t seed = 12345;
+      for (int r = 0; r < records; ++r) {
+        seed = seed * 1664525u + 1013904223u;
+        insert_vertex(m, seed % m.face_count(), r % 2 ? 0.2f : -0.1f);
+        double t0 = now_ms();
+        if (!inc.update(m)) break;
+        double t1 = now_ms();
+        (void)subdivide_into(m, o, fws, fres);
+        double t2 = now_ms();
+        inc_ms.push_back(t1 - t0);
+        full_ms.push_back(t2 - t1);
+        dirty += inc.last_update().dirty_faces;
+        region += inc.last_update().region_faces;
+        fallbacks += inc.last_update().full;
+      }
+      if (inc_ms.empty()) continue;
+      incremental_table << "| " << name << " | " << (uniform_mode ? "uniform L2" : "ASA t=0.8 L2") << " | "
+                        << inc.result().mesh.face_count() << " | " << fmt("%.2f", median(full_ms)) << " | "
+                        << fmt("%.2f", median(inc_ms)) << " | " << fmt("%.1f", median(full_ms) / median(inc_ms))
+                        << "x | " << fmt("%.0f", dirty / inc_ms.size()) << " | "
+                        << fmt("%.0f", region / inc_ms.size()) << " | " << fallbacks << " / " << inc_ms.size()
+                        << " |\n";
+      std::printf("%s incremental %s: full %.2f ms, incremental %.2f ms\n", name.c_str(),
+                  uniform_mode ? "uniform" : "ASA", median(full_ms), median(inc_ms));
+    }
+  }
+
   // Surface distance to the original before and after ASA, on meshes
   // simplified to 1/20 and 1/10 of their triangles (meshoptimizer), standing
   // in for stream prefixes decoded at compression ratios 20 and 10.
@@ -399,6 +463,13 @@ int main(int argc, char** argv) {
          "`time share / output share` = (ASA time / uniform time) / (ASA faces / uniform faces): at most 1 "
          "means ASA costs no more per output triangle than uniform.\n\n"
       << asa_table.str() << "\n";
+  out << "### Incremental updates (the client's case)\n\n"
+         "After each decoder-like record (a vertex inserted into a random face: one face replaced, two "
+         "appended), `IncrementalSubdivider::update` against a full `subdivide_into` with a warm workspace "
+         "(medians over the records). The incremental result is checked equal to the full one face for face "
+         "in tests/asa/asa_incremental_test.cpp. Its cost is the region's subdivision plus an O(output) "
+         "splice (copying the clean patches with renumbered vertices).\n\n"
+      << incremental_table.str() << "\n";
   out << "### Does ASA bring a coarse mesh closer to the original?\n\n"
          "Coarse meshes are meshoptimizer `meshopt_simplify` results at 1/20 and 1/10 of the triangles (they "
          "keep a subset of the original vertices, like a decoded stream prefix; the codec's own prefixes can "
