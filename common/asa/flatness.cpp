@@ -61,14 +61,19 @@ uint32_t count_vertex_faces(const LevelView& m, std::vector<uint32_t>& faces) {
 uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, float t,
                       std::vector<uint8_t>& target) {
   target.assign(m.face_count, 0);
-  const uint32_t corners = 3 * m.face_count;
-  for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t o = m.opposite[c];
-    if (o == kNone || o < c || m.feature_edge[c]) continue;
-    if (dot(normals[c / 3], normals[o / 3]) <= t) target[c / 3] = target[o / 3] = 1;
-  }
   uint32_t count = 0;
-  for (uint8_t x : target) count += x;
+  for (uint32_t f = 0; f < m.face_count; ++f) {
+    const Vec3f n = normals[f];
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
+      const uint32_t o = m.opposite[c];
+      // Each edge once, from its smaller corner; feature edges are skipped.
+      if (o == kNone || o < c || m.feature_edge[c]) continue;
+      if (dot(n, normals[o / 3]) <= t) {
+        count += !target[f] + !target[o / 3];
+        target[f] = target[o / 3] = 1;
+      }
+    }
+  }
   return count;
 }
 

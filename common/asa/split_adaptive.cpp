@@ -16,26 +16,49 @@
 namespace meshstream::asa {
 namespace {
 
+// Writes output faces into arrays pre-sized to the 4F upper bound (no
+// push_back in the loop); finish() trims them.
 struct Emitter {
   LevelMesh& out;
   std::vector<FaceKind>* face_kind;
   bool topology;
   bool track_source = false;
   uint32_t source = 0;  // input face of the parent being split
+  uint32_t count = 0;   // faces written
 
-  uint32_t emit(uint32_t a, uint32_t b, uint32_t c, uint8_t green, FaceKind kind) {
-    const uint32_t f = static_cast<uint32_t>(out.triangles.size());
-    out.triangles.push_back({a, b, c});
-    if (face_kind) face_kind->push_back(kind);
-    if (track_source) out.source.push_back(source);
+  void start(size_t capacity) {
+    out.triangles.resize(capacity);
+    if (face_kind) face_kind->resize(capacity);
+    if (track_source) out.source.resize(capacity);
     if (topology) {
-      for (int i = 0; i < 3; ++i) {
-        out.opposite.push_back(kNone);
-        out.feature_edge.push_back(0);
+      out.opposite.resize(3 * capacity);
+      out.feature_edge.resize(3 * capacity);
+      out.green.resize(capacity);
+    }
+  }
+  uint32_t emit(uint32_t a, uint32_t b, uint32_t c, uint8_t green, FaceKind kind) {
+    const uint32_t f = count++;
+    out.triangles[f] = {a, b, c};
+    if (face_kind) (*face_kind)[f] = kind;
+    if (track_source) out.source[f] = source;
+    if (topology) {
+      for (uint32_t i = 0; i < 3; ++i) {
+        out.opposite[3 * f + i] = kNone;
+        out.feature_edge[3 * f + i] = 0;
       }
-      out.green.push_back(green);
+      out.green[f] = green;
     }
     return f;
+  }
+  void finish() {
+    out.triangles.resize(count);
+    if (face_kind) face_kind->resize(count);
+    if (track_source) out.source.resize(count);
+    if (topology) {
+      out.opposite.resize(3 * static_cast<size_t>(count));
+      out.feature_edge.resize(3 * static_cast<size_t>(count));
+      out.green.resize(count);
+    }
   }
   uint32_t vertex(uint32_t corner) const { return out.triangles[corner / 3][corner % 3]; }
 };
@@ -130,27 +153,27 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     }
   }
 
-  out.triangles.clear();
-  out.triangles.reserve(4 * static_cast<size_t>(F));
-  if (face_kind) {
-    face_kind->clear();
-    face_kind->reserve(4 * static_cast<size_t>(F));
-  }
   const bool topo = in.want_topology;
   if (topo) {
-    out.opposite.clear();
-    out.opposite.reserve(12 * static_cast<size_t>(F));
-    out.feature_edge.clear();
-    out.feature_edge.reserve(12 * static_cast<size_t>(F));
-    out.green.clear();
-    out.green.reserve(4 * static_cast<size_t>(F));
     s.slot_a.resize(corners);
     s.slot_b.resize(corners);
   }
   Emitter e{out, face_kind, topo};
   e.track_source = in.source != nullptr;
-  out.source.clear();
-  if (e.track_source) out.source.reserve(4 * static_cast<size_t>(F));
+  if (!e.track_source) out.source.clear();
+  // Exact output size first, so the arrays are written in place.
+  size_t total = 0;
+  for (uint32_t f = 0; f < F; ++f) {
+    switch (closure.action[f]) {
+      case kKeep: total += 1; break;
+      case kBisect: total += 2; break;
+      case kRed: total += 4; break;
+      case kOpened:
+        if (m.green[f] == kGreenFirst) total += 4 + (split[3 * f] ? 1 : 0) + (split[3 * f + 3] ? 1 : 0);
+        break;
+    }
+  }
+  e.start(total);
   const uint8_t* fe = m.feature_edge;
   auto set_slot = [&](uint32_t parent, uint32_t a, uint32_t b) {
     s.slot_a[parent] = a;
@@ -245,6 +268,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     }
   }
 
+  e.finish();
   if (!topo) return;
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t o = opp[c];
