@@ -143,28 +143,35 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
   const bool boundary = mesh.is_boundary(apex);
   if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return;
   const auto& p = mesh.positions();
-  auto l1 = [&](uint32_t a, uint32_t b) {
-    return int64_t(std::abs(int64_t(p[a].x) - p[b].x)) + std::abs(int64_t(p[a].y) - p[b].y) +
-           std::abs(int64_t(p[a].z) - p[b].z);
-  };
   auto l2 = [&](uint32_t a, uint32_t b) {
     const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y, dz = int64_t(p[a].z) - p[b].z;
     return dx * dx + dy * dy + dz * dz;
   };
+  thread_local std::vector<int64_t> edge;
   thread_local std::vector<std::pair<int64_t, uint32_t>> scored;
   scored.clear();
   const uint32_t last_start = boundary ? faces - fan : faces - 1;
-  for (uint32_t r = 0; r <= last_start; ++r) {
-    bool free = true;
-    for (uint32_t j = 0; j < fan && free; ++j) free = !used[(r + j) % faces];
-    if (!free) continue;
-    int64_t score = 0;
-    if (k == 3) {
-      score = l2(star_ring[r], star_ring[(r + 1) % star_ring.size()]);
-    } else {
-      for (uint32_t j = 1; j < fan; ++j) score += l2(apex, star_ring[(r + j) % faces]);
+  if (k == 3) {
+    for (uint32_t r = 0; r <= last_start; ++r) {
+      if (used[r]) continue;
+      scored.push_back({-l2(star_ring[r], star_ring[(r + 1) % star_ring.size()]), r});
     }
-    scored.push_back({-score, r});
+  } else {
+    // Squared apex edge lengths, then a sliding sum over the k-3 diagonals
+    // of each run (ring entries r+1 .. r+k-3).
+    edge.resize(faces);
+    for (uint32_t i = 0; i < faces; ++i) edge[i] = l2(apex, star_ring[i]);
+    int64_t window = 0;
+    for (uint32_t j = 1; j < fan; ++j) window += edge[j % faces];
+    uint32_t used_in_run = 0;
+    for (uint32_t j = 0; j < fan; ++j) used_in_run += used[j % faces];
+    for (uint32_t r = 0; r <= last_start; ++r) {
+      if (used_in_run == 0) scored.push_back({-window, r});
+      // Slide the run one face on: drop face r and diagonal r+1, add the next.
+      window += edge[(r + fan) % faces] - edge[(r + 1) % faces];
+      used_in_run += used[(r + fan) % faces];
+      used_in_run -= used[r];
+    }
   }
   std::sort(scored.begin(), scored.end());
   for (const auto& e : scored) out.push_back(e.second);
