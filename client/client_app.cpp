@@ -133,7 +133,7 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
   std::thread network([&] {
     client.run(decoded, [&](const StreamFacts& f) {
       facts = f;
-      pipeline.set_totals(f.total_bytes, f.records_total);
+      pipeline.set_totals(f.total_bytes, f.records_total, f.end_record);
       log.header(f, elapsed());
     });
   });
@@ -147,9 +147,11 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
     decoded.stop();
   }
   Status pipeline_status = pipeline.wait_finished();
-  pipeline.stop();
-  client.stop();
+  // The last record may be shown before the server's StreamEnd arrives:
+  // let the network thread finish the conversation (it stops by itself).
+  if (!pipeline_status) client.stop();
   network.join();
+  pipeline.stop();
   mailbox.close();
 
   const std::optional<StreamOutcome> outcome = decoded.outcome();

@@ -30,10 +30,11 @@ Status DisplayPipeline::wait_finished() {
   return {};
 }
 
-void DisplayPipeline::set_totals(uint64_t bytes_total, uint32_t records_total) {
+void DisplayPipeline::set_totals(uint64_t bytes_total, uint32_t records_total, uint32_t end_record) {
   std::lock_guard lock(mutex_);
   bytes_total_ = bytes_total;
   records_total_ = records_total;
+  end_record_ = end_record;
 }
 
 void DisplayPipeline::mark_finished(std::optional<Error> error) {
@@ -66,12 +67,13 @@ void DisplayPipeline::loop() {
     seen_pokes = pokes;
     PipelineSettings settings;
     uint64_t bytes_total;
-    uint32_t records_total;
+    uint32_t records_total, end_record;
     {
       std::lock_guard lock(mutex_);
       settings = settings_;
       bytes_total = bytes_total_;
       records_total = records_total_;
+      end_record = end_record_;
     }
     const bool pending = decoded_.has_pending();
     if (!pending && !(rerun && last) && (outcome_seen || !decoded_.outcome())) continue;
@@ -105,7 +107,10 @@ void DisplayPipeline::loop() {
       frame.bytes_received = u.bytes_decoded;
       frame.decode_ms = u.decode_ms;
       frame.coalesced_updates = u.updates > 0 ? u.updates - 1 : 0;
-      frame.final = u.ended && decoded_.outcome() && decoded_.outcome()->ok && !decoded_.has_pending();
+      // Final once the last record the server will send is in (the end
+      // frame itself may still be on its way), or the stream ended well.
+      frame.final = (end_record > 0 && u.records_decoded >= end_record) ||
+                    (u.ended && decoded_.outcome() && decoded_.outcome()->ok && !decoded_.has_pending());
       info.new_records = true;
       frame.decoded = std::make_shared<const Mesh>(mirror);
     } else {
@@ -136,6 +141,7 @@ void DisplayPipeline::loop() {
       mark_finished(std::nullopt);
     }
   }
+  mark_finished(std::nullopt);  // stopped
 }
 
 void DisplayPipeline::set_asa(bool asa_enabled, const AsaOptions& options) {

@@ -50,7 +50,9 @@ class DisplayPipeline : public StreamControls {
   // Blocks until the stream ended and its last state is published (or the
   // stream failed). The error, if the pipeline (ASA) failed.
   Status wait_finished();
-  void set_totals(uint64_t bytes_total, uint32_t records_total);
+  // From the stream header: totals, and the record count after which the
+  // stream is complete (StreamHeader.end_record: the budget's last record).
+  void set_totals(uint64_t bytes_total, uint32_t records_total, uint32_t end_record);
 
   // StreamControls
   void set_asa(bool asa_enabled, const AsaOptions& options) override;
@@ -79,6 +81,7 @@ class DisplayPipeline : public StreamControls {
   std::optional<Error> error_;
   uint64_t bytes_total_ = 0;
   uint32_t records_total_ = 0;
+  uint32_t end_record_ = 0;
   uint64_t sequence_ = 0;
   std::thread thread_;
 };

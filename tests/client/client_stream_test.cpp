@@ -170,6 +170,39 @@ TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
             }()));
 }
 
+// The incremental path (only the region a record changed is recomputed)
+// gives the same triangles at the same positions as subdividing everything.
+TEST_F(ClientStreamTest, IncrementalAsaEqualsOfflineSubdivideAtEachRecord) {
+  TempDir out;
+  Server paced;  // paced so that most records get their own display update
+  ASSERT_TRUE(paced.start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate", "150000",
+                           "--max-chunk-bytes", "1024"},
+                          out.path()))
+      << paced.log();
+  const std::vector<std::string> asa{"--levels", "1", "--flatness", "0.8", "--crease", "50"};
+  const ClientRun r = client(paced.address(), {"demo", "--json", "--out", out.path(), "--asa-levels", "1",
+                                               "--flatness", "0.8", "--crease", "50", "--asa-path",
+                                               "incremental"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_monotone_events(r.events);
+  std::vector<nlohmann::json> incremental;
+  for (const auto& e : of_kind(r.events, "refinement")) {
+    if (e["asa_path"] == "incremental") incremental.push_back(e);
+  }
+  ASSERT_GE(incremental.size(), 3u) << "the incremental path was never taken";
+  for (size_t pick : {size_t(0), incremental.size() / 2, incremental.size() - 1}) {
+    const auto& e = incremental[pick];
+    const int64_t index = e["index"];
+    char name[32];
+    std::snprintf(name, sizeof name, "%04lld.ply", static_cast<long long>(index));
+    const Mesh display = load_ply(out / name);
+    const std::string prefix = "iprefix" + std::to_string(index) + ".ply";
+    tool_decode(e["bytes"].get<uint64_t>(), prefix);
+    const Mesh expected = tool_subdivide(*dir_ / prefix, asa, "isub" + std::to_string(index) + ".ply");
+    EXPECT_TRUE(same_geometry(display, expected)) << "record " << index;
+  }
+}
+
 TEST_F(ClientStreamTest, NoAsaShowsTheDecodedMesh) {
   TempDir out;
   const ClientRun r = client(server_->address(), {"demo", "--json", "--no-asa", "--out", out.path()});
