@@ -58,7 +58,10 @@ class LayerBuilder {
       const double abl = length(ab);
       line = abl > 0 ? length(cross(pv - ad, ab)) / abl : length(pv - ad);
     }
-    return plane + 0.5 * length(d) + line;
+    // Geometric error on a log scale, plus half the valence: among vertices
+    // of similar error the low-valence ones go first, which gives larger
+    // independent sets and keeps valences regular (measured: -2.5 % size).
+    return std::log1p(plane + 0.5 * length(d) + line) + 0.5 * double(k);
   }
 
   // Tries to remove v; returns true and fills `removal` on success.

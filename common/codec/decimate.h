@@ -18,10 +18,13 @@
 // - no fan triangle is degenerate on the grid (zero area, exact integers) or
 //   turns against the star's normal (cosine <= kMinFanCosine).
 // Among valid apexes the one whose worst fan triangle is the best shaped wins.
-// Importance = distance of v from the plane of its star (area normal
+// Importance = log(1 + e) + valence / 2, where the geometric error e (grid
+// units) is the distance of v from the plane of its star (area normal
 // through the ring centroid) plus half its distance from the ring average
-// (the decoder's prediction); for a boundary vertex plus its distance from
-// the new boundary edge's line (the boundary's shape). Cheapest first.
+// (the decoder's prediction), plus for a boundary vertex its distance from
+// the new boundary edge's line (the boundary's shape). Cheapest first. The
+// valence term is a regularizer in the spirit of Alliez & Desbrun's
+// valence-driven decimation (2001): at similar error, low valences first.
 #pragma once
 
 #include <cstdint>
