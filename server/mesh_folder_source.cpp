@@ -171,13 +171,14 @@ class MeshFolderSource final : public CatalogSource {
         std::string line = "[" + std::to_string(n) + "/" + std::to_string(jobs.size()) + "] ";
         if (jobs[i].result) {
           char facts[160];
-          std::snprintf(facts, sizeof facts, "%s %s: %u vertices, %zu bytes, %s in %.2f s",
-                        jobs[i].from_cache ? "cached" : "encoded", jobs[i].path.c_str(),
+          std::snprintf(facts, sizeof facts, "%s %s: %u vertices, %zu bytes in %.2f s",
+                        jobs[i].from_cache ? "from cache" : "encoded", jobs[i].path.c_str(),
                         jobs[i].result->index.header.vertex_count, jobs[i].result->stream().size(),
-                        jobs[i].from_cache ? "mapped" : "encoded", seconds);
+                        seconds);
           line += facts;
         } else {
-          line += "skipped " + jobs[i].path.string() + ": " + jobs[i].result.error().message;
+          // Import and encode errors already name the file.
+          line += "skipped: " + jobs[i].result.error().message;
         }
         log(line);
       }
