@@ -1,0 +1,156 @@
+// End to end: the real meshstream-server streams a procedural model to the
+// real meshstream-client, which renders snapshots off-screen (--snapshot,
+// --snapshot-at) and opens the live window under Xvfb (--view --exit-after).
+// Skips visibly when the binaries are not built.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "client/viewer/rgba_image.h"
+#include "common/mesh/export.h"
+#include "common/mesh/procedural.h"
+#include "tests/viewer/child_process.h"
+#include "tests/viewer/image_checks.h"
+#include "tests/viewer/xvfb_display.h"
+
+namespace meshstream::client {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+std::string server_binary() { return std::string(MESHSTREAM_BINARY_DIR) + "/server/meshstream-server"; }
+std::string client_binary() { return std::string(MESHSTREAM_BINARY_DIR) + "/client/meshstream-client"; }
+
+class ClientEndToEnd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!fs::exists(server_binary()) || !fs::exists(client_binary())) return;
+    dir_ = new fs::path(fs::temp_directory_path() /
+                        ("meshstream_viewer_e2e_" + std::to_string(::getpid())));
+    fs::create_directories(*dir_ / "models");
+    // A model with detail at several scales, so early records look coarse.
+    if (!write_ply(make_demo_mesh(12000), (*dir_ / "models" / "knot.ply").string())) {
+      TearDownTestSuite();  // the tests then skip, saying why
+    }
+  }
+  static void TearDownTestSuite() {
+    if (dir_) {
+      std::error_code ignored;
+      fs::remove_all(*dir_, ignored);
+      delete dir_;
+      dir_ = nullptr;
+    }
+  }
+
+  void SetUp() override {
+    if (!dir_) GTEST_SKIP() << "meshstream-server or meshstream-client not built";
+  }
+
+  // Starts a server on a free port; "" on failure (log in the message).
+  std::string start_server(testing::ChildProcess& server, const std::vector<std::string>& extra) {
+    std::vector<std::string> args{server_binary(), "--models", (*dir_ / "models").string(),
+                                  "--cache", (*dir_ / "cache").string(), "--listen",
+                                  "127.0.0.1:0"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    if (!server.start(args, (*dir_ / "server.log").string())) return {};
+    for (int i = 0; i < 20; ++i) {
+      auto line = server.read_line(30s);
+      if (!line) return {};
+      if (line->rfind("listening on ", 0) == 0) return line->substr(13);
+    }
+    return {};
+  }
+
+  // Runs the client to completion; its exit code (-1 on timeout).
+  int run_client(const std::vector<std::string>& extra, std::chrono::seconds timeout = 60s) {
+    std::vector<std::string> args{client_binary(), address_, "knot", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    testing::ChildProcess client;
+    if (!client.start(args, (*dir_ / "client.log").string())) return -1;
+    return client.wait(timeout).value_or(-1);
+  }
+
+  std::string path(const std::string& name) const { return (*dir_ / name).string(); }
+
+  RgbaImage read_or_fail(const std::string& file) {
+    auto image = read_png(file);
+    EXPECT_TRUE(image.has_value()) << (image ? "" : image.error().message);
+    if (!image) return {};
+    testing::keep_for_inspection(*image, "e2e_" + fs::path(file).stem().string());
+    return *image;
+  }
+
+  std::string client_log() const {
+    std::ifstream in(*dir_ / "client.log");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+  static fs::path* dir_;
+  std::string address_;
+};
+
+fs::path* ClientEndToEnd::dir_ = nullptr;
+
+TEST_F(ClientEndToEnd, SnapshotsShowTheModelRefiningAndWhatAsaDoes) {
+  testing::ChildProcess server;
+  address_ = start_server(server, {});
+  ASSERT_FALSE(address_.empty()) << "server did not start";
+  const std::vector<std::string> size{"--width", "320", "--height", "240"};
+  auto with = [&](std::vector<std::string> a) {
+    a.insert(a.end(), size.begin(), size.end());
+    return a;
+  };
+  ASSERT_EQ(run_client(with({"--snapshot", path("early.png"), "--snapshot-at", "0"})), 0)
+      << client_log();
+  ASSERT_EQ(run_client(with({"--snapshot", path("final.png")})), 0) << client_log();
+  ASSERT_EQ(run_client(with({"--snapshot", path("final_no_asa.png"), "--no-asa"})), 0)
+      << client_log();
+  ASSERT_EQ(run_client(with({"--snapshot", path("early_no_asa.png"), "--snapshot-at", "0",
+                             "--no-asa"})), 0)
+      << client_log();
+
+  RgbaImage early = read_or_fail(path("early.png"));
+  RgbaImage final = read_or_fail(path("final.png"));
+  RgbaImage final_no_asa = read_or_fail(path("final_no_asa.png"));
+  RgbaImage early_no_asa = read_or_fail(path("early_no_asa.png"));
+  for (const RgbaImage* image : {&early, &final, &final_no_asa, &early_no_asa}) {
+    ASSERT_EQ(image->width, 320);
+    ASSERT_EQ(image->height, 240);
+    auto c = testing::foreground_coverage(*image);
+    EXPECT_GT(c.foreground, 320u * 240u / 10);  // not blank
+    EXPECT_GT(c.min_x, 0);                      // framed: nothing cut off
+    EXPECT_GT(c.min_y, 0);
+    EXPECT_LT(c.max_x, 319);
+    EXPECT_LT(c.max_y, 239);
+  }
+  EXPECT_GT(testing::differing_pixels(early, final), 320u * 240u / 100)
+      << "the base mesh and the final mesh look the same";
+  EXPECT_GT(testing::differing_pixels(early, early_no_asa), 320u * 240u / 200)
+      << "ASA did not change the coarse mesh's picture";
+}
+
+TEST_F(ClientEndToEnd, WindowFollowsAThrottledStreamUnderXvfb) {
+  if (testing::XvfbDisplay::find_xvfb().empty()) {
+    GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb): window test skipped";
+  }
+  testing::XvfbDisplay xvfb;
+  std::string display = xvfb.start();
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  testing::ChildProcess server;
+  address_ = start_server(server, {"--rate", "200000"});
+  ASSERT_FALSE(address_.empty()) << "server did not start";
+  const char* old = std::getenv("DISPLAY");
+  std::string saved = old ? old : "";
+  ::setenv("DISPLAY", display.c_str(), 1);
+  int code = run_client({"--view", "--exit-after", "45", "--width", "400", "--height", "300"});
+  if (old) ::setenv("DISPLAY", saved.c_str(), 1); else ::unsetenv("DISPLAY");
+  EXPECT_EQ(code, 0) << client_log();
+}
+
+}  // namespace
+}  // namespace meshstream::client
