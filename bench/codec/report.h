@@ -135,8 +135,10 @@ inline void write_markdown(const std::filesystem::path& path,
      << "imports, cleaned by `import_mesh` (so Draco and ours code the very same mesh), "
      << "positions quantized to " << s.quant_bits << " bits by both. Draco runs in-process "
      << "(`draco::ExpertEncoder`, edgebreaker, speed = 10 - level, positions only). Throughput "
-     << "figures are medians of " << s.decode_runs << " decodes and " << s.encode_runs
-     << " encodes, one thread, on a shared 2-core machine; bits per vertex (bpv) count the "
+     << "figures are medians of " << s.decode_runs << " decodes (Draco's and ours "
+     << "interleaved run by run) and " << s.encode_runs
+     << " encodes, in the thread's CPU time (one thread; the 2-core machine is shared, so "
+     << "wall time would count other people's builds); bits per vertex (bpv) count the "
      << "whole file over the cleaned mesh's vertices.\n\n";
 
   // Sizes.
