@@ -101,7 +101,7 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
 // The decoder's prediction of a vertex inserted into `ring`: the rounded
 // average of the ring's positions. Exact integers.
 Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
-// How a residual is modelled: `scale` (twice log2 of the ring's mean edge
+// How a residual is modelled: `scale` (log2 of the ring's mean L1 edge
 // length on the grid) picks the model set; the axes are taken in order of
 // the ring normal's components, largest first (role 0 is the axis closest to
 // the normal: its residual is the curvature offset, the other two are
