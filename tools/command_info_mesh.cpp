@@ -49,6 +49,7 @@ nlohmann::json report_json(const CleanReport& r) {
           {"split_vertices", r.split_vertices},
           {"detached_faces", r.detached_faces},
           {"flipped_faces", r.flipped_faces},
+          {"double_sided_flaps", r.double_sided_flaps},
           {"changed", r.changed()},
           {"notes", r.notes}};
 }
@@ -131,6 +132,7 @@ int run_info_mesh(const std::string& path, bool json) {
   line(r.split_vertices, "split vertices");
   line(r.detached_faces, "detached faces");
   line(r.flipped_faces, "flipped faces");
+  line(r.double_sided_flaps, "flaps dropped");
   for (const std::string& note : r.notes) std::printf("  note: %s\n", note.c_str());
   std::printf("mesh (what encode and subdivide work on):\n");
   print_stats(stats);

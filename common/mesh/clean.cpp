@@ -127,8 +127,9 @@ uint32_t drop_degenerate(Mesh& mesh) {
 }
 
 // Drops every face whose vertex set equals an earlier face's (either
-// orientation); the first one stays.
-uint32_t drop_duplicates(Mesh& mesh) {
+// orientation); the first one stays and is flagged in `had_twin` (aligned
+// with the remaining faces).
+uint32_t drop_duplicates(Mesh& mesh, std::vector<uint8_t>& had_twin) {
   const uint32_t f_count = mesh.face_count();
   std::vector<std::array<uint32_t, 3>> keys(f_count);
   for (uint32_t f = 0; f < f_count; ++f) {
@@ -140,22 +141,52 @@ uint32_t drop_duplicates(Mesh& mesh) {
   std::sort(order.begin(), order.end(), [&keys](uint32_t a, uint32_t b) {
     return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
   });
-  std::vector<uint8_t> duplicate(f_count, 0);
+  std::vector<uint8_t> duplicate(f_count, 0), twin(f_count, 0);
   uint32_t dups = 0;
+  uint32_t first_of_group = 0;
   for (uint32_t k = 1; k < f_count; ++k) {
     if (keys[order[k]] == keys[order[k - 1]]) {
       duplicate[order[k]] = 1;
+      twin[order[first_of_group]] = 1;
       ++dups;
+    } else {
+      first_of_group = k;
     }
   }
+  had_twin.clear();
   if (dups == 0) return 0;
   std::vector<Triangle> kept;
   kept.reserve(f_count - dups);
   for (uint32_t f = 0; f < f_count; ++f) {
-    if (!duplicate[f]) kept.push_back(mesh.triangles[f]);
+    if (duplicate[f]) continue;
+    kept.push_back(mesh.triangles[f]);
+    had_twin.push_back(twin[f]);
   }
   mesh.triangles.swap(kept);
   return dups;
+}
+
+// After repair: a face that had a duplicate (nearly always its reverse: a
+// double-sided triangle, as in the VRIP dragons) and now shares no edge with
+// any other face was a flap hanging off the surface at non-manifold edges.
+// It adds nothing to the surface and would be a component of its own for
+// the codec: drop it. Returns the number of faces dropped.
+uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin) {
+  if (had_twin.size() != mesh.triangles.size()) return 0;
+  const EdgeGroups groups = build_edge_groups(mesh);
+  std::vector<uint8_t> shared_edges(mesh.face_count(), 0);
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) < 2) continue;
+    for (uint32_t k = groups.begin[e]; k < groups.begin[e + 1]; ++k) shared_edges[groups.uses[k].face] = 1;
+  }
+  std::vector<Triangle> kept;
+  kept.reserve(mesh.triangles.size());
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    if (!had_twin[f] || shared_edges[f]) kept.push_back(mesh.triangles[f]);
+  }
+  const uint32_t dropped = mesh.face_count() - static_cast<uint32_t>(kept.size());
+  mesh.triangles.swap(kept);
+  return dropped;
 }
 
 uint32_t drop_unreferenced(Mesh& mesh) {
@@ -178,7 +209,7 @@ uint32_t drop_unreferenced(Mesh& mesh) {
 
 bool CleanReport::changed() const {
   return welded_vertices || degenerate_faces || duplicate_faces || unreferenced_vertices ||
-         split_vertices || detached_faces || flipped_faces || !notes.empty();
+         split_vertices || detached_faces || flipped_faces || double_sided_flaps || !notes.empty();
 }
 
 Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
@@ -212,7 +243,8 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
 
   if (options.weld) report.welded_vertices = weld(mesh, report.notes);
   report.degenerate_faces = drop_degenerate(mesh);
-  if (options.drop_duplicate_faces) report.duplicate_faces = drop_duplicates(mesh);
+  std::vector<uint8_t> had_twin;
+  if (options.drop_duplicate_faces) report.duplicate_faces = drop_duplicates(mesh, had_twin);
   report.unreferenced_vertices = drop_unreferenced(mesh);
   if (mesh.triangles.empty()) {
     if (report.faces_in_file == 0) {
@@ -240,6 +272,13 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
   report.split_vertices = repaired->split_vertices;
   report.detached_faces = repaired->detached_faces;
   report.flipped_faces = repaired->flipped_faces;
+  if (options.drop_double_sided_flaps) {
+    report.double_sided_flaps = drop_isolated_twins(mesh, had_twin);
+    if (report.double_sided_flaps > 0) report.unreferenced_vertices += drop_unreferenced(mesh);
+    if (mesh.triangles.empty()) {
+      return make_error(ErrorCode::kInvalidMesh, "no usable triangle: every face is a double-sided flap");
+    }
+  }
   return report;
 }
 

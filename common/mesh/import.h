@@ -28,6 +28,11 @@ struct CleanReport {
   uint32_t split_vertices = 0;         // copies added by the non-manifold repair
   uint32_t detached_faces = 0;         // faces given their own copies of an edge's vertices
   uint32_t flipped_faces = 0;          // re-oriented to make orientation consistent
+  // Dropped after repair: the kept copy of a duplicated face (nearly always a
+  // face and its reverse: a double-sided triangle) that repair had to cut
+  // loose on every edge — a flap, not part of the surface. Their now unused
+  // vertices are counted in unreferenced_vertices.
+  uint32_t double_sided_flaps = 0;
   // Everything else worth telling, e.g. "normals dropped: they differ
   // between corners of one vertex (per-face normals)".
   std::vector<std::string> notes;
@@ -48,6 +53,10 @@ struct ImportOptions {
   // dropping degenerate/unreferenced parts; non-manifold edges and vertices
   // are counted in the report but neither repaired nor refused.
   bool keep_nonmanifold = false;
+  // After repair, drop flaps left by double-sided triangles (see
+  // CleanReport::double_sided_flaps) instead of keeping each as a separate
+  // one-triangle component.
+  bool drop_double_sided_flaps = true;
 };
 
 struct ImportedMesh {
@@ -64,7 +73,8 @@ struct ImportedMesh {
 // kept); drop unreferenced vertices; then, unless the mesh already is one,
 // make it a consistently oriented manifold (manifold_repair.h: faces are never
 // dropped — vertices are split, faces that cannot stay on an edge are
-// detached, faces are flipped). Vertex order is the file's, minus what was
+// detached, faces are flipped); finally drop double-sided flaps the repair
+// cut loose (option drop_double_sided_flaps). Vertex order is the file's, minus what was
 // dropped, plus repair copies appended at the end. Cost: O(V log V + F log F)
 // plus parsing; about 0.25 s for the 200k-triangle dragon_res2.ply.
 Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& options = {});

@@ -239,5 +239,32 @@ TEST(ImportErrors, WrapIsSplitIntoItsTwoSheets) {
   EXPECT_EQ(stats.boundary_edges, 8u);  // as in the file: no new cut
 }
 
+TEST(ImportErrors, DoubleSidedFlapIsDroppedNotKeptAsAPiece) {
+  // A closed tetrahedron plus a double-sided triangle (a face and its
+  // reverse) hanging off its edge (1, 2): the duplicate goes, the remaining
+  // copy is cut loose by the repair and then dropped as a flap.
+  const std::string tetra =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\n"
+      "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+  TempFile file("flap.obj", tetra + "f 1 2 5\nf 2 1 5\n");
+  auto imported = import_mesh(file.path());
+  ASSERT_TRUE(imported) << imported.error().message;
+  EXPECT_EQ(imported->report.duplicate_faces, 1u);
+  EXPECT_EQ(imported->report.double_sided_flaps, 1u);
+  EXPECT_EQ(imported->mesh.face_count(), 4u);
+  EXPECT_EQ(imported->mesh.vertex_count(), 4u);
+  const MeshStats stats = compute_stats(imported->mesh);
+  EXPECT_EQ(stats.components, 1u);
+  EXPECT_EQ(stats.boundary_edges, 0u);
+  // With the option off the flap stays, as its own component.
+  ImportOptions keep;
+  keep.drop_double_sided_flaps = false;
+  auto kept = import_mesh(file.path(), keep);
+  ASSERT_TRUE(kept) << kept.error().message;
+  EXPECT_EQ(kept->mesh.face_count(), 5u);
+  EXPECT_EQ(compute_stats(kept->mesh).components, 2u);
+  EXPECT_TRUE(Adjacency::build(kept->mesh));
+}
+
 }  // namespace
 }  // namespace meshstream
