@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "client/display_frame.h"
@@ -14,29 +15,42 @@ class FrameHistory {
  public:
   explicit FrameHistory(size_t capacity = 24) : capacity_(capacity < 4 ? 4 : capacity) {}
 
-  // Appends; when full, drops every second frame of the older ones (the
-  // first and the newest always stay), so the kept frames stay spread over
-  // the whole stream. O(capacity) when thinning, O(1) otherwise.
+  // Appends. Keeps the frames whose arrival number is a multiple of a stride,
+  // plus the newest; when more than `capacity` are kept the stride doubles,
+  // so the kept frames stay evenly spread over the whole stream (the first
+  // frame always stays). Amortized O(1); O(capacity) when the stride doubles.
   void add(const DisplayFrame& frame) {
-    frames_.push_back(frame);
-    if (frames_.size() <= capacity_) return;
-    std::vector<DisplayFrame> kept;
-    kept.reserve(capacity_);
-    for (size_t i = 0; i + 1 < frames_.size(); ++i) {
-      if (i % 2 == 0) kept.push_back(std::move(frames_[i]));
+    uint64_t ordinal = received_++;
+    // The previous newest stays only if it is on the stride.
+    if (!entries_.empty() && entries_.back().ordinal % stride_ != 0) entries_.pop_back();
+    entries_.push_back({ordinal, frame});
+    while (entries_.size() > capacity_) {
+      stride_ *= 2;
+      std::vector<Entry> kept;
+      kept.reserve(capacity_);
+      for (size_t i = 0; i < entries_.size(); ++i) {
+        if (entries_[i].ordinal % stride_ == 0 || i + 1 == entries_.size()) {
+          kept.push_back(std::move(entries_[i]));
+        }
+      }
+      entries_ = std::move(kept);
     }
-    kept.push_back(std::move(frames_.back()));
-    frames_ = std::move(kept);
   }
 
-  size_t size() const { return frames_.size(); }
-  bool empty() const { return frames_.empty(); }
-  const DisplayFrame& operator[](size_t i) const { return frames_[i]; }
-  const DisplayFrame& newest() const { return frames_.back(); }
+  size_t size() const { return entries_.size(); }
+  bool empty() const { return entries_.empty(); }
+  const DisplayFrame& operator[](size_t i) const { return entries_[i].frame; }
+  const DisplayFrame& newest() const { return entries_.back().frame; }
 
  private:
+  struct Entry {
+    uint64_t ordinal;
+    DisplayFrame frame;
+  };
   size_t capacity_;
-  std::vector<DisplayFrame> frames_;
+  uint64_t received_ = 0;
+  uint64_t stride_ = 1;
+  std::vector<Entry> entries_;
 };
 
 }  // namespace meshstream::client

@@ -133,7 +133,11 @@ void MeshRenderer::release() {
 void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind) {
   vertex_count_ = mesh.vertex_count();
   triangle_count_ = mesh.face_count();
-  std::vector<Vec3f> normals = compute_vertex_normals(mesh);
+  // Normals the mesh brings are used as they are (no O(V + F) pass on the
+  // render thread); otherwise area-weighted ones are computed here.
+  std::vector<Vec3f> computed;
+  if (mesh.normals.size() != mesh.positions.size()) computed = compute_vertex_normals(mesh);
+  const std::vector<Vec3f>& normals = computed.empty() ? mesh.normals : computed;
   auto send = [&](GLenum target, GLuint buffer, size_t bytes, const void* data) {
     gl_.BindBuffer(target, buffer);
     gl_.BufferData(target, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);

@@ -48,8 +48,9 @@ class MeshRenderer {
   MeshRenderer& operator=(const MeshRenderer&) = delete;
   ~MeshRenderer();  // frees the GL objects (context must be current)
 
-  // Replaces the drawn mesh: computes area-weighted vertex normals and sends
-  // positions, normals and indices to the GPU (O(V + F), one copy each).
+  // Replaces the drawn mesh: sends positions, normals (the mesh's own when it
+  // has one per vertex, else area-weighted ones computed here) and indices to
+  // the GPU (O(V + F), one copy each).
   // `face_kind` (may be null or of the wrong size: then every face shows as
   // untouched) labels each face. Distances are reset to zero. Precondition:
   // indices in range (validate untrusted meshes first).
