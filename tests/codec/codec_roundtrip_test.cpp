@@ -1,5 +1,6 @@
 // Exact round trips, valid prefixes, incremental feeding and budgets on
 // procedural meshes (real meshes: real_mesh_test.cpp).
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -112,6 +113,48 @@ TEST_P(ProceduralRoundTrip, ByteByByteFeedingEqualsOneFeed) {
   EXPECT_EQ(applied, dec.index()->records.size());
   EXPECT_EQ(dec.mesh().positions, whole->positions);
   EXPECT_EQ(dec.mesh().triangles, whole->triangles);
+}
+
+// The delta of each record names every face that changed and every vertex
+// that was added, so a post-processor can redo only that region.
+TEST_P(ProceduralRoundTrip, DeltasCoverEveryChange) {
+  Case c = procedural_cases()[GetParam()];
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 100;
+  auto bytes = encode_hcs(c.mesh, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  IncrementalDecoder dec;
+  uint64_t fed = 0;
+  Mesh before;
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const uint64_t end = index->records[i].offset + index->records[i].size;
+    ASSERT_TRUE(dec.feed(std::span<const uint8_t>(bytes->data() + fed, end - fed)));
+    fed = end;
+    ASSERT_EQ(dec.last_deltas().size(), 1u);
+    const RecordDelta& d = dec.last_deltas()[0];
+    EXPECT_EQ(d.record, i);
+    const Mesh& after = dec.mesh();
+    if (i == 0) {
+      EXPECT_TRUE(d.full_rebuild);
+    } else {
+      EXPECT_FALSE(d.full_rebuild);
+      std::vector<uint32_t> touched = d.touched_faces;
+      std::sort(touched.begin(), touched.end());
+      for (uint32_t f = 0; f < after.face_count(); ++f) {
+        const bool changed = f >= before.face_count() || before.triangles[f] != after.triangles[f];
+        if (changed) EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), f)) << "face " << f;
+      }
+      for (uint32_t f : touched) EXPECT_LT(f, after.face_count());
+      ASSERT_EQ(d.added_vertices.size(), after.vertex_count() - before.vertex_count());
+      for (size_t j = 0; j < d.added_vertices.size(); ++j)
+        EXPECT_EQ(d.added_vertices[j], before.vertex_count() + j);
+      for (uint32_t v = 0; v < before.vertex_count(); ++v) EXPECT_EQ(before.positions[v], after.positions[v]);
+    }
+    before = after;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, ProceduralRoundTrip, ::testing::Range(0, 6));
