@@ -91,10 +91,12 @@ struct IncrementalDecoder::State {
       auto state = RefinementState::from_base(base->positions, base->faces, h.quant_bits);
       if (!state) return where(state.error());
       refine = std::move(*state);
-      // The header's totals are checked against the index; cap what a
-      // hostile header can make us reserve.
-      const uint32_t cap = 1u << 26;
-      const uint32_t nv = std::min(h.vertex_count, cap), nf = std::min(h.face_count, cap);
+      // Reserve for the final size, but never more than the stream's bytes
+      // could describe (every inserted vertex costs well over a bit), so a
+      // hostile header cannot make us allocate gigabytes.
+      const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * index->total_bytes();
+      const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
+      const uint32_t nf = static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
       refine->mesh.reserve(nv, nf);
       refine->order_next.reserve(nv);
       refine->created_layer.reserve(nv);
