@@ -39,38 +39,40 @@
 
 namespace meshstream::asa {
 
-void ButterflyWeights::configure(float tension, uint32_t max_valence) {
+void ButterflyWeights::configure(float tension) {
   tension_ = tension;
-  max_valence_ = 0;
   table_.clear();
   offset_.clear();
-  ensure(max_valence);
 }
 
-void ButterflyWeights::ensure(uint32_t max_valence) {
-  if (max_valence < 6) max_valence = 6;
-  if (max_valence <= max_valence_ && !offset_.empty()) return;
-  offset_.resize(max_valence + 1, 0);
-  for (uint32_t K = max_valence_ + 1; K <= max_valence; ++K) {
-    offset_[K] = static_cast<uint32_t>(table_.size());
-    if (K < 3) continue;
-    std::vector<double> s(K + 1, 0.0);
-    if (K == 3) {
-      s = {5.0 / 12, -1.0 / 12, -1.0 / 12, 3.0 / 4};
-    } else if (K == 4) {
-      s = {3.0 / 8, 0.0, -1.0 / 8, 0.0, 3.0 / 4};
-    } else {
-      double sum = 0;
-      for (uint32_t j = 0; j < K; ++j) {
-        double x = 2.0 * std::numbers::pi * j / K;
-        s[j] = (0.25 + std::cos(x) + 0.5 * std::cos(2.0 * x)) / K;
-        sum += s[j];
-      }
-      s[K] = 1.0 - sum;  // 3/4 up to rounding, as OpenMesh does
-    }
-    for (double w : s) table_.push_back(static_cast<float>(w));
+void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vertex_features,
+                                    uint32_t vertex_count) {
+  for (uint32_t v = 0; v < vertex_count; ++v) {
+    const uint32_t K = valence[v];
+    if (vertex_features[v] == 0 && K >= 3 && K != 6 && (K >= offset_.size() || offset_[K] == kNone)) add(K);
   }
-  max_valence_ = max_valence;
+}
+
+void ButterflyWeights::add(uint32_t K) {
+  if (K < 3) return;
+  if (K >= offset_.size()) offset_.resize(K + 1, kNone);
+  if (offset_[K] != kNone) return;
+  offset_[K] = static_cast<uint32_t>(table_.size());
+  std::vector<double> s(K + 1, 0.0);
+  if (K == 3) {
+    s = {5.0 / 12, -1.0 / 12, -1.0 / 12, 3.0 / 4};
+  } else if (K == 4) {
+    s = {3.0 / 8, 0.0, -1.0 / 8, 0.0, 3.0 / 4};
+  } else {
+    double sum = 0;
+    for (uint32_t j = 0; j < K; ++j) {
+      double x = 2.0 * std::numbers::pi * j / K;
+      s[j] = (0.25 + std::cos(x) + 0.5 * std::cos(2.0 * x)) / K;
+      sum += s[j];
+    }
+    s[K] = 1.0 - sum;  // 3/4 up to rounding, as OpenMesh does
+  }
+  for (double w : s) table_.push_back(static_cast<float>(w));
 }
 
 uint32_t other_feature_neighbor_at_next(const LevelView& m, uint32_t c) {

@@ -13,23 +13,26 @@
 namespace meshstream::asa {
 
 // Precomputed weights: tension omega for the ten-point stencil and the
-// extraordinary-vertex weights s_j for every valence K up to max_valence.
+// extraordinary-vertex weights s_j for the valences that occur. Only valences
+// present are tabulated (K + 1 floats each), so a fan with a huge valence
+// costs O(K), not O(K^2).
 class ButterflyWeights {
  public:
-  // O(max_valence^2) once; grows on demand through ensure().
-  void configure(float tension, uint32_t max_valence);
-  void ensure(uint32_t max_valence);
+  void configure(float tension);
+  // Adds the weights of every interior (feature-free) vertex's valence.
+  // O(V) plus O(K) per new valence.
+  void add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t vertex_count);
+  void add(uint32_t K);
 
   float tension() const { return tension_; }
-  // s_0 .. s_{K-1} for valence K (K >= 3), then the centre weight at [K].
+  // s_0 .. s_{K-1} for valence K (K >= 3, added before), then the centre
+  // weight at [K].
   const float* extraordinary(uint32_t K) const { return table_.data() + offset_[K]; }
-  uint32_t max_valence() const { return max_valence_; }
 
  private:
   float tension_ = 0;
-  uint32_t max_valence_ = 0;
   std::vector<float> table_;
-  std::vector<uint32_t> offset_;
+  std::vector<uint32_t> offset_;  // per valence, kNone when absent
 };
 
 enum class EdgePlacement {
@@ -41,8 +44,8 @@ enum class EdgePlacement {
 // independent of corner numbering: both sides of an edge give the same bits
 // (the stencil is always walked from intrinsic starting points and summed in
 // symmetric pairs), so patches computed at different times agree.
-// Preconditions: c < 3 * face_count, weights.max_valence() >= every valence
-// of a non-feature vertex. O(1) for regular edges, O(K) otherwise.
+// Preconditions: c < 3 * face_count, the weights hold every valence of a
+// non-feature vertex. O(1) for regular edges, O(K) otherwise.
 Vec3f butterfly_point(const LevelView& mesh, uint32_t c, const ButterflyWeights& weights,
                       EdgePlacement placement);
 

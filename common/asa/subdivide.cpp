@@ -89,10 +89,11 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   view.feature_edge = base.feature_edge.data();
   asa::count_vertex_features(view, base.vertex_features);
   view.vertex_features = base.vertex_features.data();
-  uint32_t max_faces = asa::count_vertex_faces(view, base.valence);
+  asa::count_vertex_faces(view, base.valence);
   view.valence = base.valence.data();
   view.green = nullptr;
-  ws.weights.configure(options.tension, max_faces);
+  ws.weights.configure(options.tension);
+  ws.weights.add_valences(base.valence.data(), base.vertex_features.data(), V);
 
   const Vec4f* colors = mesh.colors.empty() ? nullptr : mesh.colors.data();
   const Vec2f* texcoords = mesh.texcoords.empty() ? nullptr : mesh.texcoords.data();
@@ -106,7 +107,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     for (uint32_t f = 0; f < F; ++f) ws.identity[f] = f;
     source = ws.identity.data();
   }
-  if (options.levels == 0) {
+  if (options.levels == 0 || F == 0) {
     result.mesh = mesh;
     result.face_kind.assign(F, FaceKind::kUntouched);
     if (options.track_source_faces) result.source_face = ws.identity;
@@ -140,11 +141,11 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     }
     if (!last) {
       if (!options.uniform) {
-        max_faces = std::max(max_faces, [&] {
-          asa::LevelView counted = out.view();
-          return asa::count_vertex_faces(counted, out.valence);
-        }());
-        ws.weights.ensure(max_faces);
+        // Bisections change valences: recount and add any new ones.
+        asa::LevelView counted = out.view();
+        asa::count_vertex_faces(counted, out.valence);
+        ws.weights.add_valences(out.valence.data(), out.vertex_features.data(),
+                                static_cast<uint32_t>(out.valence.size()));
       }
       view = out.view();
       if (source) source = out.source.data();

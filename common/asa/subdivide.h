@@ -1,6 +1,36 @@
 // ASA: adaptive modified-Butterfly subdivision driven by local flatness
 // (Cheang 1998; stencils of Zorin, Schröder and Sweldens 1996). See
 // ../shared/ALGORITHMS.md sections 2 and 3.
+//
+// The module, one job per file:
+//   butterfly_stencils  every Butterfly rule (regular ten-point with tension,
+//                       K = 3, 4, >= 5, both-extraordinary average, boundary
+//                       four-point, boundary-touching interior edges exactly as
+//                       OpenMesh's ModifiedButterFlyT, creases, projection);
+//                       the rules themselves are inline in butterfly_rules.h
+//   flatness            face normals, crease tagging, flatness targets
+//   closure             conforming closure with red-green rules (worklist)
+//   split_uniform       1-to-4 split of every face, child corner table by
+//                       index arithmetic
+//   split_adaptive      keep / bisect / 1-to-4 / re-split a green pair's parent
+//   corner_table        fast opposite-corner builder for the input
+//   subdivide           levels, attributes, buffers (this header)
+//   incremental         redo only the region a change touched (incremental.h)
+//
+// Output order: the input's vertices first (same index, bit-identical
+// position), then one new vertex per split edge, level by level. Faces:
+// each input face's descendants are contiguous, in input face order.
+// Attributes: colours and texture coordinates of a new vertex are the
+// average of its edge's endpoints (linear: colours stay in range, texture
+// coordinates stay on their chart); normals, when the input has them, are
+// recomputed (area-weighted) on the output.
+// Creases (crease_degrees > 0): edges bending more than the angle at level 0
+// are tagged; their halves stay tagged at every level. They get the curve
+// four-point rule; a vertex with other than two crease/boundary edges is a
+// corner (the curve is extended past it by reflection); no interior stencil
+// reaches across a crease (wings across it are reflected, crease vertices are
+// never extraordinary centres). In ASA mode crease edges do not mark their
+// faces as targets: they are sharp on purpose.
 #pragma once
 
 #include <cstdint>

@@ -32,7 +32,9 @@ struct Level {
     mesh.positions = lm.positions;
     mesh.triangles = lm.triangles;
     LevelView v = lm.view();
-    weights.configure(0, count_vertex_faces(v, lm.valence));
+    count_vertex_faces(v, lm.valence);
+    weights.configure(0);
+    weights.add_valences(lm.valence.data(), lm.vertex_features.data(), static_cast<uint32_t>(lm.valence.size()));
   }
   void finish() {
     std::vector<Vec3f> normals;
@@ -41,7 +43,9 @@ struct Level {
     tag_feature_edges(v, 0, normals, lm.feature_edge);
     v = lm.view();
     count_vertex_features(v, lm.vertex_features);
-    weights.configure(0, count_vertex_faces(v, lm.valence));
+    count_vertex_faces(v, lm.valence);
+    weights.configure(0);
+    weights.add_valences(lm.valence.data(), lm.vertex_features.data(), static_cast<uint32_t>(lm.valence.size()));
   }
   // Splits with the given closure; returns the next level.
   LevelMesh split(const ClosureBuffers& closure) {

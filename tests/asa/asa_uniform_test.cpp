@@ -197,3 +197,53 @@ TEST(AsaUniform, WorkspaceReuseGivesSameResult) {
 
 }  // namespace
 }  // namespace meshstream
+
+namespace meshstream {
+namespace {
+
+TEST(AsaEdgeCases, EmptyMeshAndIsolatedVertices) {
+  Mesh empty;
+  auto r = subdivide(empty, AsaOptions{});
+  ASSERT_TRUE(r.has_value());
+  EXPECT_TRUE(r->mesh.empty());
+  Mesh points;
+  points.positions = {{0, 0, 0}, {1, 0, 0}};
+  r = subdivide(points, AsaOptions{});
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->mesh.vertex_count(), 2u);
+  // An isolated vertex next to a real mesh stays where it is.
+  Mesh m = asa_test::octahedron();
+  m.positions.push_back({5, 5, 5});
+  AsaOptions o;
+  o.uniform = true;
+  r = subdivide(m, o);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_TRUE(asa_test::conforming(m, *r));
+}
+
+// A double cone whose two apexes have valence 3000: weights are tabulated
+// per valence present (O(K)), and the stencils stay finite.
+TEST(AsaEdgeCases, HugeValence) {
+  const uint32_t n = 3000;
+  Mesh m;
+  m.positions.push_back({0, 0, 1});
+  m.positions.push_back({0, 0, -1});
+  for (uint32_t i = 0; i < n; ++i) {
+    const float a = 2.0f * 3.14159265f * i / n;
+    m.positions.push_back({std::cos(a), std::sin(a), 0});
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t a = 2 + i, b = 2 + (i + 1) % n;
+    m.triangles.push_back({0, a, b});
+    m.triangles.push_back({1, b, a});
+  }
+  AsaOptions o;
+  o.uniform = true;
+  o.levels = 2;
+  auto r = subdivide(m, o);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_TRUE(asa_test::conforming(m, *r));
+}
+
+}  // namespace
+}  // namespace meshstream
