@@ -87,6 +87,13 @@ std::vector<uint8_t> measure_ours(const Mesh& mesh, const Settings& s, MeshMeasu
   }
   m.ours_records = static_cast<uint32_t>(index->records.size());
   m.ours_base_bytes = index->records.empty() ? 0 : index->records[0].offset + index->records[0].size;
+  DecodeBudget ratio20;
+  ratio20.kind = DecodeBudget::Kind::kRatio;
+  ratio20.value = 20;
+  m.ours_bytes_at_ratio20 = prefix_for_budget(*index, ratio20);
+  for (const RecordEntry& r : index->records) {
+    if (r.offset + r.size <= m.ours_bytes_at_ratio20) m.ours_vertices_at_ratio20 = r.vertices;
+  }
   auto decoded = decode_hcs(*stream);
   if (!decoded) {
     m.ours_error = "decode_hcs: " + decoded.error().message;

@@ -46,6 +46,8 @@ struct MeshMeasurements {
   uint64_t ours_base_bytes = 0;
   double ours_encode_vps = 0, ours_decode_vps = 0;
   bool ours_counts_match = false;  // full decode has the input's vertex and face counts
+  uint32_t ours_vertices_at_ratio20 = 0;  // in the prefix of 1/20 of the stream (HCS's ratio 20)
+  uint64_t ours_bytes_at_ratio20 = 0;
 
   std::vector<RdPoint> ours_curve;
   std::vector<RdPoint> chain_curve;
