@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
-#include "client/incremental_asa.h"
+#include "common/asa/incremental.h"
 
 namespace meshstream::client {
 
@@ -11,16 +11,22 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+bool same_options(const AsaOptions& a, const AsaOptions& b) {
+  return a.levels == b.levels && a.flatness == b.flatness && a.uniform == b.uniform && a.rule == b.rule &&
+         a.tension == b.tension && a.crease_degrees == b.crease_degrees;
+}
 }  // namespace
 
 struct DisplayBuilder::State {
-  AsaWorkspace workspace;
-  AsaWorkspace region_workspace;
-  IncrementalAsa incremental;
-  // Auto path: the region size (as a fraction of the mesh's faces) up to
-  // which the incremental path is tried; adapted from measurements.
-  double region_fraction = 0.5;
-  double full_ms_per_face = 0;  // last full run (subdivide + adopt), per decoded face
+  AsaWorkspace workspace;  // full path
+  // Incremental path (common/asa/incremental.h): keeps the previous input
+  // and result, recomputes the region around what changed, and falls back to
+  // a full run itself when more than `dirty_fraction` of the mesh changed.
+  std::unique_ptr<IncrementalSubdivider> incremental;
+  AsaOptions incremental_options;
+  float dirty_fraction = 0.25f;
+  double full_ms_per_face = 0;  // measured on the last full run
 };
 
 DisplayBuilder::DisplayBuilder() : state_(std::make_unique<State>()) {}
@@ -32,6 +38,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
                                           const MeshChanges& changes, bool asa_enabled,
                                           const AsaOptions& options, bool options_changed,
                                           BuildReport& report) {
+  (void)changes;  // the incremental subdivider finds the changes itself, by index
   report = {};
   State& s = *state_;
   if (!asa_enabled || options.levels == 0) {
@@ -40,49 +47,48 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   }
   const Mesh& mesh = *decoded_shared;
   const uint32_t F = mesh.face_count();
-  const bool can_increment = path_ != AsaPath::kFull && IncrementalAsa::supports(options);
   const auto start = Clock::now();
 
-  if (can_increment && s.incremental.ready() && !options_changed && !changes.full) {
-    const uint32_t limit = path_ == AsaPath::kIncremental
-                               ? UINT32_MAX - 1
-                               : static_cast<uint32_t>(s.region_fraction * double(F));
-    const uint32_t region = s.incremental.plan(mesh, changes, limit);
-    if (region != UINT32_MAX && s.incremental.update(mesh, options, s.region_workspace)) {
-      auto display = std::make_shared<Mesh>();
-      auto kinds = std::make_shared<std::vector<FaceKind>>();
-      s.incremental.assemble(mesh, *display, *kinds);
-      report.asa_ms = ms_since(start);
-      report.incremental = true;
-      report.region_faces = s.incremental.last_region_faces;
-      // Adapt: if this cost more than a full run would have, try smaller regions.
-      if (s.full_ms_per_face > 0) {
-        const double full_estimate = s.full_ms_per_face * double(F);
-        const double used = double(s.incremental.last_submesh_faces) / std::max(1.0, double(F));
-        if (report.asa_ms > full_estimate) {
-          s.region_fraction = std::max(0.02, std::min(s.region_fraction, used) * 0.8);
-        } else {
-          s.region_fraction = std::min(0.9, s.region_fraction * 1.05);
-        }
-      }
-      return DisplayMesh{std::move(display), std::move(kinds)};
-    }
-    // Too large, or not mergeable: recompute everything below.
+  if (path_ == AsaPath::kFull) {
+    s.incremental.reset();
+    AsaResult result;
+    if (auto st = subdivide_into(mesh, options, s.workspace, result); !st) return tl::unexpected(st.error());
+    report.asa_ms = ms_since(start);
+    DisplayMesh out;
+    out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
+    out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
+    return out;
   }
 
-  AsaResult result;
-  if (auto st = subdivide_into(mesh, options, s.workspace, result); !st) return tl::unexpected(st.error());
-  if (can_increment) {
-    if (!s.incremental.adopt(mesh, options, result)) s.incremental.reset();
-  } else {
-    s.incremental.reset();
+  if (!s.incremental || options_changed || !same_options(options, s.incremental_options)) {
+    IncrementalOptions io;
+    // Forced incremental: region updates unless the subdivider cannot prove
+    // the seam; auto: its default threshold, lowered when measured slower.
+    io.max_dirty_fraction = path_ == AsaPath::kIncremental ? 1.0f : s.dirty_fraction;
+    s.incremental = std::make_unique<IncrementalSubdivider>(options, io);
+    s.incremental_options = options;
   }
+  if (auto st = s.incremental->update(mesh); !st) return tl::unexpected(st.error());
+  const IncrementalStats& stats = s.incremental->last_update();
+  const AsaResult& result = s.incremental->result();
+  auto display = std::make_shared<const Mesh>(result.mesh);
+  auto kinds = std::make_shared<const std::vector<FaceKind>>(result.face_kind);
   report.asa_ms = ms_since(start);
-  if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
-  DisplayMesh out;
-  out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
-  out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
-  return out;
+  report.incremental = !stats.full;
+  report.region_faces = stats.region_faces;
+  if (stats.full) {
+    if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
+  } else if (path_ == AsaPath::kAuto && s.full_ms_per_face > 0 && F > 0) {
+    // Keep the faster path: when a region update cost more than a full run
+    // would have, make regions of this size go the full way from now on.
+    const double full_estimate = s.full_ms_per_face * double(F);
+    const float dirty = static_cast<float>(double(stats.dirty_faces) / double(F));
+    if (report.asa_ms > full_estimate && dirty < s.dirty_fraction) {
+      s.dirty_fraction = std::max(0.01f, dirty * 0.8f);
+      s.incremental.reset();  // re-created with the new threshold next time
+    }
+  }
+  return DisplayMesh{std::move(display), std::move(kinds)};
 }
 
 }  // namespace meshstream::client

@@ -1,9 +1,9 @@
 // Turns the decoded mesh into the display mesh after each update: ASA
 // (common/asa/subdivide.h) either on the whole mesh, or incrementally on
-// the region the update changed (client/incremental_asa.h), keeping
+// the region the update changed (common/asa/incremental.h), keeping
 // whichever path has been faster for updates of that size. Both paths give
-// the same triangles with the same positions; only the order of vertices
-// and faces may differ.
+// the same triangles with the same positions (same face order); only the
+// numbering of the new vertices may differ.
 #pragma once
 
 #include <cstdint>
