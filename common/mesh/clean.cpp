@@ -267,6 +267,7 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
     if (auto status = check_manifold(mesh); !status) return tl::unexpected(status.error());
     return report;
   }
+  const uint32_t vertices_before_repair = mesh.vertex_count();
   auto repaired = make_manifold(mesh);
   if (!repaired) return tl::unexpected(repaired.error());
   report.split_vertices = repaired->split_vertices;
@@ -274,7 +275,23 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
   report.flipped_faces = repaired->flipped_faces;
   if (options.drop_double_sided_flaps) {
     report.double_sided_flaps = drop_isolated_twins(mesh, had_twin);
-    if (report.double_sided_flaps > 0) report.unreferenced_vertices += drop_unreferenced(mesh);
+    if (report.double_sided_flaps > 0) {
+      // Vertices only the flaps used: repair copies (appended after the
+      // original vertices) were never really added; originals are unreferenced.
+      std::vector<uint8_t> used(mesh.vertex_count(), 0);
+      for (const Triangle& t : mesh.triangles) {
+        for (uint32_t v : t) used[v] = 1;
+      }
+      for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+        if (used[v]) continue;
+        if (v >= vertices_before_repair) {
+          --report.split_vertices;
+        } else {
+          ++report.unreferenced_vertices;
+        }
+      }
+      drop_unreferenced(mesh);
+    }
     if (mesh.triangles.empty()) {
       return make_error(ErrorCode::kInvalidMesh, "no usable triangle: every face is a double-sided flap");
     }

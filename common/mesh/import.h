@@ -30,8 +30,9 @@ struct CleanReport {
   uint32_t flipped_faces = 0;          // re-oriented to make orientation consistent
   // Dropped after repair: the kept copy of a duplicated face (nearly always a
   // face and its reverse: a double-sided triangle) that repair had to cut
-  // loose on every edge — a flap, not part of the surface. Their now unused
-  // vertices are counted in unreferenced_vertices.
+  // loose on every edge — a flap, not part of the surface. Vertex copies made
+  // only for flaps are not counted in split_vertices; original vertices only
+  // flaps used are counted in unreferenced_vertices.
   uint32_t double_sided_flaps = 0;
   // Everything else worth telling, e.g. "normals dropped: they differ
   // between corners of one vertex (per-face normals)".

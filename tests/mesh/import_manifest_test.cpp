@@ -133,7 +133,7 @@ TEST_P(ManifestTest, DefaultImportIsManifoldAndCountsWhatItChanged) {
     EXPECT_EQ(report.split_vertices, 0u);
     EXPECT_EQ(report.detached_faces, 0u);
   } else {
-    EXPECT_GT(report.split_vertices, 0u);
+    EXPECT_GT(report.split_vertices + report.double_sided_flaps, 0u);  // the repair did something
   }
   EXPECT_TRUE(validate_arrays(imported->mesh));
   auto adjacency = Adjacency::build(imported->mesh);
