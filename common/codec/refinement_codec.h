@@ -38,7 +38,7 @@ namespace meshstream {
 inline constexpr int kScaleContexts = 20;
 
 struct RefinementModels {
-  BitTreeModel<2> patch_count[26];   // by count_context; 3 = escape
+  BitTreeModel<2> patch_count[26 * 3];  // by count_context; 3 = escape
   AdaptiveUIntModel patch_count_extra;
   BitTreeModel<4> start_rank[6];     // by min(k - 3, 5); 15 = escape
   AdaptiveUIntModel start_rank_big;
@@ -72,9 +72,11 @@ struct ResolvedPatch {
 
 // Context of the patch count at walk vertex u: its valence (kept up to
 // date by apply_patch, so the decoder swings around u only when it holds
-// patches) and whether the previous walk vertex held patches.
+// patches), whether the previous walk vertex held patches, and u's age in
+// layers (1, 2, 3+).
 inline uint32_t count_context(const RefinementState& s, uint32_t u) {
-  return std::min<uint32_t>(s.valence[u], 12) * 2 + (s.last_count > 0 ? 1 : 0);
+  const uint32_t age = std::min<uint32_t>(s.layer - s.created_layer[u], 3) - 1;
+  return (std::min<uint32_t>(s.valence[u], 12) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age;
 }
 
 // Resolves the patch whose first fan face is star index r and whose vertex
