@@ -1,89 +1,114 @@
+// Corners grouped by vertex: corner k at v contributes the outgoing
+// half-edge v -> to(k) = vertex(next k) and the incoming third(k) -> v, with
+// third(k) = vertex(prev k). The twin of v -> w is the incoming half-edge of
+// the corner at v whose third vertex is w, so matching, validation and the
+// one-fan check all happen inside one vertex's contiguous bucket.
 #include "common/asa/corner_table.h"
 
+#include <algorithm>
 #include <string>
 
 #include "common/asa/level_mesh.h"
 
 namespace meshstream::asa {
+namespace {
+
+struct Entry {
+  uint32_t to, third, corner;
+};
+
+std::string edge_name(uint32_t a, uint32_t b) {
+  return "edge (" + std::to_string(a) + ", " + std::to_string(b) + ")";
+}
+
+}  // namespace
 
 Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, CornerTableScratch& s) {
   const uint32_t V = mesh.vertex_count(), corners = 3 * mesh.face_count();
   const uint32_t* cv = corners ? mesh.triangles.front().data() : nullptr;
-  // Bucket every half-edge (the edge faced by corner c, from vertex(next c)
-  // to vertex(prev c)) under its smaller vertex. Entry: larger vertex in the
-  // high word, corner * 2 + (1 if it runs from larger to smaller) below.
   s.offset.assign(static_cast<size_t>(V) + 1, 0);
-  std::vector<uint32_t>& faces_at = s.faces_at;
-  faces_at.assign(V, 0);
-  for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
-    ++s.offset[(a < b ? a : b) + 1];
-    ++faces_at[cv[c]];
-  }
+  for (uint32_t c = 0; c < corners; ++c) ++s.offset[cv[c] + 1];
   for (uint32_t v = 0; v < V; ++v) s.offset[v + 1] += s.offset[v];
-  s.entries.resize(corners);
+  static_assert(sizeof(Entry) == 12);
+  s.entries.resize((static_cast<size_t>(corners) * sizeof(Entry) + 7) / 8);
+  Entry* entries = reinterpret_cast<Entry*>(s.entries.data());
   s.corners_at.assign(s.offset.begin(), s.offset.end() - 1);  // fill cursor
   for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
-    const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
-    s.entries[s.corners_at[lo]++] = (uint64_t{hi} << 32) | (uint64_t{c} << 1) | (a > b ? 1u : 0u);
+    entries[s.corners_at[cv[c]]++] = {cv[next_corner(c)], cv[prev_corner(c)], c};
   }
   opposite.assign(corners, kNone);
+  std::vector<uint32_t>& match = s.faces_at;  // per bucket entry: successor around v
+  std::vector<uint8_t>& has_pred = s.visited;
   for (uint32_t v = 0; v < V; ++v) {
-    const uint32_t begin = s.offset[v], end = s.offset[v + 1];
-    for (uint32_t i = begin; i < end; ++i) {
-      const uint64_t ei = s.entries[i];
-      const uint32_t hi = static_cast<uint32_t>(ei >> 32);
-      const uint32_t ci = static_cast<uint32_t>(ei & 0xFFFFFFFFu) >> 1;
-      for (uint32_t j = i + 1; j < end; ++j) {
-        const uint64_t ej = s.entries[j];
-        if (static_cast<uint32_t>(ej >> 32) != hi) continue;
-        const uint32_t cj = static_cast<uint32_t>(ej & 0xFFFFFFFFu) >> 1;
-        auto name = [&] { return "edge (" + std::to_string(v) + ", " + std::to_string(hi) + ")"; };
-        if ((ei & 1) == (ej & 1)) {
-          return make_error(ErrorCode::kNonManifold,
-                            name() + " is used twice in the same direction (more than two faces, or "
-                                   "inconsistent orientation) by faces " +
-                                std::to_string(ci / 3) + " and " + std::to_string(cj / 3));
+    Entry* e = entries + s.offset[v];
+    const uint32_t n = s.offset[v + 1] - s.offset[v];
+    if (n == 0) continue;
+    match.assign(n, kNone);
+    has_pred.assign(n, 0);
+    // The twin of v -> e[i].to is third(j) -> v of the entry j with
+    // e[j].third == e[i].to. Large fans are sorted by third first.
+    const bool sorted = n > 32;
+    if (sorted) std::sort(e, e + n, [](const Entry& a, const Entry& b) { return a.third < b.third; });
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint32_t to = e[i].to;
+      uint32_t found = kNone;
+      if (sorted) {
+        const Entry* lo = std::lower_bound(e, e + n, to, [](const Entry& a, uint32_t x) { return a.third < x; });
+        if (lo != e + n && lo->third == to) {
+          found = static_cast<uint32_t>(lo - e);
+          if (lo + 1 != e + n && (lo + 1)->third == to)
+            return make_error(ErrorCode::kNonManifold, edge_name(v, to) + " has more than two faces");
         }
-        if (opposite[ci] != kNone || opposite[cj] != kNone) {
-          return make_error(ErrorCode::kNonManifold, name() + " has more than two faces");
+      } else {
+        for (uint32_t j = 0; j < n; ++j) {
+          if (e[j].third != to) continue;
+          if (found != kNone) return make_error(ErrorCode::kNonManifold, edge_name(v, to) + " has more than two faces");
+          found = j;
         }
-        opposite[ci] = cj;
-        opposite[cj] = ci;
       }
-    }
-  }
-  // One fan per vertex: walking around from any corner (both ways when the
-  // fan is open) must meet every corner of the vertex.
-  s.visited.assign(V, 0);
-  for (uint32_t c0 = 0; c0 < corners; ++c0) {
-    const uint32_t v = cv[c0];
-    if (s.visited[v]) continue;
-    s.visited[v] = 1;
-    uint32_t count = 1;
-    uint32_t c = c0;
-    bool closed = false;
-    for (;;) {  // counter-clockwise
-      const uint32_t o = opposite[next_corner(c)];
-      if (o == kNone) break;
-      c = next_corner(o);
-      if (c == c0) {
-        closed = true;
-        break;
+      if (found == kNone) continue;
+      if (has_pred[found]) {
+        // Two outgoing half-edges v -> to: the same edge twice in one direction.
+        return make_error(ErrorCode::kNonManifold,
+                          edge_name(v, to) +
+                              " is used twice in the same direction (more than two faces, or inconsistent "
+                              "orientation) by faces " +
+                              std::to_string(e[i].corner / 3) + " and another face");
       }
-      if (++count > faces_at[v]) break;
+      has_pred[found] = 1;
+      match[i] = found;
+      opposite[prev_corner(e[i].corner)] = next_corner(e[found].corner);
     }
-    if (!closed) {
-      c = c0;
-      for (;;) {  // clockwise
-        const uint32_t o = opposite[prev_corner(c)];
-        if (o == kNone) break;
-        c = prev_corner(o);
-        if (++count > faces_at[v]) break;
+    // One fan: at most one entry without predecessor (an open fan's first
+    // face); walking successors from it, or from any entry of a closed fan,
+    // must visit all n.
+    uint32_t start = kNone, starts = 0;
+    for (uint32_t i = 0; i < n; ++i)
+      if (!has_pred[i]) {
+        ++starts;
+        start = i;
       }
+    if (starts == 0) start = 0;
+    uint32_t visited = 0;
+    if (starts <= 1) {
+      uint32_t i = start;
+      do {
+        ++visited;
+        i = match[i];
+      } while (i != kNone && i != start && visited <= n);
     }
-    if (count != faces_at[v]) {
+    if (starts > 1 || visited != n) {
+      // A duplicate outgoing edge leaves two entries without a successor's
+      // match; report it as Adjacency does when it is one.
+      for (uint32_t i = 0; i < n; ++i)
+        for (uint32_t j = i + 1; j < n; ++j)
+          if (e[i].to == e[j].to) {
+            return make_error(ErrorCode::kNonManifold,
+                              edge_name(v, e[i].to) +
+                                  " is used twice in the same direction (more than two faces, or inconsistent "
+                                  "orientation) by faces " +
+                                  std::to_string(e[i].corner / 3) + " and " + std::to_string(e[j].corner / 3));
+          }
       return make_error(ErrorCode::kNonManifold,
                         "vertex " + std::to_string(v) + " joins more than one fan of faces (non-manifold vertex)");
     }
