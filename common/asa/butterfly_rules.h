@@ -35,7 +35,7 @@ inline uint32_t walk_to_feature_cw(const LevelView& m, uint32_t x, uint32_t limi
 // bad table must not loop forever.
 inline uint32_t walk_limit(const LevelView& m) { return m.face_count + 1; }
 
-inline Vec3f curve_point(const LevelView& m, uint32_t c) {
+[[gnu::noinline]] inline Vec3f curve_point(const LevelView& m, uint32_t c) {
   const uint32_t n = next_corner(c), p = prev_corner(c);
   const uint32_t a = m.corner_vertex[n], b = m.corner_vertex[p];
   const Vec3f A = P(m, a), B = P(m, b);
@@ -53,7 +53,7 @@ inline uint32_t across_neighbor(const LevelView& m, uint32_t x) {
   return m.corner_vertex[next_corner(x)];
 }
 
-inline Vec3f regular_point(const LevelView& m, uint32_t c, float w) {
+[[gnu::always_inline]] inline Vec3f regular_point(const LevelView& m, uint32_t c, float w) {
   const uint32_t n = next_corner(c), p = prev_corner(c);
   const uint32_t o = m.opposite[c];
   const uint32_t no = next_corner(o), po = prev_corner(o);
@@ -81,7 +81,7 @@ inline Vec3f regular_point(const LevelView& m, uint32_t c, float w) {
 
 // Extraordinary stencil of interior vertex(x), valence K, walking
 // counter-clockwise from vertex(next(x)) (the edge's other endpoint, j = 0).
-inline Vec3f extraordinary_point(const LevelView& m, uint32_t x, uint32_t K, const ButterflyWeights& wt) {
+[[gnu::noinline]] inline Vec3f extraordinary_point(const LevelView& m, uint32_t x, uint32_t K, const ButterflyWeights& wt) {
   const float* s = wt.extraordinary(K);
   Vec3f sum = P(m, m.corner_vertex[x]) * s[K];
   for (uint32_t j = 0; j < K; ++j) {
@@ -91,7 +91,7 @@ inline Vec3f extraordinary_point(const LevelView& m, uint32_t x, uint32_t K, con
   return sum;
 }
 
-inline Vec3f zorin_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt) {
+[[gnu::always_inline]] inline Vec3f zorin_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt) {
   if (m.feature_edge[c]) return curve_point(m, c);
   const uint32_t n = next_corner(c);
   const uint32_t o = m.opposite[c];
@@ -119,7 +119,7 @@ inline Vec3f unit_face_normal(const LevelView& m, uint32_t f) {
 }
 
 
-inline Vec3f edge_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt, EdgePlacement placement) {
+[[gnu::always_inline]] inline Vec3f edge_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt, EdgePlacement placement) {
   const Vec3f s = zorin_point(m, c, wt);
   if (placement == EdgePlacement::kZorin || m.feature_edge[c]) return s;
   const uint32_t o = m.opposite[c];
