@@ -209,9 +209,11 @@ int main(int argc, char** argv) {
     models.push_back(m);
     return true;
   };
-  // The demo model as the server's --demo serves it (procedural, default size).
-  if (run({tool_bin(), "generate", "demo", "-o", dir / "demo.ply"}, dir / "gen.out", dir / "gen.err") != 0 ||
-      !encode(dir / "demo.ply", "demo", "procedural demo model (meshstream generate demo)")) {
+  // The demo model as `meshstream-server --demo` serves it: the procedural
+  // trefoil at 200k faces, encoded with the default options.
+  if (run({tool_bin(), "generate", "demo", "--size", "200000", "-o", dir / "demo.ply"}, dir / "gen.out",
+          dir / "gen.err") != 0 ||
+      !encode(dir / "demo.ply", "demo", "procedural demo model (meshstream generate demo --size 200000)")) {
     std::fprintf(stderr, "client_bench: no demo model\n");
     return 1;
   }

@@ -149,6 +149,9 @@ class Server {
   bool start(const std::vector<std::string>& args, const std::string& dir, uint16_t port = 0) {
     out_ = dir + "/server.out";
     err_ = dir + "/server.err";
+    // A previous server's line must not be mistaken for this one's.
+    std::error_code ignored;
+    fs::remove(out_, ignored);
     std::vector<std::string> argv{server_bin(), "--listen", "127.0.0.1:" + std::to_string(port)};
     argv.insert(argv.end(), args.begin(), args.end());
     if (!child_.start(argv, out_, err_)) return false;
