@@ -23,11 +23,18 @@ struct ViewerOptions {
   // to this PNG as the window closes; for tests and scripted captures.
   std::string exit_screenshot;
   bool exit_screenshot_with_panel = false;  // include the ImGui panel in it
+  // Colouring at start: 0 shaded, 1 what ASA did, 2 distance to the final mesh.
+  int initial_coloring = 0;
+  bool initial_wireframe = false;
 };
 
 // Opens the window and runs the render loop on the calling thread until the
 // user closes it (or exit_after_frames). Uploads happen here; decode and ASA
 // stay on the pipeline's threads. kUnsupported when no display can be opened.
+// For scripted captures (docs/images/make_snapshot_strip.sh) the environment
+// may fill options the caller left at their defaults:
+// MESHSTREAM_VIEWER_CAPTURE=FILE.png (exit screenshot with the panel),
+// MESHSTREAM_VIEWER_COLORING=shaded|kinds|distance, MESHSTREAM_VIEWER_WIREFRAME=1.
 Status run_viewer(const ViewerOptions& options, LatestFrameMailbox& frames, StreamControls& controls);
 
 struct SnapshotOptions {

@@ -29,7 +29,7 @@ PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const Dis
   PanelActions actions;
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
-  ImGui::Begin("meshstream");
+  ImGui::Begin("meshstream", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
 
   // Stream.
   if (!state.has_frame) {
@@ -124,6 +124,7 @@ PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const Dis
   }
   ImGui::TextDisabled("drag: orbit  shift/right drag: pan  wheel: zoom");
   ImGui::TextDisabled("1/2/3 colour  W wire  F frame  space pause  S shot");
+  state.right_edge_px = ImGui::GetWindowPos().x + ImGui::GetWindowWidth();
   ImGui::End();
   return actions;
 }

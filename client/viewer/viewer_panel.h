@@ -35,6 +35,7 @@ struct PanelState {
   float fps = 0;
   bool screenshot_requested = false;
   std::string message;  // last screenshot result
+  float right_edge_px = 0;  // where the panel ends, in window pixels (for framing)
 };
 
 struct PanelActions {

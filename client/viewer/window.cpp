@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <thread>
 #include <vector>
@@ -151,6 +152,8 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   if (Status opened = imgui.open(window); !opened) return tl::unexpected(opened.error());
 
   PanelState panel;
+  panel.coloring = static_cast<ColorMode>(std::clamp(options.initial_coloring, 0, 2));
+  panel.wireframe = options.initial_wireframe;
   panel.asa_enabled = controls.asa_enabled();
   panel.asa = controls.asa_options();
   RenderStyle style;
@@ -254,9 +257,16 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
       }
     }
     input.keys.clear();
-    if (want_frame && has_shown) {
+    if (want_frame && has_shown && report.frames_drawn > 0) {  // after the panel has a size
+      // Frame into the part of the window right of the panel: fit the model
+      // to that width, then slide it over by half the panel.
       const auto& mesh = shown.display ? shown.display : shown.decoded;
-      camera.frame(*mesh, aspect);
+      float covered = std::clamp(panel.right_edge_px, 0.0f, 0.5f * static_cast<float>(window_w));
+      float free_aspect = window_h > 0 ? (static_cast<float>(window_w) - covered) /
+                                             static_cast<float>(window_h)
+                                       : aspect;
+      camera.frame(*mesh, std::min(aspect, free_aspect));
+      camera.pan(covered / 2, 0, static_cast<float>(window_h));
       want_frame = false;
     }
 
@@ -332,8 +342,22 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   return report;
 }
 
-Status run_viewer(const ViewerOptions& options, LatestFrameMailbox& frames,
+Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,
                   StreamControls& controls) {
+  ViewerOptions options = given;
+  auto env = [](const char* name) -> std::string {
+    const char* value = std::getenv(name);
+    return value ? value : "";
+  };
+  if (options.exit_screenshot.empty() && !env("MESHSTREAM_VIEWER_CAPTURE").empty()) {
+    options.exit_screenshot = env("MESHSTREAM_VIEWER_CAPTURE");
+    options.exit_screenshot_with_panel = true;
+  }
+  if (options.initial_coloring == 0) {
+    std::string coloring = env("MESHSTREAM_VIEWER_COLORING");
+    options.initial_coloring = coloring == "kinds" ? 1 : coloring == "distance" ? 2 : 0;
+  }
+  if (!options.initial_wireframe) options.initial_wireframe = env("MESHSTREAM_VIEWER_WIREFRAME") == "1";
   auto report = run_viewer_with_report(options, frames, controls);
   if (!report) return tl::unexpected(report.error());
   return {};
