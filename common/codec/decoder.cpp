@@ -98,9 +98,7 @@ struct IncrementalDecoder::State {
       const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
       const uint32_t nf = static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
       refine->mesh.reserve(nv, nf);
-      refine->order_next.reserve(nv);
-      refine->created_layer.reserve(nv);
-      refine->valence.reserve(nv);
+      refine->vertices.reserve(nv);
       mesh = Mesh{};
       mesh.positions.reserve(nv);
       mesh.triangles.reserve(nf);

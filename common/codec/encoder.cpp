@@ -181,10 +181,10 @@ class RecordWriter {
     std::vector<std::pair<uint32_t, uint32_t>> order;  // (r, removal)
     std::vector<ResolvedPatch> patches;
     while (remaining > 0) {
-      while (s_.cursor != kNone && s_.created_layer[s_.cursor] == s_.layer) s_.cursor = s_.order_next[s_.cursor];
+      while (s_.cursor != kNone && s_.vertices[s_.cursor].layer == s_.layer) s_.cursor = s_.vertices[s_.cursor].next;
       if (s_.cursor == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: walk ended with patches left");
       const uint32_t u = s_.cursor;
-      s_.cursor = s_.order_next[u];
+      s_.cursor = s_.vertices[u].next;
       ++walk_steps_;
       s_.mesh.star(u, star_ring, star_corners);
       const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());

@@ -34,15 +34,13 @@ Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
   if (!mesh) return tl::unexpected(mesh.error());
   RefinementState s;
   s.mesh = std::move(*mesh);
-  s.order_next.resize(n);
-  for (uint32_t v = 0; v < n; ++v) s.order_next[v] = v + 1 < n ? v + 1 : kNone;
+  s.vertices.resize(n);
+  for (uint32_t v = 0; v < n; ++v) s.vertices[v].next = v + 1 < n ? v + 1 : kNone;
   s.order_head = n > 0 ? 0 : kNone;
-  s.created_layer.assign(n, 0);
-  s.valence.resize(n);
   std::vector<uint32_t> ring, corners;
   for (uint32_t v = 0; v < n; ++v) {
     s.mesh.star(v, ring, corners);
-    s.valence[v] = static_cast<uint32_t>(ring.size());
+    s.vertices[v].valence = static_cast<uint32_t>(ring.size());
   }
   s.max_coordinate = (int32_t(1) << quant_bits) - 1;
   return s;
@@ -205,19 +203,17 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
                      Vec3i position, std::vector<uint32_t>* touched) {
   const uint32_t v = state.mesh.insert_vertex(patch.ring, patch.fan_corners, open, position, touched);
   const uint32_t apex = patch.ring[0];
-  state.order_next.push_back(state.order_next[apex]);
-  state.order_next[apex] = v;
-  state.created_layer.push_back(state.layer);
+  const uint32_t k = static_cast<uint32_t>(patch.ring.size());
+  state.vertices.push_back({state.vertices[apex].next, state.layer, k});
+  state.vertices[apex].next = v;
   // Valences: the apex trades its k-3 diagonals for v, R_1 and R_k-1 gain v,
   // and the ends of a re-opened boundary edge lose each other.
-  const uint32_t k = static_cast<uint32_t>(patch.ring.size());
-  state.valence.push_back(k);
-  state.valence[apex] = state.valence[apex] + 4 - k;
-  state.valence[patch.ring[1]] += 1;
-  state.valence[patch.ring[k - 1]] += 1;
+  state.vertices[apex].valence = state.vertices[apex].valence + 4 - k;
+  state.vertices[patch.ring[1]].valence += 1;
+  state.vertices[patch.ring[k - 1]].valence += 1;
   if (open != kNone) {
-    state.valence[patch.ring[open]] -= 1;
-    state.valence[patch.ring[(open + 1) % k]] -= 1;
+    state.vertices[patch.ring[open]].valence -= 1;
+    state.vertices[patch.ring[(open + 1) % k]].valence -= 1;
   }
   return v;
 }
@@ -280,12 +276,12 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   auto fail = [&](const std::string& what) -> Status { return bad(what); };
 
   for (uint32_t step = 0; step < h.walk_steps; ++step) {
-    while (state.cursor != kNone && state.created_layer[state.cursor] == state.layer) {
-      state.cursor = state.order_next[state.cursor];
+    while (state.cursor != kNone && state.vertices[state.cursor].layer == state.layer) {
+      state.cursor = state.vertices[state.cursor].next;
     }
     if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
     const uint32_t u = state.cursor;
-    state.cursor = state.order_next[u];
+    state.cursor = state.vertices[u].next;
     uint32_t count = m.patch_count[count_context(state, u)].decode(dec);
     if (count == 3) count += m.patch_count_extra.decode(dec);
     state.last_count = count;

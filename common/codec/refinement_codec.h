@@ -49,14 +49,21 @@ struct RefinementModels {
 
 struct RefinementState {
   EditableMesh mesh;
-  std::vector<uint32_t> order_next;  // order list; kNone ends it
+  // Per vertex, together because the walk touches all three at once (one
+  // cache line instead of three): the next vertex in the order list (kNone
+  // ends it), the layer that inserted it (0 for the base) and its valence,
+  // kept up to date by apply_patch.
+  struct VertexEntry {
+    uint32_t next = kNone;
+    uint32_t layer = 0;
+    uint32_t valence = 0;
+  };
+  std::vector<VertexEntry> vertices;
   uint32_t order_head = kNone;
-  std::vector<uint32_t> created_layer;  // 0 for base vertices
   uint32_t layer = 0;                   // layers started so far
   uint32_t cursor = kNone;              // next vertex of the walk
   int32_t max_coordinate = 4095;
   uint32_t last_count = 0;              // patches at the previous walk vertex
-  std::vector<uint32_t> valence;        // neighbours per vertex, kept by apply_patch
   RefinementModels models;
 
   // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
@@ -75,8 +82,8 @@ struct ResolvedPatch {
 // patches), whether the previous walk vertex held patches, and u's age in
 // layers (1, 2, 3+).
 inline uint32_t count_context(const RefinementState& s, uint32_t u) {
-  const uint32_t age = std::min<uint32_t>(s.layer - s.created_layer[u], 3) - 1;
-  return (std::min<uint32_t>(s.valence[u], 12) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age;
+  const uint32_t age = std::min<uint32_t>(s.layer - s.vertices[u].layer, 3) - 1;
+  return (std::min<uint32_t>(s.vertices[u].valence, 12) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age;
 }
 
 // Resolves the patch whose first fan face is star index r and whose vertex
