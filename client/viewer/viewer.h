@@ -26,6 +26,7 @@ struct ViewerOptions {
   // Colouring at start: 0 shaded, 1 what ASA did, 2 distance to the final mesh.
   int initial_coloring = 0;
   bool initial_wireframe = false;
+  std::string screenshot_dir = ".";  // where the screenshot button writes
 };
 
 // Opens the window and runs the render loop on the calling thread until the

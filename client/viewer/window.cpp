@@ -135,7 +135,8 @@ class ImGuiSession {
 }  // namespace
 
 Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
-                                            LatestFrameMailbox& frames, StreamControls& controls) {
+                                            LatestFrameMailbox& frames, StreamControls& controls,
+                                            const std::vector<ScriptedCommand>& script) {
   GlfwSession glfw;
   if (Status opened = glfw.open(options); !opened) return tl::unexpected(opened.error());
   GLFWwindow* window = glfw.window();
@@ -176,6 +177,13 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   auto show = [&](const DisplayFrame& frame) {
     std::shared_ptr<const Mesh> mesh = frame.display ? frame.display : frame.decoded;
     if (!mesh) return;
+    // A bad index would make the GPU read out of bounds: refuse, say why.
+    if (Status valid = validate_arrays(*mesh); !valid) {
+      panel.message = "frame " + std::to_string(frame.sequence) +
+                      " not shown: " + valid.error().message;
+      ++report.rejected_meshes;
+      return;
+    }
     auto start = Clock::now();
     renderer->upload(*mesh, frame.face_kind.get());
     double ms = ms_since(start);
@@ -213,6 +221,7 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     }
     if (auto answer = distances.take_result(); answer && answer->tag == distance_tag) {
       renderer->upload_distances(answer->distances);
+      ++report.distance_uploads;
       panel.distance_ready = true;
       panel.distance_max_found = answer->max;
       panel.reference_diagonal = answer->reference_diagonal;
@@ -241,19 +250,44 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     input.scroll = 0;
     last_x = x;
     last_y = y;
+    std::vector<ScriptedCommand> commands;
+    for (const ScriptedCommand& c : script) {
+      if (c.at_frame == report.frames_drawn) commands.push_back(c);
+    }
     if (!io.WantCaptureKeyboard) {
       for (int key : input.keys) {
+        ScriptedCommand c;
         switch (key) {
-          case GLFW_KEY_F: want_frame = true; break;
-          case GLFW_KEY_W: panel.wireframe = !panel.wireframe; break;
-          case GLFW_KEY_1: panel.coloring = ColorMode::kShaded; break;
-          case GLFW_KEY_2: panel.coloring = ColorMode::kAsaKinds; break;
-          case GLFW_KEY_3: panel.coloring = ColorMode::kDistance; break;
-          case GLFW_KEY_SPACE: controls.paused() ? controls.resume() : controls.pause(); break;
-          case GLFW_KEY_S: panel.screenshot_requested = true; break;
-          case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
-          default: break;
+          case GLFW_KEY_F: c.command = ViewerCommand::kFrameModel; break;
+          case GLFW_KEY_W: c.command = ViewerCommand::kToggleWireframe; break;
+          case GLFW_KEY_1: c.command = ViewerCommand::kColorShaded; break;
+          case GLFW_KEY_2: c.command = ViewerCommand::kColorAsaKinds; break;
+          case GLFW_KEY_3: c.command = ViewerCommand::kColorDistance; break;
+          case GLFW_KEY_SPACE: c.command = ViewerCommand::kTogglePause; break;
+          case GLFW_KEY_S: c.command = ViewerCommand::kScreenshot; break;
+          case GLFW_KEY_ESCAPE: c.command = ViewerCommand::kClose; break;
+          default: continue;
         }
+        commands.push_back(c);
+      }
+    }
+    for (const ScriptedCommand& c : commands) {
+      switch (c.command) {
+        case ViewerCommand::kFrameModel: want_frame = true; break;
+        case ViewerCommand::kToggleWireframe: panel.wireframe = !panel.wireframe; break;
+        case ViewerCommand::kColorShaded: panel.coloring = ColorMode::kShaded; break;
+        case ViewerCommand::kColorAsaKinds: panel.coloring = ColorMode::kAsaKinds; break;
+        case ViewerCommand::kColorDistance: panel.coloring = ColorMode::kDistance; break;
+        case ViewerCommand::kTogglePause:
+          controls.paused() ? controls.resume() : controls.pause();
+          break;
+        case ViewerCommand::kScreenshot: panel.screenshot_requested = true; break;
+        case ViewerCommand::kClose: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
+        case ViewerCommand::kSetAsa:
+          panel.asa_enabled = c.asa_enabled;
+          panel.asa = c.asa;
+          controls.set_asa(panel.asa_enabled, panel.asa);
+          break;
       }
     }
     input.keys.clear();
@@ -283,10 +317,12 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
                       report.frames_drawn + 1 >= options.exit_after_frames;
     if (panel.screenshot_requested && fb_w > 0 && fb_h > 0) {
       panel.screenshot_requested = false;
-      std::string path = "meshstream-screenshot-" + std::to_string(shown.sequence) + "-" +
+      std::string path = options.screenshot_dir + "/meshstream-screenshot-" +
+                         std::to_string(shown.sequence) + "-" +
                          std::to_string(++screenshot_counter) + ".png";
       Status written = write_png(path, read_back_buffer(*gl, fb_w, fb_h));
       panel.message = written ? "saved " + path : written.error().message;
+      if (written) report.screenshots.push_back(path);
     }
     bool capture_exit = (last_frame || glfwWindowShouldClose(window)) &&
                         !options.exit_screenshot.empty() && fb_w > 0 && fb_h > 0;
@@ -330,6 +366,8 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     double spare_ms = 1000.0 / 60.0 - ms_since(frame_start);
     if (spare_ms > 1.0) glfwWaitEventsTimeout(spare_ms / 1000.0);
   }
+  report.final_coloring = static_cast<int>(panel.coloring);
+  report.final_wireframe = panel.wireframe;
   report.mean_frame_ms = report.frames_drawn ? ms_since(loop_start) / report.frames_drawn : 0;
   if (!options.exit_screenshot.empty()) {
     if (last_model_image.rgba.empty()) {

@@ -3,10 +3,33 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "client/viewer/viewer.h"
+#include "common/asa/subdivide.h"
 
 namespace meshstream::client {
+
+// What a person can ask with keys or the panel; tests script these by frame.
+enum class ViewerCommand {
+  kFrameModel,       // F
+  kToggleWireframe,  // W
+  kColorShaded,      // 1
+  kColorAsaKinds,    // 2
+  kColorDistance,    // 3
+  kTogglePause,      // Space (StreamControls::pause / resume)
+  kScreenshot,       // S (PNG of the model in ViewerOptions::screenshot_dir)
+  kClose,            // Escape
+  kSetAsa,           // the panel's ASA controls (StreamControls::set_asa)
+};
+
+struct ScriptedCommand {
+  uint64_t at_frame = 0;  // applied before drawing this frame (0-based)
+  ViewerCommand command = ViewerCommand::kFrameModel;
+  bool asa_enabled = true;  // kSetAsa only
+  AsaOptions asa;           // kSetAsa only
+};
 
 struct ViewerReport {
   uint64_t frames_drawn = 0;
@@ -14,6 +37,11 @@ struct ViewerReport {
   uint64_t last_sequence_shown = 0; // DisplayFrame::sequence of the newest upload
   double max_upload_ms = 0;         // longest single upload (normals + buffers)
   double mean_frame_ms = 0;         // wall time per frame, including waits
+  uint64_t distance_uploads = 0;    // per-vertex distances to the final mesh shown
+  uint64_t rejected_meshes = 0;     // frames whose mesh failed validate_arrays
+  std::vector<std::string> screenshots;  // PNGs written by kScreenshot
+  int final_coloring = 0;           // ColorMode at exit
+  bool final_wireframe = false;
 };
 
 // Opens the window, shows frames from `frames` as they arrive, steers the
@@ -22,7 +50,10 @@ struct ViewerReport {
 // or no OpenGL 3.3 core context is available; kIo when exit_screenshot
 // cannot be written. Runs on the calling thread (GLFW wants the main thread
 // on some platforms).
+// `script` injects commands as if typed (for tests; keys and the panel use
+// the same path).
 Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
-                                            LatestFrameMailbox& frames, StreamControls& controls);
+                                            LatestFrameMailbox& frames, StreamControls& controls,
+                                            const std::vector<ScriptedCommand>& script = {});
 
 }  // namespace meshstream::client

@@ -36,12 +36,20 @@ class FakeControls : public StreamControls {
     std::lock_guard lock(mutex_);
     return enabled_;
   }
-  void pause() override { paused_ = true; }
-  void resume() override { paused_ = false; }
+  void pause() override {
+    paused_ = true;
+    ++pause_calls;
+  }
+  void resume() override {
+    paused_ = false;
+    ++resume_calls;
+  }
   bool paused() const override { return paused_; }
   double current_rate_bytes_per_s() const override { return 12345.0; }
 
   std::atomic<int> set_asa_calls{0};
+  std::atomic<int> pause_calls{0};
+  std::atomic<int> resume_calls{0};
 
  private:
   mutable std::mutex mutex_;
@@ -155,6 +163,68 @@ TEST_F(WindowTest, ShowsTheNewestFrameOnceTheStreamEnds) {
   ASSERT_TRUE(image.has_value()) << image.error().message;
   testing::keep_for_inspection(*image, "window_panel");
   std::filesystem::remove(options.exit_screenshot);
+}
+
+TEST_F(WindowTest, CommandsSteerTheStreamAndTheView) {
+  LatestFrameMailbox mailbox;
+  FakeControls controls;
+  for (uint32_t i = 1; i <= 3; ++i) mailbox.publish(make_frame(i, i, i == 3));
+  AsaOptions asa;
+  asa.levels = 2;
+  asa.flatness = 0.9f;
+  asa.rule = ButterflyRule::kProjection;
+  asa.crease_degrees = 30;
+  std::vector<ScriptedCommand> script{
+      {2, ViewerCommand::kTogglePause},     {4, ViewerCommand::kTogglePause},
+      {5, ViewerCommand::kSetAsa, true, asa}, {6, ViewerCommand::kColorDistance},
+      {7, ViewerCommand::kToggleWireframe}, {8, ViewerCommand::kScreenshot},
+      {9, ViewerCommand::kFrameModel},      {40, ViewerCommand::kClose},
+  };
+  ViewerOptions options;
+  options.width = 320;
+  options.height = 240;
+  options.exit_after_frames = 1000;  // kClose ends it first
+  options.screenshot_dir = std::filesystem::temp_directory_path().string();
+  auto report = run_viewer_with_report(options, mailbox, controls, script);
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  EXPECT_EQ(report->frames_drawn, 41u);  // the close request's frame is still drawn
+  EXPECT_EQ(controls.pause_calls, 1);
+  EXPECT_EQ(controls.resume_calls, 1);
+  EXPECT_FALSE(controls.paused());
+  ASSERT_EQ(controls.set_asa_calls, 1);
+  EXPECT_TRUE(controls.asa_enabled());
+  EXPECT_EQ(controls.asa_options().levels, 2);
+  EXPECT_EQ(controls.asa_options().rule, ButterflyRule::kProjection);
+  EXPECT_FLOAT_EQ(controls.asa_options().crease_degrees, 30.0f);
+  EXPECT_EQ(report->final_coloring, 2);
+  EXPECT_TRUE(report->final_wireframe);
+  // The final mesh was known from the start, so distances reached the GPU.
+  EXPECT_GE(report->distance_uploads, 1u);
+  ASSERT_EQ(report->screenshots.size(), 1u);
+  auto shot = read_png(report->screenshots[0]);
+  ASSERT_TRUE(shot.has_value()) << shot.error().message;
+  EXPECT_EQ(shot->width, 320);
+  EXPECT_GT(testing::foreground_coverage(*shot).foreground, 320u * 240u / 10);
+  testing::keep_for_inspection(*shot, "window_screenshot_distance_wire");
+  std::filesystem::remove(report->screenshots[0]);
+}
+
+TEST_F(WindowTest, RefusesABrokenMeshWithoutCrashing) {
+  LatestFrameMailbox mailbox;
+  FakeControls controls;
+  DisplayFrame frame = make_frame(1, 1, false);
+  auto broken = std::make_shared<Mesh>(*frame.decoded);
+  broken->triangles[0][0] = 1u << 30;  // far outside the vertex array
+  frame.display = broken;
+  mailbox.publish(frame);
+  ViewerOptions options;
+  options.width = 160;
+  options.height = 120;
+  options.exit_after_frames = 3;
+  auto report = run_viewer_with_report(options, mailbox, controls);
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  EXPECT_EQ(report->rejected_meshes, 1u);
+  EXPECT_EQ(report->meshes_uploaded, 0u);
 }
 
 TEST(WindowWithoutDisplay, IsUnsupportedNotACrash) {
