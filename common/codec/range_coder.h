@@ -48,11 +48,11 @@ class RangeDecoder {
   explicit RangeDecoder(std::span<const uint8_t> in);
   uint32_t decode_bit(BitModel& model);
   uint32_t decode_direct(int count);
-  // Bytes requested past the end of the input (a correct stream needs at
-  // most 4 of them: the encoder's flush is shorter than the decoder's
-  // look-ahead).
+  // Bytes requested past the end of the input. A correct stream needs at
+  // most 8 of them: the decoder looks 4 bytes ahead and the encoder drops up
+  // to 4 trailing zero bytes of its flush.
   size_t overrun() const { return overrun_; }
-  bool exhausted_badly() const { return overrun_ > 4; }
+  bool exhausted_badly() const { return overrun_ > 8; }
 
  private:
   uint8_t next_byte() {

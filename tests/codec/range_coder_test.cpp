@@ -62,7 +62,7 @@ TEST(RangeCoder, GarbageNeverReadsOutOfBounds) {
     for (auto& b : junk) b = static_cast<uint8_t>(rng());
     RangeDecoder dec(junk);
     AdaptiveIntModel m;
-    for (int i = 0; i < 100; ++i) (void)m.decode(dec);
+    for (int i = 0; i < 2000; ++i) (void)m.decode(dec);
     if (junk.size() < 20) {
       EXPECT_TRUE(dec.exhausted_badly());
     }
