@@ -202,11 +202,15 @@ class RecordWriter {
       std::sort(order.begin(), order.end());
       const uint32_t count = static_cast<uint32_t>(order.size());
       RefinementModels& m = s_.models;
-      m.patch_count[count_context(s_, u)].encode(enc_, std::min(count, 3u));
-      if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);
+      const uint32_t free_faces = mark_taken_faces(s_, star_ring, faces, used_);
+      if (free_faces > 0) {
+        m.patch_count[count_context(s_, u, free_faces)].encode(enc_, std::min(count, 3u));
+        if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);
+      } else if (count > 0) {
+        return make_error(ErrorCode::kInvalidMesh, "internal: patch at a vertex without free faces");
+      }
       s_.last_count = count;
       patches.resize(count);
-      used_.assign(faces, 0);
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals[order[j].second];
         const uint32_t k = static_cast<uint32_t>(r.ring.size());

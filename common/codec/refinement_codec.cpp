@@ -131,6 +131,20 @@ bool decode_residual(RefinementModels& models, RangeDecoder& dec, const Residual
   return true;
 }
 
+uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>& star_ring,
+                          uint32_t faces, std::vector<uint8_t>& used) {
+  used.assign(faces, 0);
+  uint32_t free_faces = 0;
+  const size_t n = star_ring.size();
+  for (uint32_t i = 0; i < faces; ++i) {
+    const bool taken = s.vertices[star_ring[i]].layer == s.layer ||
+                       s.vertices[star_ring[(i + 1) % n]].layer == s.layer;
+    used[i] = taken ? 1 : 0;
+    free_faces += taken ? 0 : 1;
+  }
+  return free_faces;
+}
+
 void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
                        const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out) {
   out.clear();
@@ -282,21 +296,24 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
     const uint32_t u = state.cursor;
     state.cursor = state.vertices[u].next;
-    uint32_t count = m.patch_count[count_context(state, u)].decode(dec);
-    if (count == 3) count += m.patch_count_extra.decode(dec);
-    state.last_count = count;
-    if (count == 0) continue;
     mesh.star(u, star_ring, star_corners);
     const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
     const uint32_t faces = static_cast<uint32_t>(star_corners.size());
-    if (count > faces || inserted + count > h.insertions) {
+    const uint32_t free_faces = mark_taken_faces(state, star_ring, faces, used_faces);
+    uint32_t count = 0;
+    if (free_faces > 0) {
+      count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
+      if (count == 3) count += m.patch_count_extra.decode(dec);
+    }
+    state.last_count = count;
+    if (count == 0) continue;
+    if (count > free_faces || inserted + count > h.insertions) {
       return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
-                             " patches, more than it or the record holds");
+                  " patches, more than it or the record holds");
     }
     patches.resize(count);
     positions.resize(count);
     opens.resize(count);
-    used_faces.assign(faces, 0);
     for (uint32_t i = 0; i < count; ++i) {
       const uint32_t k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
       rank_patch_starts(mesh, u, star_ring, used_faces, k, candidates);

@@ -38,7 +38,7 @@ namespace meshstream {
 inline constexpr int kScaleContexts = 20;
 
 struct RefinementModels {
-  BitTreeModel<2> patch_count[26 * 3];  // by count_context; 3 = escape
+  BitTreeModel<2> patch_count[8 * 2 * 3];  // by count_context; 3 = escape
   AdaptiveUIntModel patch_count_extra;
   BitTreeModel<4> start_rank[6];     // by min(k - 3, 5); 15 = escape
   AdaptiveUIntModel start_rank_big;
@@ -77,13 +77,19 @@ struct ResolvedPatch {
   std::vector<uint32_t> fan_corners;  // k-2 corners at the apex
 };
 
-// Context of the patch count at walk vertex u: its valence (kept up to
-// date by apply_patch, so the decoder swings around u only when it holds
-// patches), whether the previous walk vertex held patches, and u's age in
-// layers (1, 2, 3+).
-inline uint32_t count_context(const RefinementState& s, uint32_t u) {
+// Marks in `used` (one entry per face of u's star) the faces that hold a
+// vertex inserted in the current layer: they belong to a patch already
+// restored, so no fan can use them. Returns the number of free faces; a
+// walk vertex with none cannot be an apex and codes nothing. O(faces).
+uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>& star_ring,
+                          uint32_t faces, std::vector<uint8_t>& used);
+
+// Context of the patch count at walk vertex u: its free faces (capped at
+// 7), whether the previous walk vertex held patches, and u's age in layers
+// (1, 2, 3+).
+inline uint32_t count_context(const RefinementState& s, uint32_t u, uint32_t free_faces) {
   const uint32_t age = std::min<uint32_t>(s.layer - s.vertices[u].layer, 3) - 1;
-  return (std::min<uint32_t>(s.vertices[u].valence, 12) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age;
+  return (std::min<uint32_t>(free_faces, 7) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age;
 }
 
 // Resolves the patch whose first fan face is star index r and whose vertex
