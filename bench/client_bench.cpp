@@ -235,7 +235,9 @@ int main(int argc, char** argv) {
      << "Loopback, the real `meshstream-server` and `meshstream-client --json` (default ASA: 1 level, t = 0.85, "
         "Zorin rule; path auto). Times are the client's own clock from its start (resolve + connect + Hello) "
         "to the event. Unthrottled rows are medians of "
-     << (quick ? 1 : 3) << " runs; throttled rows one run.\n\n";
+     << (quick ? 1 : 3) << " runs; throttled rows one run. Load average when the run started: "
+     << read_text("/proc/loadavg").substr(0, 14) << "(the 2 cores are shared: figures include waiting "
+     << "for CPU).\n\n";
   md << "| model | stream | records | rate | first display ms | half the records ms | end ms | display updates | "
         "coalesced | decode ms per update (median / max) | ASA ms per update (median / max) | incremental updates |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
