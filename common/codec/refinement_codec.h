@@ -38,7 +38,7 @@ namespace meshstream {
 inline constexpr int kScaleContexts = 20;
 
 struct RefinementModels {
-  BitTreeModel<2> patch_count[8 * 2 * 3];  // by count_context; 3 = escape
+  BitTreeModel<2> patch_count[8 * 2 * 3 * 4];  // by count_context; 3 = escape
   AdaptiveUIntModel patch_count_extra;
   BitTreeModel<4> start_rank[6];     // by min(k - 3, 5); 15 = escape
   AdaptiveUIntModel start_rank_big;
@@ -85,12 +85,15 @@ uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>&
                           uint32_t faces, std::vector<uint8_t>& used);
 
 // Context of the patch count at walk vertex u: its free faces (capped at
-// 7), whether the previous walk vertex held patches, and u's age in layers
-// (1, 2, 3+).
+// 7), whether the previous walk vertex held patches, u's age in layers
+// (1, 2, 3+) and its valence (<= 5, 6, 7-8, 9+).
 inline uint32_t count_context(const RefinementState& s, uint32_t u, uint32_t free_faces) {
   const uint32_t age = std::min<uint32_t>(s.layer - s.vertices[u].layer, 3) - 1;
-  return (std::min<uint32_t>(free_faces, 7) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age;
+  const uint32_t val = std::min<uint32_t>(s.vertices[u].valence, 12);
+  const uint32_t vb = val <= 5 ? 0 : val == 6 ? 1 : val <= 8 ? 2 : 3;
+  return ((std::min<uint32_t>(free_faces, 7) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age) * 4 + vb;
 }
+
 
 // Resolves the patch whose first fan face is star index r and whose vertex
 // has valence k, given the apex's star. False when it does not fit (r or k
