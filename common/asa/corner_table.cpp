@@ -116,4 +116,10 @@ Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, Corner
   return {};
 }
 
+void faces_per_vertex(const CornerTableScratch& s, std::vector<uint32_t>& faces) {
+  const size_t V = s.offset.empty() ? 0 : s.offset.size() - 1;
+  faces.resize(V);
+  for (size_t v = 0; v < V; ++v) faces[v] = s.offset[v + 1] - s.offset[v];
+}
+
 }  // namespace meshstream::asa

@@ -31,4 +31,8 @@ struct CornerTableScratch {
 // O(V + F) time; no allocation once the scratch has capacity.
 Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, CornerTableScratch& scratch);
 
+// After a successful build_opposites: the number of faces around each vertex
+// (the valence of an interior vertex), read from the buckets. O(V).
+void faces_per_vertex(const CornerTableScratch& scratch, std::vector<uint32_t>& faces);
+
 }  // namespace meshstream::asa

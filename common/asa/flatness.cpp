@@ -20,20 +20,24 @@ void compute_face_normals(const LevelView& m, std::vector<Vec3f>& normals) {
   }
 }
 
-void tag_feature_edges(const LevelView& m, float crease_degrees, const std::vector<Vec3f>& normals,
-                       std::vector<uint8_t>& feature_edge) {
+uint32_t tag_feature_edges(const LevelView& m, float crease_degrees, const std::vector<Vec3f>& normals,
+                           std::vector<uint8_t>& feature_edge) {
   const uint32_t corners = 3 * m.face_count;
-  feature_edge.assign(corners, 0);
+  feature_edge.resize(corners);
+  uint32_t tagged = 0;
   const bool creases = crease_degrees > 0;
   const float cos_limit = std::cos(crease_degrees * static_cast<float>(std::numbers::pi) / 180.0f);
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t o = m.opposite[c];
-    if (o == kNone) {
-      feature_edge[c] = 1;
-    } else if (creases && c < o && dot(normals[c / 3], normals[o / 3]) < cos_limit) {
-      feature_edge[c] = feature_edge[o] = 1;
+    uint8_t sharp = o == kNone;
+    if (!sharp && creases) {
+      // Both corners of the edge compute the same test (dot is symmetric).
+      sharp = dot(normals[c / 3], normals[o / 3]) < cos_limit;
     }
+    feature_edge[c] = sharp;
+    tagged += sharp;
   }
+  return tagged;
 }
 
 void count_vertex_features(const LevelView& m, std::vector<uint8_t>& vertex_features) {

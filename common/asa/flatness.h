@@ -15,8 +15,9 @@ void compute_face_normals(const LevelView& mesh, std::vector<Vec3f>& normals);
 // Per corner: 1 when the edge it faces is a boundary edge or bends by more
 // than crease_degrees (angle between the two face normals); crease_degrees
 // <= 0 tags boundaries only. Both corners of an edge get the same flag.
-// Needs mesh.corner_vertex, opposite and positions. O(F).
-void tag_feature_edges(const LevelView& mesh, float crease_degrees, const std::vector<Vec3f>& normals,
+// Needs mesh.corner_vertex, opposite and positions. Returns the number of
+// corners tagged. O(F).
+uint32_t tag_feature_edges(const LevelView& mesh, float crease_degrees, const std::vector<Vec3f>& normals,
                        std::vector<uint8_t>& feature_edge);
 
 // Per vertex: the number of feature edges at it (saturating at 255). O(F).

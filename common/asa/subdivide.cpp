@@ -85,11 +85,15 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   // Normals: for crease tagging and flatness (the uniform scheme needs none).
   const bool need_normals = options.crease_degrees > 0 || !options.uniform;
   if (need_normals) asa::compute_face_normals(view, ws.normals);
-  asa::tag_feature_edges(view, options.crease_degrees, ws.normals, base.feature_edge);
+  const uint32_t tagged = asa::tag_feature_edges(view, options.crease_degrees, ws.normals, base.feature_edge);
   view.feature_edge = base.feature_edge.data();
-  asa::count_vertex_features(view, base.vertex_features);
+  if (tagged) {
+    asa::count_vertex_features(view, base.vertex_features);
+  } else {
+    base.vertex_features.assign(V, 0);  // closed and no creases
+  }
   view.vertex_features = base.vertex_features.data();
-  asa::count_vertex_faces(view, base.valence);
+  asa::faces_per_vertex(ws.corner_scratch, base.valence);
   view.valence = base.valence.data();
   view.green = nullptr;
   ws.weights.configure(options.tension);
