@@ -18,13 +18,15 @@
 // - no fan triangle is degenerate on the grid (zero area, exact integers) or
 //   turns against the star's normal (cosine <= kMinFanCosine).
 // Among valid apexes the one whose worst fan triangle is the best shaped wins.
-// Importance = log(1 + e) + valence / 2, where the geometric error e (grid
+// Importance = log(1 + e) + valence / 4, where the geometric error e (grid
 // units) is the distance of v from the plane of its star (area normal
 // through the ring centroid) plus half its distance from the ring average
 // (the decoder's prediction), plus for a boundary vertex its distance from
-// the new boundary edge's line (the boundary's shape). Cheapest first. The
-// valence term is a regularizer in the spirit of Alliez & Desbrun's
-// valence-driven decimation (2001): at similar error, low valences first.
+// the new boundary edge's line (the boundary's shape). Each layer draws its
+// independent set, cheapest first, from the cheapest half of the candidates
+// only, so important vertices stay for coarser layers. The valence term is a
+// regularizer in the spirit of Alliez & Desbrun's valence-driven decimation
+// (2001): at similar error, low valences first (larger sets, smaller stream).
 #pragma once
 
 #include <cstdint>
