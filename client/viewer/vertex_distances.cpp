@@ -31,13 +31,14 @@ void DistanceWorker::set_reference(std::shared_ptr<const Mesh> reference) {
   {
     std::lock_guard lock(mutex_);
     reference_ = std::move(reference);
+    reference_given_ = true;
   }
   wake_.notify_all();
 }
 
 bool DistanceWorker::has_reference() const {
   std::lock_guard lock(mutex_);
-  return has_reference_ || reference_ != nullptr;
+  return reference_given_;
 }
 
 void DistanceWorker::request(std::shared_ptr<const Mesh> mesh, uint64_t tag) {
@@ -79,6 +80,12 @@ void DistanceWorker::run() {
     answer.tag = tag;
     answer.distances = vertex_distances(*job, bvh);
     for (float d : answer.distances) answer.max = std::max(answer.max, d);
+    if (!answer.distances.empty()) {
+      std::vector<float> sorted = answer.distances;
+      auto nth = sorted.begin() + static_cast<std::ptrdiff_t>((sorted.size() - 1) * 98 / 100);
+      std::nth_element(sorted.begin(), nth, sorted.end());
+      answer.p98 = *nth;
+    }
     answer.reference_diagonal = diagonal;
     lock.lock();
     answer_ = std::move(answer);

@@ -31,6 +31,8 @@ class DistanceWorker {
   DistanceWorker& operator=(const DistanceWorker&) = delete;
 
   void set_reference(std::shared_ptr<const Mesh> reference);
+  // True from the moment set_reference was called (requests made while the
+  // hierarchy is still being built are answered once it is ready).
   bool has_reference() const;
   // Distances of `mesh`, reported with `tag` by take_result.
   void request(std::shared_ptr<const Mesh> mesh, uint64_t tag);
@@ -39,6 +41,7 @@ class DistanceWorker {
     uint64_t tag = 0;
     std::vector<float> distances;
     float max = 0;
+    float p98 = 0;  // 98th percentile: the colour ramp's default top, robust to a few outliers
     float reference_diagonal = 0;
   };
   // The newest finished answer not yet taken. Never blocks.
@@ -52,7 +55,8 @@ class DistanceWorker {
   std::shared_ptr<const Mesh> reference_;  // pending: hierarchy not built yet
   std::shared_ptr<const Mesh> job_;
   uint64_t job_tag_ = 0;
-  bool has_reference_ = false;
+  bool reference_given_ = false;  // set_reference was called (the build may be running)
+  bool has_reference_ = false;    // the hierarchy is built and not empty
   std::optional<Answer> answer_;
   std::thread thread_;
 };

@@ -99,7 +99,7 @@ PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const Dis
         ImGui::Text("max %.3g (%.3f%% of diagonal)", state.distance_max_found,
                     100.0f * state.distance_max_found / diagonal);
       }
-      ImGui::Checkbox("ramp to the largest distance", &state.distance_auto);
+      ImGui::Checkbox("red at the 98th percentile", &state.distance_auto);
       if (!state.distance_auto) {
         ImGui::SliderFloat("red at % diagonal", &state.distance_max_percent, 0.01f, 5.0f, "%.2f",
                            ImGuiSliderFlags_Logarithmic);

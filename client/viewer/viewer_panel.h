@@ -16,7 +16,8 @@ struct PanelState {
   // display
   ColorMode coloring = ColorMode::kShaded;
   bool wireframe = false;
-  bool distance_auto = true;          // ramp maximum = largest distance found
+  bool distance_auto = true;          // ramp maximum = 98th percentile of the distances
+  float distance_p98 = 0;
   float distance_max_percent = 0.5f;  // else this % of the final mesh's diagonal
   float distance_max_found = 0;
   float reference_diagonal = 0;

@@ -173,6 +173,8 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   double last_x = 0, last_y = 0;
   glfwGetCursorPos(window, &last_x, &last_y);
   auto loop_start = Clock::now();
+  auto last_activity = loop_start;
+  int last_window_w = 0, last_window_h = 0;
 
   auto show = [&](const DisplayFrame& frame) {
     std::shared_ptr<const Mesh> mesh = frame.display ? frame.display : frame.decoded;
@@ -204,10 +206,12 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   while (!glfwWindowShouldClose(window)) {
     auto frame_start = Clock::now();
     glfwPollEvents();
+    bool activity = false;  // anything that may change the picture
 
     // 1. New stream state: upload only when the sequence moved.
     if (auto frame = frames.take_newer(seen)) {
       seen = frame->sequence;
+      activity = true;
       latest = *frame;
       panel.has_frame = true;
       history.add(latest);
@@ -221,9 +225,11 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     }
     if (auto answer = distances.take_result(); answer && answer->tag == distance_tag) {
       renderer->upload_distances(answer->distances);
+      activity = true;
       ++report.distance_uploads;
       panel.distance_ready = true;
       panel.distance_max_found = answer->max;
+      panel.distance_p98 = answer->p98;
       panel.reference_diagonal = answer->reference_diagonal;
     }
     panel.distance_reference_known = distances.has_reference();
@@ -247,6 +253,12 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
       if (right || middle || (left && shift)) camera.pan(dx, dy, static_cast<float>(window_h));
       if (input.scroll != 0) camera.zoom(input.scroll);
     }
+    activity |= input.scroll != 0 || x != last_x || y != last_y || !input.keys.empty() ||
+                glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS ||
+                glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
+                window_w != last_window_w || window_h != last_window_h;
+    last_window_w = window_w;
+    last_window_h = window_h;
     input.scroll = 0;
     last_x = x;
     last_y = y;
@@ -271,6 +283,7 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
         commands.push_back(c);
       }
     }
+    activity |= !commands.empty();
     for (const ScriptedCommand& c : commands) {
       switch (c.command) {
         case ViewerCommand::kFrameModel: want_frame = true; break;
@@ -308,7 +321,7 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     style.coloring = panel.coloring;
     style.wireframe = panel.wireframe;
     style.distance_max = panel.distance_auto
-                             ? std::max(panel.distance_max_found, 1e-12f)
+                             ? std::max(panel.distance_p98, 1e-12f)
                              : panel.distance_max_percent / 100.0f *
                                    std::max(panel.reference_diagonal, 1e-12f);
     gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -362,8 +375,12 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
 
     if (last_frame) break;
     // Xvfb and some drivers ignore the swap interval: cap at ~60 frames per
-    // second so an idle viewer does not spin a core.
-    double spare_ms = 1000.0 / 60.0 - ms_since(frame_start);
+    // second, and at 20 once nothing has happened for half a second, so an
+    // idle viewer on a software rasterizer leaves the cores to decoding, ASA
+    // and the distance worker. Any input event wakes the wait at once.
+    if (activity) last_activity = Clock::now();
+    double frame_budget_ms = ms_since(last_activity) > 500.0 ? 50.0 : 1000.0 / 60.0;
+    double spare_ms = frame_budget_ms - ms_since(frame_start);
     if (spare_ms > 1.0) glfwWaitEventsTimeout(spare_ms / 1000.0);
   }
   report.final_coloring = static_cast<int>(panel.coloring);

@@ -130,6 +130,8 @@ TEST(DistanceWorker, AnswersTheNewestRequestAgainstTheReference) {
   ASSERT_EQ(answer->tag, 2u);
   ASSERT_EQ(answer->distances.size(), near_mesh->vertex_count());
   EXPECT_NEAR(answer->max, 0.25f, 0.02f);
+  EXPECT_LE(answer->p98, answer->max);
+  EXPECT_GE(answer->p98, 0.25f - 1e-5f);
   EXPECT_NEAR(answer->reference_diagonal, 2 * std::sqrt(3.0f), 0.05f);
 }
 

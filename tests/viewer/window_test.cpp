@@ -209,6 +209,48 @@ TEST_F(WindowTest, CommandsSteerTheStreamAndTheView) {
   std::filesystem::remove(report->screenshots[0]);
 }
 
+TEST_F(WindowTest, DistanceColouringShowsWhereTheDisplayLeavesTheFinalMesh) {
+  LatestFrameMailbox mailbox;
+  FakeControls controls;
+  // Final frame: the display bulges out of the decoded (final) mesh on its
+  // upper half only, so the upper half must turn warm and the lower stay blue.
+  DisplayFrame frame = make_frame(1, 3, true);
+  auto display = std::make_shared<Mesh>(*frame.decoded);
+  for (Vec3f& p : display->positions) {
+    if (p.y > 0) p = p * 1.2f;
+  }
+  frame.display = display;
+  frame.face_kind = nullptr;
+  mailbox.publish(frame);
+  ViewerOptions options;
+  options.width = 400;
+  options.height = 300;
+  options.initial_coloring = 2;
+  options.exit_after_frames = 1000;
+  options.screenshot_dir = std::filesystem::temp_directory_path().string();
+  std::vector<ScriptedCommand> script;
+  // Screenshots now and then; the distances arrive from the worker within
+  // a few frames, the last one must show them.
+  for (uint64_t f = 20; f <= 120; f += 20) script.push_back({f, ViewerCommand::kScreenshot});
+  script.push_back({121, ViewerCommand::kClose});
+  auto report = run_viewer_with_report(options, mailbox, controls, script);
+  ASSERT_TRUE(report.has_value()) << report.error().message;
+  ASSERT_GE(report->distance_uploads, 1u);
+  ASSERT_FALSE(report->screenshots.empty());
+  auto shot = read_png(report->screenshots.back());
+  ASSERT_TRUE(shot.has_value());
+  testing::keep_for_inspection(*shot, "window_distance_bulge");
+  size_t warm = 0, blue = 0;
+  for (size_t i = 0; i + 3 < shot->rgba.size(); i += 4) {
+    int r = shot->rgba[i], b = shot->rgba[i + 2];
+    warm += r > b + 60 ? 1 : 0;
+    blue += b > r + 60 ? 1 : 0;
+  }
+  EXPECT_GT(warm, 2000u);
+  EXPECT_GT(blue, 2000u);
+  for (const std::string& path : report->screenshots) std::filesystem::remove(path);
+}
+
 TEST_F(WindowTest, RefusesABrokenMeshWithoutCrashing) {
   LatestFrameMailbox mailbox;
   FakeControls controls;
