@@ -238,6 +238,7 @@ int main(int argc, char** argv) {
      << (quick ? 1 : 3) << " runs; throttled rows one run. Load average when the run started: "
      << read_text("/proc/loadavg").substr(0, 14) << "(the 2 cores are shared: figures include waiting "
      << "for CPU).\n\n";
+  std::vector<std::string> first_display_notes, budget_notes;
   md << "| model | stream | records | rate | first display ms | half the records ms | end ms | display updates | "
         "coalesced | decode ms per update (median / max) | ASA ms per update (median / max) | incremental updates |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -270,6 +271,15 @@ int main(int argc, char** argv) {
       }
       if (first.empty()) continue;
       const NetRun& r = *std::find_if(runs.begin(), runs.end(), [](const NetRun& x) { return x.ok; });
+      if (rate == 0) {
+        first_display_notes.push_back(m.name + " " + fmt("%.1f", median(first)) + " ms (runs: " +
+                                      [&] {
+                                        std::string all;
+                                        for (double f : first) all += (all.empty() ? "" : ", ") + fmt("%.1f", f);
+                                        return all;
+                                      }() +
+                                      ")");
+      }
       std::printf("%s %s: first %.1f ms, half %.1f ms, end %.1f ms, %u updates, %u coalesced\n", m.name.c_str(),
                   rate_name.c_str(), median(first), median(half), median(end), r.updates, r.coalesced);
       md << "| " << m.name << " | " << fmt("%.0f", double(m.bytes) / 1000.0) << " KB | " << m.records << " | "
@@ -317,11 +327,22 @@ int main(int argc, char** argv) {
     auto trio = [&](const std::vector<double>& v) {
       return fmt("%.2f", median(v)) + " / " + fmt("%.2f", percentile(v, 0.95)) + " / " + fmt("%.2f", max_of(v));
     };
+    budget_notes.push_back(m.name + ": " + std::to_string(under) + " of " + std::to_string(eligible));
     md << "| " << m.name << " | " << rows.size() << " | " << rows.back().display_faces << " | " << trio(dec)
        << " | " << trio(full) << " | " << trio(inc) << " | " << region << " / " << equal << " of " << rows.size()
        << " | " << inc_faster << " / " << rows.size() - inc_faster << " | " << under << " of " << eligible
        << " |\n";
   }
+  md << "\n**Targets.** First displayed mesh within 20 ms of connecting, unthrottled (median of the runs): ";
+  for (size_t i = 0; i < first_display_notes.size(); ++i) md << (i ? "; " : "") << first_display_notes[i];
+  md << ". Decode + ASA under 16 ms per update for display meshes up to 200k triangles (replay, with the "
+        "faster ASA path per update): ";
+  for (size_t i = 0; i < budget_notes.size(); ++i) md << (i ? "; " : "") << budget_notes[i];
+  md << " updates. On loopback the stream itself is not the limit: unthrottled, the end time is the decoder "
+        "and ASA sharing two busy cores, and ASA coalesces most records (the `coalesced` column), so the "
+        "display jumps in a few large steps; at 100 KB/s nearly every record is shown, and the region path "
+        "serves the updates that change little of the mesh. Throttled first-display times include the time "
+        "to receive the container prefix and the base mesh at that rate.\n";
   md << "\nModels: ";
   for (size_t i = 0; i < models.size(); ++i) {
     md << (i ? "; " : "") << models[i].name << " = " << models[i].origin << ", " << models[i].vertices
