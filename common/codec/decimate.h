@@ -1,5 +1,5 @@
 // Layered decimation (HCS, Li & Kuo 1998): each layer removes an independent
-// set of interior vertices, least important first, and fills every hole with
+// set of vertices, least important first, and fills every hole with
 // a fan from one of its ring vertices. The decoder restores layers in reverse
 // order; within a layer the patches are disjoint, so any order works.
 //
@@ -17,16 +17,19 @@
 //   vertex the new triangle is not already a face;
 // - no fan triangle is degenerate on the grid (zero area, exact integers) or
 //   turns against the star's normal (cosine <= kMinFanCosine).
-// Among valid apexes the one whose worst fan triangle is the best shaped wins.
-// Importance = log(1 + e) + valence / 4, where the geometric error e (grid
-// units) is the distance of v from the plane of its star (area normal
-// through the ring centroid) plus half its distance from the ring average
-// (the decoder's prediction), plus for a boundary vertex its distance from
-// the new boundary edge's line (the boundary's shape). Each layer draws its
-// independent set, cheapest first, from the cheapest half of the candidates
-// only, so important vertices stay for coarser layers. The valence term is a
-// regularizer in the spirit of Alliez & Desbrun's valence-driven decimation
-// (2001): at similar error, low valences first (larger sets, smaller stream).
+// A fan from apex a is exactly the half-edge collapse of v into a, so the
+// error is Garland & Heckbert's quadric (1997): every vertex carries the
+// area-weighted planes of the original faces around it (and, weighted by
+// squared length, planes through boundary edges perpendicular to their face,
+// so boundaries keep their shape); removing v into a costs the mean squared
+// distance of a from v's planes, and a inherits v's quadric. Among valid
+// apexes the least error wins (shape breaks near-ties).
+// Importance = log(1 + sqrt(least quadric error) + |v - ring average| / 4)
+// + valence / 4, in grid units: the prediction term keeps residuals small,
+// the valence term is a regularizer in the spirit of Alliez & Desbrun's
+// valence-driven decimation (2001). Each layer draws its independent set,
+// cheapest first, from the cheapest half of the candidates only, so
+// important vertices stay for coarser layers.
 #pragma once
 
 #include <cstdint>

@@ -27,26 +27,6 @@ uint64_t position_key(Vec3i p) {
   return uint64_t(uint32_t(p.x)) | uint64_t(uint32_t(p.y)) << 21 | uint64_t(uint32_t(p.z)) << 42;
 }
 
-// Oriented faces as rotation-normalized triples of position keys, sorted:
-// two meshes with equal lists have the same faces up to vertex re-indexing.
-std::vector<std::array<uint64_t, 3>> face_signature(const BaseMesh& m) {
-  std::vector<std::array<uint64_t, 3>> out;
-  out.reserve(m.faces.size());
-  for (const Triangle& t : m.faces) {
-    std::array<uint64_t, 3> k = {position_key(m.positions[t[0]]), position_key(m.positions[t[1]]),
-                                 position_key(m.positions[t[2]])};
-    // The smallest of the three rotations (ties between equal positions too).
-    std::array<uint64_t, 3> best = k;
-    for (int r = 0; r < 2; ++r) {
-      std::rotate(k.begin(), k.begin() + 1, k.end());
-      best = std::min(best, k);
-    }
-    out.push_back(best);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 struct ChosenBase {
   uint8_t coder = kBaseCoderOwn;
   std::vector<uint8_t> bytes;
