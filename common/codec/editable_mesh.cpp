@@ -30,17 +30,22 @@ void EditableMesh::star(uint32_t v, std::vector<uint32_t>& ring, std::vector<uin
   corners.clear();
   const uint32_t start = vertex_corner_[v];
   if (start == kNone) return;
+  const uint32_t* corner_vertex = reinterpret_cast<const uint32_t*>(faces_.data());
+  const uint32_t* opposite = opposite_.data();
   uint32_t c = start;
   uint32_t last = start;
-  // The cap only guards against a broken table; a valid one ends the loop.
-  const size_t cap = opposite_.size();
-  do {
+  // The bound only guards against a broken table; a valid one ends the loop.
+  for (size_t guard = opposite_.size(); guard > 0; --guard) {
     corners.push_back(c);
-    ring.push_back(vertex(next(c)));
+    const uint32_t n = next(c);
+    ring.push_back(corner_vertex[n]);
     last = c;
-    c = swing_ccw(c);
-  } while (c != kNone && c != start && corners.size() <= cap);
-  if (boundary_[v]) ring.push_back(vertex(prev(last)));
+    const uint32_t o = opposite[n];
+    if (o == kNone) break;
+    c = next(o);
+    if (c == start) break;
+  }
+  if (boundary_[v]) ring.push_back(corner_vertex[prev(last)]);
 }
 
 void EditableMesh::remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,

@@ -29,6 +29,8 @@ namespace meshstream {
 // Largest ring an edit handles (the codec limits removals to far less).
 inline constexpr uint32_t kMaxPatchValence = 64;
 
+static_assert(sizeof(Triangle) == 3 * sizeof(uint32_t), "faces are packed index triples");
+
 class EditableMesh {
  public:
   // Builds from a manifold, consistently oriented mesh (checked through
@@ -38,7 +40,8 @@ class EditableMesh {
   static uint32_t face_of(uint32_t c) { return c / 3; }
   static uint32_t next(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
   static uint32_t prev(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
-  uint32_t vertex(uint32_t c) const { return faces_[c / 3][c % 3]; }
+  // Faces are packed triples, so corner c is simply the c-th index.
+  uint32_t vertex(uint32_t c) const { return reinterpret_cast<const uint32_t*>(faces_.data())[c]; }
   uint32_t opposite(uint32_t c) const { return opposite_[c]; }
   uint32_t swing_ccw(uint32_t c) const {
     const uint32_t o = opposite_[next(c)];

@@ -183,6 +183,9 @@ class RecordWriter {
       const uint32_t count = static_cast<uint32_t>(order.size());
       RefinementModels& m = s_.models;
       const uint32_t free_faces = mark_taken_faces(s_, star_ring, faces, used_);
+      if (free_faces != free_face_count(s_, u)) {
+        return make_error(ErrorCode::kInvalidMesh, "internal: free face counts disagree");
+      }
       if (free_faces > 0) {
         m.patch_count[count_context(s_, u, free_faces)].encode(enc_, std::min(count, 3u));
         if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);

@@ -81,29 +81,34 @@ Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ri
 }
 
 ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
-  const auto& p = mesh.positions();
+  const Vec3i* p = mesh.positions().data();
   int64_t total = 0;
   int64_t n[3] = {0, 0, 0};
   const size_t k = ring.size();
   const Vec3i o = p[ring[0]];
+  Vec3i a = o;
   for (size_t i = 0; i < k; ++i) {
-    const Vec3i a = p[ring[i]], b = p[ring[(i + 1) % k]];
+    const Vec3i b = i + 1 < k ? p[ring[i + 1]] : o;
     total += std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
     const int64_t ax = a.x - o.x, ay = a.y - o.y, az = a.z - o.z;
     const int64_t bx = b.x - o.x, by = b.y - o.y, bz = b.z - o.z;
     n[0] += ay * bz - az * by;
     n[1] += az * bx - ax * bz;
     n[2] += ax * by - ay * bx;
+    a = b;
   }
   ResidualContext ctx;
   // log2 of the mean L1 edge length, in integers: octave buckets (finer
   // buckets measured slightly worse: too little data per model).
   const uint64_t mean = uint64_t(total) / k + 1;
   ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
-  std::sort(ctx.axis, ctx.axis + 3, [&](int x, int y) {
-    const int64_t ax = std::abs(n[x]), ay = std::abs(n[y]);
-    return ax > ay || (ax == ay && x < y);
-  });
+  // Axes by |normal component|, largest first; ties keep axis order.
+  const int64_t m[3] = {std::abs(n[0]), std::abs(n[1]), std::abs(n[2])};
+  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
+  int* ax = ctx.axis;
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
   ctx.flip = n[ctx.axis[0]] < 0;
   return ctx;
 }
@@ -133,14 +138,19 @@ bool decode_residual(RefinementModels& models, RangeDecoder& dec, const Residual
 
 uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>& star_ring,
                           uint32_t faces, std::vector<uint8_t>& used) {
-  used.assign(faces, 0);
-  uint32_t free_faces = 0;
+  used.resize(faces);
+  if (faces == 0) return 0;
   const size_t n = star_ring.size();
+  // Face i joins ring entries i and i+1 (the last wraps to 0 when interior).
+  const bool first_new = s.vertices[star_ring[0]].layer == s.layer;
+  bool prev_new = first_new;
+  uint32_t free_faces = 0;
   for (uint32_t i = 0; i < faces; ++i) {
-    const bool taken = s.vertices[star_ring[i]].layer == s.layer ||
-                       s.vertices[star_ring[(i + 1) % n]].layer == s.layer;
+    const bool next_new = i + 1 < n ? s.vertices[star_ring[i + 1]].layer == s.layer : first_new;
+    const bool taken = prev_new || next_new;
     used[i] = taken ? 1 : 0;
     free_faces += taken ? 0 : 1;
+    prev_new = next_new;
   }
   return free_faces;
 }
@@ -222,6 +232,16 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
   state.vertices[apex].next = v;
   // Valences: the apex trades its k-3 diagonals for v, R_1 and R_k-1 gain v,
   // and the ends of a re-opened boundary edge lose each other.
+  // Every ring vertex now has one or two faces holding v (none across the
+  // re-opened boundary edge): count them as taken in this layer.
+  for (uint32_t i = 0; i < k; ++i) {
+    RefinementState::VertexEntry& e = state.vertices[patch.ring[i]];
+    if (e.taken_layer != state.layer) {
+      e.taken_layer = state.layer;
+      e.taken = 0;
+    }
+    e.taken += (i != open ? 1u : 0u) + ((i + k - 1) % k != open ? 1u : 0u);
+  }
   state.vertices[apex].valence = state.vertices[apex].valence + 4 - k;
   state.vertices[patch.ring[1]].valence += 1;
   state.vertices[patch.ring[k - 1]].valence += 1;
@@ -296,10 +316,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
     const uint32_t u = state.cursor;
     state.cursor = state.vertices[u].next;
-    mesh.star(u, star_ring, star_corners);
-    const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
-    const uint32_t faces = static_cast<uint32_t>(star_corners.size());
-    const uint32_t free_faces = mark_taken_faces(state, star_ring, faces, used_faces);
+    const uint32_t free_faces = free_face_count(state, u);
     uint32_t count = 0;
     if (free_faces > 0) {
       count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
@@ -307,6 +324,12 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     }
     state.last_count = count;
     if (count == 0) continue;
+    mesh.star(u, star_ring, star_corners);
+    const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
+    const uint32_t faces = static_cast<uint32_t>(star_corners.size());
+    if (mark_taken_faces(state, star_ring, faces, used_faces) != free_faces) {
+      return fail("internal: free face counts disagree");
+    }
     if (count > free_faces || inserted + count > h.insertions) {
       return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
                   " patches, more than it or the record holds");

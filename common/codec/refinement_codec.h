@@ -57,6 +57,8 @@ struct RefinementState {
     uint32_t next = kNone;
     uint32_t layer = 0;
     uint32_t valence = 0;
+    uint32_t taken = 0;        // faces holding a vertex of layer `taken_layer`
+    uint32_t taken_layer = 0;
   };
   std::vector<VertexEntry> vertices;
   uint32_t order_head = kNone;
@@ -83,6 +85,16 @@ struct ResolvedPatch {
 // walk vertex with none cannot be an apex and codes nothing. O(faces).
 uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>& star_ring,
                           uint32_t faces, std::vector<uint8_t>& used);
+
+// The number of u's faces that hold no vertex inserted in the current layer,
+// from counts apply_patch keeps (no swing around u needed). Equals what
+// mark_taken_faces finds.
+inline uint32_t free_face_count(const RefinementState& s, uint32_t u) {
+  const RefinementState::VertexEntry& e = s.vertices[u];
+  const uint32_t faces = e.valence - (s.mesh.is_boundary(u) ? 1 : 0);
+  const uint32_t taken = e.taken_layer == s.layer ? e.taken : 0;
+  return faces > taken ? faces - taken : 0;
+}
 
 // Context of the patch count at walk vertex u: its free faces (capped at
 // 7), whether the previous walk vertex held patches, u's age in layers
