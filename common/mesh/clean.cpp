@@ -35,7 +35,7 @@ std::string describe_non_finite(const Vec3f& p) {
     s << x;
     return s.str();
   };
-  return "(" + one(p.x) + ", " + one(p.y) + ", " + one(p.z) + ")";
+  return std::string("(") + one(p.x) + ", " + one(p.y) + ", " + one(p.z) + ")";
 }
 
 // Applies old->new vertex renumbering (kNone = removed; the first old vertex

@@ -150,7 +150,7 @@ class BodyReader {
       as_float = static_cast<float>(value);
     }
     if (result.ec != std::errc() || result.ptr != last) {
-      error_ = "'" + std::string(token) + "' is not a valid number here";
+      error_ = std::string("'") + std::string(token) + "' is not a valid number here";
       return false;
     }
     pos_ = end;
