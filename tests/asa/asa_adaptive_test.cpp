@@ -24,7 +24,9 @@ TEST(AsaAdaptive, RealMeshesStayConformingManifolds) {
       auto r = subdivide(m, asa(levels, t));
       ASSERT_TRUE(r.has_value()) << name;
       EXPECT_TRUE(asa_test::conforming(m, *r)) << name << " t=" << t;
-      if (t > 0.99f) EXPECT_GT(r->mesh.face_count(), m.face_count()) << name;
+      if (t > 0.99f) {
+        EXPECT_GT(r->mesh.face_count(), m.face_count()) << name;
+      }
       int bisected = 0;
       for (FaceKind k : r->face_kind) bisected += k == FaceKind::kBisected;
       EXPECT_EQ(bisected % 2, 0) << "bisected faces come in pairs";

@@ -116,9 +116,13 @@ TEST(AsaClosure, TwoTargetedNeighboursMakeATargetAndPropagate) {
   // Every face ends with 0, 1 (bisect) or 3 (red) split edges.
   for (uint32_t f = 0; f < L.mesh.face_count(); ++f) {
     const int k = b.edge_split[3 * f] + b.edge_split[3 * f + 1] + b.edge_split[3 * f + 2];
-    if (b.action[f] == kRed) EXPECT_EQ(k, 3);
-    else if (b.action[f] == kBisect) EXPECT_EQ(k, 1);
-    else EXPECT_EQ(k, 0);
+    if (b.action[f] == kRed) {
+      EXPECT_EQ(k, 3);
+    } else if (b.action[f] == kBisect) {
+      EXPECT_EQ(k, 1);
+    } else {
+      EXPECT_EQ(k, 0);
+    }
   }
   expect_topology_consistent(L.split(b));
 }
@@ -135,7 +139,9 @@ TEST(AsaClosure, PropagationReachesAFixedPoint) {
   for (uint32_t f = 0; f < L.mesh.face_count(); ++f) {
     const int k = b.edge_split[3 * f] + b.edge_split[3 * f + 1] + b.edge_split[3 * f + 2];
     EXPECT_TRUE(k == 0 || k == 1 || k == 3) << "face " << f << " has " << k << " split edges";
-    if (target[f]) EXPECT_EQ(b.action[f], kRed);
+    if (target[f]) {
+      EXPECT_EQ(b.action[f], kRed);
+    }
   }
   expect_topology_consistent(L.split(b));
 }
@@ -169,7 +175,9 @@ TEST(AsaClosure, GreenHalfIsNeverBisectedAgain) {
     EXPECT_EQ(b1.action[first], kOpened);
     EXPECT_EQ(b1.action[first + 1], kOpened);
     for (uint32_t f = 0; f < L1.lm.green.size(); ++f)
-      if (L1.lm.green[f] != kNotGreen) EXPECT_NE(b1.action[f], kBisect) << "green face " << f << " bisected";
+      if (L1.lm.green[f] != kNotGreen) {
+        EXPECT_NE(b1.action[f], kBisect) << "green face " << f << " bisected";
+      }
     LevelMesh level2 = L1.split(b1);
     expect_topology_consistent(level2);
     // The parent's split reuses M: no new vertex lies on the old edge B-C
@@ -193,7 +201,9 @@ TEST(AsaClosure, GreenHalfIsNeverBisectedAgain) {
       EXPECT_EQ(b2.action[first + 1], kOpened);
     }
     for (uint32_t f = 0; f < L1.lm.green.size(); ++f)
-      if (L1.lm.green[f] != kNotGreen) EXPECT_NE(b2.action[f], kBisect);
+      if (L1.lm.green[f] != kNotGreen) {
+        EXPECT_NE(b2.action[f], kBisect);
+      }
     expect_topology_consistent(L1.split(b2));
   }
 }

@@ -63,7 +63,9 @@ void run_records(const Mesh& start, const AsaOptions& options, int records, cons
     EXPECT_TRUE(same_output(inc.result(), *full)) << what << " after record " << r;
     EXPECT_TRUE(asa_test::conforming(m, inc.result())) << what << " after record " << r;
   }
-  if (expect_partial) EXPECT_GT(partial, records / 2) << what << ": most updates should be partial";
+  if (expect_partial) {
+    EXPECT_GT(partial, records / 2) << what << ": most updates should be partial";
+  }
 }
 
 TEST(AsaIncremental, UniformMatchesFullSubdivision) {
