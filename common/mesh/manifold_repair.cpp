@@ -334,13 +334,14 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
     const auto [detached, copies] = detach_extra_faces(mesh, groups);
     counts.detached_faces += detached;
     counts.split_vertices += copies;
-    // The corner table is the judge (and the cheapest full check): usually
-    // satisfied after the first round; detaching can leave new non-manifold
-    // vertices for another round.
+    // Detaching faces nearly always leaves new non-manifold vertices: go
+    // straight to another round. Otherwise the corner table is the judge
+    // (and the cheapest full check).
+    if (detached > 0) continue;
     auto adjacency = Adjacency::build(mesh);
     if (adjacency) return counts;
     last_problem = adjacency.error().message;
-    if (*flipped == 0 && split == 0 && detached == 0) break;  // stuck
+    if (*flipped == 0 && split == 0) break;  // stuck
   }
   return make_error(ErrorCode::kNonManifold, "non-manifold repair did not converge: " + last_problem);
 }
