@@ -27,6 +27,7 @@ struct DisplayBuilder::State {
   AsaOptions incremental_options;
   float dirty_fraction = 0.25f;
   double full_ms_per_face = 0;  // measured on the last full run
+  std::vector<uint8_t> seen;    // scratch: changed faces counted once
 };
 
 DisplayBuilder::DisplayBuilder() : state_(std::make_unique<State>()) {}
@@ -49,11 +50,32 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   const uint32_t F = mesh.face_count();
   const auto start = Clock::now();
 
-  if (path_ == AsaPath::kFull) {
+  // Auto: an update that rewrote a large part of the mesh (typically many
+  // coalesced records) goes straight to a plain full run; the incremental
+  // subdivider would only find that out after diffing the whole mesh, and
+  // its result would still have to be copied.
+  bool plain_full = path_ == AsaPath::kFull;
+  if (path_ == AsaPath::kAuto && !changes.full && !options_changed && F > 0) {
+    s.seen.assign(F, 0);
+    uint32_t unique = 0;
+    for (uint32_t f : changes.faces) {
+      if (f < F && !s.seen[f]) {
+        s.seen[f] = 1;
+        ++unique;
+      }
+    }
+    // The dirty region is the changed faces widened by a few rings: several
+    // times larger than the changed faces themselves.
+    plain_full = 4.0 * double(unique) > double(s.dirty_fraction) * double(F);
+  } else if (path_ == AsaPath::kAuto && changes.full) {
+    plain_full = true;
+  }
+  if (plain_full) {
     s.incremental.reset();
     AsaResult result;
     if (auto st = subdivide_into(mesh, options, s.workspace, result); !st) return tl::unexpected(st.error());
     report.asa_ms = ms_since(start);
+    if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
     DisplayMesh out;
     out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
     out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
