@@ -236,7 +236,7 @@ int main(int argc, char** argv) {
         "Zorin rule; path auto). Times are the client's own clock from its start (resolve + connect + Hello) "
         "to the event. Unthrottled rows are medians of "
      << (quick ? 1 : 3) << " runs; throttled rows one run. Load average when the run started: "
-     << read_text("/proc/loadavg").substr(0, 14) << "(the 2 cores are shared: figures include waiting "
+     << read_text("/proc/loadavg").substr(0, 14) << " (the 2 cores are shared: figures include waiting "
      << "for CPU).\n\n";
   std::vector<std::string> first_display_notes, budget_notes;
   md << "| model | stream | records | rate | first display ms | half the records ms | end ms | display updates | "
