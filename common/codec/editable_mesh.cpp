@@ -183,11 +183,13 @@ uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
   }
   // The new vertex starts at the face after its open edge (any face if interior).
   vertex_corner_[v] = open == kNone ? 3 * slot[0] : 3 * slot[(open + 1) % k];
+  uint32_t fan_face[kMaxPatchValence];
+  for (uint32_t j = 0; j + 2 < k; ++j) fan_face[j] = face_of(fan_corners[j]);
   auto in_fan = [&](uint32_t c) {
     if (c == kNone) return false;
     const uint32_t f = face_of(c);
     for (uint32_t j = 0; j + 2 < k; ++j)
-      if (face_of(fan_corners[j]) == f) return true;
+      if (fan_face[j] == f) return true;
     return false;
   };
   for (uint32_t i = 0; i < k; ++i) {

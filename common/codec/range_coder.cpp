@@ -6,6 +6,7 @@
 namespace meshstream {
 namespace {
 
+// Keep in step with RangeDecoder::decode_bit in the header.
 constexpr uint32_t kTop = 1u << 24;
 constexpr int kModelBits = 11;
 constexpr int kMoveBits = 5;
@@ -76,26 +77,6 @@ std::vector<uint8_t> RangeEncoder::finish() {
 
 RangeDecoder::RangeDecoder(std::span<const uint8_t> in) : in_(in) {
   for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
-}
-
-uint32_t RangeDecoder::decode_bit(BitModel& model) {
-  const uint32_t bound = (range_ >> kModelBits) * model.p;
-  uint32_t bit;
-  if (code_ < bound) {
-    range_ = bound;
-    model.p = static_cast<uint16_t>(model.p + (((1u << kModelBits) - model.p) >> kMoveBits));
-    bit = 0;
-  } else {
-    code_ -= bound;
-    range_ -= bound;
-    model.p = static_cast<uint16_t>(model.p - (model.p >> kMoveBits));
-    bit = 1;
-  }
-  while (range_ < kTop) {
-    range_ <<= 8;
-    code_ = (code_ << 8) | next_byte();
-  }
-  return bit;
 }
 
 uint32_t RangeDecoder::decode_direct(int count) {

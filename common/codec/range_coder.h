@@ -46,7 +46,26 @@ class RangeEncoder {
 class RangeDecoder {
  public:
   explicit RangeDecoder(std::span<const uint8_t> in);
-  uint32_t decode_bit(BitModel& model);
+  // Inline: it runs for every coded bit.
+  uint32_t decode_bit(BitModel& model) {
+    const uint32_t bound = (range_ >> 11) * model.p;
+    uint32_t bit;
+    if (code_ < bound) {
+      range_ = bound;
+      model.p = static_cast<uint16_t>(model.p + ((2048u - model.p) >> 5));
+      bit = 0;
+    } else {
+      code_ -= bound;
+      range_ -= bound;
+      model.p = static_cast<uint16_t>(model.p - (model.p >> 5));
+      bit = 1;
+    }
+    while (range_ < (1u << 24)) {
+      range_ <<= 8;
+      code_ = (code_ << 8) | next_byte();
+    }
+    return bit;
+  }
   uint32_t decode_direct(int count);
   // Bytes requested past the end of the input. A correct stream needs at
   // most 8 of them: the decoder looks 4 bytes ahead and the encoder drops up
