@@ -162,39 +162,65 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
   const uint32_t fan = k - 2;
   const bool boundary = mesh.is_boundary(apex);
   if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return;
-  const auto& p = mesh.positions();
+  const Vec3i* p = mesh.positions().data();
   auto l2 = [&](uint32_t a, uint32_t b) {
     const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y, dz = int64_t(p[a].z) - p[b].z;
     return dx * dx + dy * dy + dz * dz;
   };
-  thread_local std::vector<int64_t> edge;
-  thread_local std::vector<std::pair<int64_t, uint32_t>> scored;
-  scored.clear();
+  // Scratch on the stack for ordinary stars, on the heap for huge ones.
+  constexpr uint32_t kSmall = 64;
+  int64_t edge_small[kSmall], score_small[kSmall];
+  std::vector<int64_t> edge_big, score_big;
+  int64_t* edge = edge_small;
+  int64_t* score = score_small;
+  if (faces > kSmall) {
+    edge_big.resize(faces);
+    score_big.resize(faces);
+    edge = edge_big.data();
+    score = score_big.data();
+  }
   const uint32_t last_start = boundary ? faces - fan : faces - 1;
+  const size_t ring_n = star_ring.size();
   if (k == 3) {
     for (uint32_t r = 0; r <= last_start; ++r) {
       if (used[r]) continue;
-      scored.push_back({-l2(star_ring[r], star_ring[(r + 1) % star_ring.size()]), r});
+      const uint32_t b = r + 1 < ring_n ? r + 1 : 0;
+      score[out.size()] = l2(star_ring[r], star_ring[b]);
+      out.push_back(r);
     }
   } else {
     // Squared apex edge lengths, then a sliding sum over the k-3 diagonals
     // of each run (ring entries r+1 .. r+k-3).
-    edge.resize(faces);
     for (uint32_t i = 0; i < faces; ++i) edge[i] = l2(apex, star_ring[i]);
+    auto wrap = [faces](uint32_t i) { return i >= faces ? i - faces : i; };
     int64_t window = 0;
-    for (uint32_t j = 1; j < fan; ++j) window += edge[j % faces];
+    for (uint32_t j = 1; j < fan; ++j) window += edge[wrap(j)];
     uint32_t used_in_run = 0;
-    for (uint32_t j = 0; j < fan; ++j) used_in_run += used[j % faces];
+    for (uint32_t j = 0; j < fan; ++j) used_in_run += used[wrap(j)];
     for (uint32_t r = 0; r <= last_start; ++r) {
-      if (used_in_run == 0) scored.push_back({-window, r});
+      if (used_in_run == 0) {
+        score[out.size()] = window;
+        out.push_back(r);
+      }
       // Slide the run one face on: drop face r and diagonal r+1, add the next.
-      window += edge[(r + fan) % faces] - edge[(r + 1) % faces];
-      used_in_run += used[(r + fan) % faces];
+      window += edge[wrap(r + fan)] - edge[wrap(r + 1)];
+      used_in_run += used[wrap(r + fan)];
       used_in_run -= used[r];
     }
   }
-  std::sort(scored.begin(), scored.end());
-  for (const auto& e : scored) out.push_back(e.second);
+  // Larger score first, ties by r (stable insertion sort: runs are few).
+  for (size_t i = 1; i < out.size(); ++i) {
+    const int64_t sc = score[i];
+    const uint32_t r = out[i];
+    size_t j = i;
+    while (j > 0 && score[j - 1] < sc) {
+      score[j] = score[j - 1];
+      out[j] = out[j - 1];
+      --j;
+    }
+    score[j] = sc;
+    out[j] = r;
+  }
 }
 
 void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
