@@ -55,6 +55,13 @@ uint32_t DecodedStream::records_decoded() const {
   return decoder_.records_decoded();
 }
 
+std::optional<std::pair<uint64_t, uint32_t>> DecodedStream::index_summary() const {
+  std::lock_guard lock(mutex_);
+  const StreamIndex* index = decoder_.index();
+  if (!index) return std::nullopt;
+  return std::make_pair(index->total_bytes(), static_cast<uint32_t>(index->records.size()));
+}
+
 uint64_t DecodedStream::bytes_received() const {
   std::lock_guard lock(mutex_);
   return bytes_received_;

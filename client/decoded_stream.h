@@ -62,6 +62,9 @@ class DecodedStream {
   Status resume_at(uint64_t offset);
   uint64_t resume_offset() const;
   uint32_t records_decoded() const;
+  // From the stream's own index once its prefix arrived: (total bytes,
+  // records); nullopt before.
+  std::optional<std::pair<uint64_t, uint32_t>> index_summary() const;
   uint64_t bytes_received() const;
   void set_bytes_received(uint64_t offset);
   void finish(StreamOutcome outcome);

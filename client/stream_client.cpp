@@ -230,6 +230,22 @@ StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
       }
       expected = end;
       if (decoded.records_decoded() > before) progressed = true;
+      // The header repeats the stream's own index: they must agree, or the
+      // records counted and resumed from would not be the stream's.
+      if (!index_checked_) {
+        if (auto summary = decoded.index_summary()) {
+          index_checked_ = true;
+          if (summary->first != facts_->total_bytes || summary->second != facts_->records_total) {
+            error = Error{ErrorCode::kCorrupt,
+                          "model '" + target_.model + "': the server's header announces " +
+                              std::to_string(facts_->records_total) + " records and " +
+                              std::to_string(facts_->total_bytes) + " bytes, the stream's own index " +
+                              std::to_string(summary->second) + " records and " +
+                              std::to_string(summary->first) + " bytes"};
+            return Attempt::kFatal;
+          }
+        }
+      }
       continue;
     }
     if (message->has_end()) {

@@ -102,6 +102,7 @@ class StreamClient {
 
   StreamTarget target_;
   std::optional<StreamFacts> facts_;
+  bool index_checked_ = false;  // header compared with the stream's own index
   std::atomic<bool> stop_{false};
   std::atomic<bool> paused_{false};
   std::atomic<int> reconnects_{0};
