@@ -3,6 +3,7 @@
 #include "common/asa/subdivide.h"
 
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -138,6 +139,28 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     } else {
       if (level > 0) asa::compute_face_normals(view, ws.normals);
       const uint32_t targets = asa::mark_targets(view, ws.normals, options.flatness, ws.target);
+      if (targets == 0) {
+        // Nothing bends: this and every later level would copy the mesh
+        // unchanged (same normals, same verdicts). Stop here.
+        const size_t V = view.vertex_count, F = view.face_count;
+        result.mesh.positions.assign(view.positions, view.positions + V);
+        result.mesh.triangles.resize(F);
+        if (F) std::memcpy(result.mesh.triangles.data(), view.corner_vertex, F * sizeof(Triangle));
+        if (colors) result.mesh.colors.assign(colors, colors + V);
+        else result.mesh.colors.clear();
+        if (texcoords) result.mesh.texcoords.assign(texcoords, texcoords + V);
+        else result.mesh.texcoords.clear();
+        result.face_kind.assign(F, FaceKind::kUntouched);
+        if (source) result.source_face.assign(source, source + F);
+        else result.source_face.clear();
+        if (!mesh.normals.empty()) result.mesh.normals = compute_vertex_normals(result.mesh);
+        else result.mesh.normals.clear();
+        for (int rest = level; rest < options.levels; ++rest) {
+          ws.stats.targets.push_back(0);
+          ws.stats.split_edges.push_back(0);
+        }
+        return {};
+      }
       const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
       asa::split_adaptive(in, ws.closure, ws.scratch, out, kinds);
       ws.stats.targets.push_back(targets);
