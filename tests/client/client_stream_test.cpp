@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/client/client_harness.h"
+#include "tests/test_meshes.h"
 
 namespace meshstream::clienttest {
 namespace {
@@ -311,6 +312,29 @@ TEST_F(ClientStreamTest, ThrottledStreamShowsSeveralRefinementsBeforeTheEnd) {
   size_t early = 0;
   for (const auto& e : refinements) early += e["elapsed_ms"].get<double>() < end_ms / 2;
   EXPECT_GE(early, 3u);
+}
+
+// A real scanned mesh (with holes: boundary rules in ASA), encoded by the
+// offline tool and served as .hcs.
+TEST_F(ClientStreamTest, RealMeshFinalMeshesEqualOfflineDecodeAndSubdivide) {
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  const std::string input = meshstream::testing::test_mesh("bun_zipper.ply");
+  if (!fs::exists(input)) GTEST_SKIP() << input << " not found";
+  TempDir models, out;
+  const std::string hcs = models / "bunny.hcs";
+  ASSERT_EQ(run({tool_bin(), "encode", input, "-o", hcs}, out / "enc.out", out / "enc.err"), 0)
+      << read_text(out / "enc.err");
+  Server server;
+  ASSERT_TRUE(server.start({"--models", models.path(), "--cache", out / "cache"}, out.path())) << server.log();
+  const ClientRun r = client(server.address(), {"bunny", "--json", "--out", out / "snaps"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_monotone_events(r.events);
+  ASSERT_EQ(run({tool_bin(), "decode", hcs, "-o", out / "decoded.ply"}, out / "dec.out", out / "dec.err"), 0);
+  EXPECT_EQ(read_text(out / "snaps/final.decoded.ply"), read_text(out / "decoded.ply"));
+  ASSERT_EQ(run({tool_bin(), "subdivide", out / "decoded.ply", "-o", out / "sub.ply"}, out / "sub.out",
+                out / "sub.err"),
+            0);
+  EXPECT_TRUE(same_geometry(load_ply(out / "snaps/final.ply"), load_ply(out / "sub.ply")));
 }
 
 TEST_F(ClientStreamTest, ListsTheCatalog) {
