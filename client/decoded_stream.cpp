@@ -25,6 +25,13 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
       pending_.faces.insert(pending_.faces.end(), d.touched_faces.begin(), d.touched_faces.end());
     }
   }
+  // Past one entry per face, copying the whole mesh is cheaper than the
+  // list (and the list would grow without bound behind a slow pipeline).
+  if (!pending_.full && pending_.faces.size() + pending_.vertices.size() > decoder_.mesh().triangles.size()) {
+    pending_.full = true;
+    pending_.vertices.clear();
+    pending_.faces.clear();
+  }
   pending_updates_ += *applied;
   pending_decode_ms_ += ms;
   lock.unlock();
