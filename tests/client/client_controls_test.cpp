@@ -128,5 +128,31 @@ TEST_F(ClientControlsTest, SetAsaReRunsOnTheCurrentMesh) {
   EXPECT_GT(on->display->face_count(), final_frame->display->face_count());
 }
 
+// Network reads never wait for ASA: with ASA far slower than the stream,
+// the network side has every record long before the pipeline is done, and
+// the pipeline shows the newest mesh, merging the records in between.
+TEST_F(ClientControlsTest, NetworkNeverWaitsForASlowPipeline) {
+  Server server;
+  ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache", "--max-chunk-bytes", "1024"},
+                           dir_.path()))
+      << server.log();
+  PipelineSettings settings;
+  settings.asa.levels = 3;  // tens of ms per update on this mesh
+  settings.path = AsaPath::kFull;
+  Session s(server, settings);
+  const auto start = std::chrono::steady_clock::now();
+  s.network.join();  // the network side ends on its own
+  const auto network_done = std::chrono::steady_clock::now();
+  ASSERT_TRUE(s.decoded.outcome() && s.decoded.outcome()->ok);
+  ASSERT_TRUE(s.pipeline->wait_finished());
+  const auto pipeline_done = std::chrono::steady_clock::now();
+  auto last = s.mailbox.take_newer(0);
+  ASSERT_TRUE(last && last->final);
+  EXPECT_LT(network_done - start, pipeline_done - start);
+  // Fewer frames than records: the records that arrived during a run of
+  // ASA were merged into the next frame.
+  EXPECT_LT(last->sequence, last->records_decoded);
+}
+
 }  // namespace
 }  // namespace meshstream::client
