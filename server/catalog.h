@@ -76,8 +76,10 @@ struct MeshFolderOptions {
 // imported and encoded at start-up on all cores, cached.
 std::unique_ptr<CatalogSource> mesh_folder_source(MeshFolderOptions options);
 
-// The procedural demo models (no folder needed).
-std::unique_ptr<CatalogSource> demo_source();
+// The procedural demo models (no folder needed): "demo" (trefoil, ~100k
+// vertices), "demo-small" (~10k) and "torus", encoded at start-up and cached
+// in `cache_dir` (empty = no cache).
+std::unique_ptr<CatalogSource> demo_source(std::string cache_dir, unsigned threads = 0);
 
 // Whether this build can import and encode mesh files / make demo models
 // (they need the mesh and codec modules' implementations).

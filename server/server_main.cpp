@@ -20,7 +20,7 @@ Catalog load_catalog(const ServerOptions& options) {
     sources.push_back(hcs_folder_source(options.models_dir));
     sources.push_back(mesh_folder_source({options.models_dir, options.cache_dir, 0}));
   }
-  if (options.demo) sources.push_back(demo_source());
+  if (options.demo) sources.push_back(demo_source(options.cache_dir));
   Catalog catalog;
   for (auto& source : sources) {
     source->load(catalog, [](const std::string& line) { spdlog::info("catalog: {}", line); });

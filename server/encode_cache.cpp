@@ -1,0 +1,121 @@
+#include "server/encode_cache.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#if MESHSTREAM_HAVE_MESH_ENCODER
+#include "common/codec/encoder.h"
+#endif
+
+namespace meshstream::server {
+
+namespace fs = std::filesystem;
+
+bool encoder_built() { return MESHSTREAM_HAVE_MESH_ENCODER != 0; }
+
+EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir) {
+  EncodeOutcome out;
+  const auto start = std::chrono::steady_clock::now();
+  auto finish = [&](Result<CatalogModel> model) {
+    out.model = std::move(model);
+    out.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  };
+#if MESHSTREAM_HAVE_MESH_ENCODER
+  const EncodeOptions options;
+  const fs::path cached =
+      cache_dir.empty() ? fs::path()
+                        : fs::path(cache_dir) / (job.key + "-q" + std::to_string(options.quant_bits) +
+                                                 "-e" + std::to_string(kEncoderVersion) + ".hcs");
+  if (!cache_dir.empty() && fs::exists(cached)) {
+    if (auto bytes = map_file(cached.string())) {
+      if (auto model = make_model(job.name, job.source, job.origin, std::move(*bytes))) {
+        out.from_cache = true;
+        return finish(std::move(model));
+      }
+    }
+    // A broken cache entry is re-encoded below and replaced.
+  }
+  auto mesh = job.make_mesh();
+  if (!mesh) return finish(tl::unexpected(mesh.error()));
+  auto encoded = encode_hcs(*mesh, options);
+  if (!encoded) return finish(tl::unexpected(std::move(encoded.error()).with_context(job.origin)));
+  if (!cache_dir.empty()) {
+    // Write then rename, so a concurrent or interrupted start never maps a
+    // half-written file.
+    const fs::path tmp = cached.string() + ".tmp" + std::to_string(::getpid());
+    std::ofstream file(tmp, std::ios::binary);
+    file.write(reinterpret_cast<const char*>(encoded->data()),
+               static_cast<std::streamsize>(encoded->size()));
+    file.close();
+    std::error_code ec;
+    if (file) fs::rename(tmp, cached, ec);
+    if (file && !ec) {
+      if (auto bytes = map_file(cached.string())) {
+        return finish(make_model(job.name, job.source, job.origin, std::move(*bytes)));
+      }
+    }
+    fs::remove(tmp, ec);
+  }
+  return finish(make_model(job.name, job.source, job.origin, own_bytes(std::move(*encoded))));
+#else
+  (void)cache_dir;
+  return finish(make_error(ErrorCode::kUnsupported,
+                           job.origin + ": this build cannot encode meshes (no encoder)"));
+#endif
+}
+
+void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsigned threads,
+                Catalog& catalog, const CatalogLog& log) {
+  if (jobs.empty()) return;
+  if (!cache_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(cache_dir, ec);
+    if (ec) {
+      log("cache " + cache_dir + " unusable (" + ec.message() + "); encoding in memory");
+      cache_dir.clear();
+    }
+  }
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(jobs.size())));
+  std::vector<EncodeOutcome> outcomes(jobs.size());
+  std::atomic<size_t> next{0};
+  size_t done = 0;
+  std::mutex log_mutex;
+  auto work = [&] {
+    for (size_t i = next++; i < jobs.size(); i = next++) {
+      outcomes[i] = encode_cached(jobs[i], cache_dir);
+      std::lock_guard lock(log_mutex);
+      std::string line = "[" + std::to_string(++done) + "/" + std::to_string(jobs.size()) + "] ";
+      const EncodeOutcome& o = outcomes[i];
+      if (o.model) {
+        char facts[256];
+        std::snprintf(facts, sizeof facts, "%s %s: %u vertices, %zu bytes in %.2f s",
+                      o.from_cache ? "from cache" : "encoded", jobs[i].origin.c_str(),
+                      o.model->index.header.vertex_count, o.model->stream().size(), o.seconds);
+        line += facts;
+      } else {
+        line += "skipped: " + o.model.error().message;  // errors name the input
+      }
+      log(line);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  for (EncodeOutcome& o : outcomes) {
+    if (o.model) (void)catalog.add(std::move(*o.model));
+  }
+}
+
+}  // namespace meshstream::server

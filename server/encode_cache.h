@@ -1,0 +1,46 @@
+// Encoding meshes into catalog models with an on-disk cache: a stream is
+// stored as `<cache>/<key>-q<bits>-e<kEncoderVersion>.hcs`, so the same input
+// encoded by the same encoder version is mapped, not encoded, on the next
+// start. Used by the mesh-folder and demo catalog sources.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "common/base/result.h"
+#include "common/mesh/mesh.h"
+#include "server/catalog.h"
+
+namespace meshstream::server {
+
+struct EncodeJob {
+  std::string name;    // catalog name
+  std::string source;  // "mesh" or "demo"
+  std::string origin;  // for messages
+  std::string key;     // identifies the input (content hash, demo parameters)
+  // Produces the mesh to encode; called only on a cache miss.
+  std::function<Result<Mesh>()> make_mesh;
+};
+
+struct EncodeOutcome {
+  Result<CatalogModel> model = make_error(ErrorCode::kIo, "not run");
+  bool from_cache = false;
+  double seconds = 0;
+};
+
+// Maps the cached stream for `job` or makes, encodes, caches and maps it.
+// `cache_dir` empty = no cache (the stream is kept in memory). A broken
+// cache entry is re-encoded and replaced; writes are atomic (temp + rename).
+// Thread-safe for distinct keys. Cost: an encode on a miss, O(1) on a hit.
+EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir);
+
+// Runs `jobs` on `threads` threads (0 = one per core), calling `log` with a
+// progress line as each finishes ("[3/12] encoded bunny.ply: ..."), and adds
+// the successes to `catalog` in job order.
+void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsigned threads,
+                Catalog& catalog, const CatalogLog& log);
+
+// Whether this build has the mesh importer, encoder and demo meshes.
+bool encoder_built();
+
+}  // namespace meshstream::server
