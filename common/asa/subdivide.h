@@ -102,7 +102,7 @@ Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options, AsaWork
 // (O(V + F)), later levels derive theirs while splitting. On error `result`
 // is left unspecified. Bad input: errors from validate_arrays and
 // Adjacency::build; kInvalidArgument for options out of range; kLimit when
-// the output would exceed 1e9 faces.
+// the output would exceed 1e9 faces. `result.mesh` must not be `mesh` itself.
 Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
                       AsaResult& result);
 
