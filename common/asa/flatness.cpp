@@ -64,19 +64,21 @@ uint32_t count_vertex_faces(const LevelView& m, std::vector<uint32_t>& faces) {
 
 uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, float t,
                       std::vector<uint8_t>& target) {
-  target.assign(m.face_count, 0);
+  target.resize(m.face_count);
   uint32_t count = 0;
+  // Each face tests its own three edges (every edge is tested from both
+  // sides: the dot product is symmetric bit for bit), so the loop writes only
+  // its own flag and has no data-dependent skip.
   for (uint32_t f = 0; f < m.face_count; ++f) {
     const Vec3f n = normals[f];
+    uint8_t bent = 0;
     for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
       const uint32_t o = m.opposite[c];
-      // Each edge once, from its smaller corner; feature edges are skipped.
-      if (o == kNone || o < c || m.feature_edge[c]) continue;
-      if (dot(n, normals[o / 3]) <= t) {
-        count += !target[f] + !target[o / 3];
-        target[f] = target[o / 3] = 1;
-      }
+      if (o == kNone || m.feature_edge[c]) continue;  // boundary edges are feature edges too
+      bent |= dot(n, normals[o / 3]) <= t;
     }
+    target[f] = bent;
+    count += bent;
   }
   return count;
 }
