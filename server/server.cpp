@@ -77,6 +77,14 @@ Status Server::listen() {
                                           std::to_string(options_.listen_port) + ": " + ec.message());
   }
   acceptor_ = std::move(acceptor);
+  // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
+  // queues a signal that arrives before run() and delivers it then.
+  signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);
+  signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
+    if (ec) return;
+    spdlog::info("received signal {}", signal);
+    stop();
+  });
   return {};
 }
 
@@ -151,12 +159,6 @@ void Server::run(std::chrono::milliseconds grace) {
     worker->guard = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(
         worker->io.get_executor());
   }
-  signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);
-  signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
-    if (ec) return;
-    spdlog::info("received signal {}", signal);
-    stop();
-  });
   asio::co_spawn(workers_[0]->io, accept_loop(), [](std::exception_ptr e) {
     if (!e) return;
     try {

@@ -26,8 +26,9 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and listens on options.listen_host:listen_port. kIo when the
-  // address is unusable (in use, not local, not an address).
+  // Binds and listens on options.listen_host:listen_port, and from then on
+  // turns SIGINT/SIGTERM into stop(). kIo when the address is unusable (in
+  // use, not local, not an address).
   Status listen();
   // The bound address (after listen()); port is the real one for port 0.
   net::tcp::endpoint local_endpoint() const;

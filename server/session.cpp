@@ -21,6 +21,10 @@ constexpr auto kLinger = std::chrono::milliseconds(1000);
 constexpr size_t kMinChunkBytes = 1024;
 constexpr size_t kMaxChunkBytes = 1 << 20;
 constexpr size_t kReadBufferBytes = 2048;
+// Slow start: a stream's first chunk is at most this large and each next one
+// may be twice as large, up to the stream's chunk size. Under load every
+// client gets its prefix and base mesh before anyone gets bulk data.
+constexpr size_t kFirstChunkBytes = 8 * 1024;
 
 std::string describe(const asio::ip::tcp::socket& socket) {
   boost::system::error_code ec;
@@ -361,7 +365,9 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
         if (!co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET)) break;
         continue;
       }
-      const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, s.chunk_bytes);
+      const size_t limit =
+          std::min(s.chunk_bytes, kFirstChunkBytes << std::min<uint32_t>(s.chunks_sent, 20));
+      const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
       const size_t size = static_cast<size_t>(cut.end - s.position);
       const auto delay = s.bucket.take(size, Clock::now());
       if (delay > Clock::duration::zero()) {
@@ -381,6 +387,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       s.position = cut.end;
       s.bytes_sent += size;
       s.records_complete = cut.records_complete;
+      ++s.chunks_sent;
       bytes_total_ += size;
       continue;
     }

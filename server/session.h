@@ -83,6 +83,7 @@ class Session : public std::enable_shared_from_this<Session> {
     uint64_t bytes_sent = 0;
     uint32_t records_complete;
     TokenBucket bucket;
+    uint32_t chunks_sent = 0;
   };
 
   net::asio::awaitable<void> read_loop(std::shared_ptr<Session> self);
