@@ -239,10 +239,15 @@ int main(int argc, char** argv) {
   std::string report_dir;
   std::vector<size_t> client_counts{1, 100, 1000};
   std::string model_choice = "auto";
+  unsigned server_threads = 0;
+  unsigned repeat = 3;
   app.add_option("--report-dir", report_dir, "write server.md here");
   app.add_option("--clients", client_counts, "client counts to run")->delimiter(',');
   app.add_option("--model", model_choice, "auto, dragon, demo or synthetic")
       ->check(CLI::IsMember({"auto", "dragon", "demo", "synthetic"}));
+  app.add_option("--repeat", repeat, "runs per client count (median reported)")
+      ->check(CLI::Range(1u, 100u));
+  app.add_option("--server-threads", server_threads, "server io threads (0 = its default)");
   CLI11_PARSE(app, argc, argv);
   raise_fd_limit();
   rlimit limit{};
@@ -254,6 +259,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> args{"--cache", (work / "cache").string(), "--max-connections", "5000",
                                 "--log-level", "warn", "--handshake-timeout-ms", "60000",
                                 "--stall-timeout-ms", "60000"};
+  if (server_threads) args.insert(args.end(), {"--threads", std::to_string(server_threads)});
   std::string model, model_text;
   std::vector<uint8_t> model_bytes;
   const std::string meshes = meshstream::testing::test_mesh_dir();
@@ -307,23 +313,48 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  std::vector<Scenario> results;
+  // Each row: the median of every metric over --repeat runs (the machine is
+  // shared, single runs vary), errors summed, peak RSS the largest seen.
+  struct Row {
+    size_t clients = 0;
+    std::vector<double> mbps, first50, first99, end50, end99, hello50, hello99, growth;
+    double peak_mib = 0;
+    size_t errors = 0;
+  };
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? -1.0 : v[v.size() / 2];
+  };
+  std::vector<Row> rows;
   for (size_t n : client_counts) {
     if (n == 0) continue;
-    std::cerr << "load_bench: " << n << " clients...\n";
-    results.push_back(run_scenario(args, work.string(), model, model_bytes, n));
-    const Scenario& r = results.back();
-    std::vector<double> first, end, hello;
-    for (const auto& t : r.times) {
-      first.push_back(t.first_chunk_ms);
-      end.push_back(t.end_ms);
-      hello.push_back(t.connect_hello_ms);
+    Row row;
+    row.clients = n;
+    for (unsigned rep = 0; rep < repeat; ++rep) {
+      const Scenario r = run_scenario(args, work.string(), model, model_bytes, n);
+      std::vector<double> first, end, hello;
+      for (const auto& t : r.times) {
+        first.push_back(t.first_chunk_ms);
+        end.push_back(t.end_ms);
+        hello.push_back(t.connect_hello_ms);
+      }
+      row.mbps.push_back(double(r.bytes) / 1e6 / std::max(r.seconds, 1e-9));
+      row.first50.push_back(percentile(first, 50));
+      row.first99.push_back(percentile(first, 99));
+      row.end50.push_back(percentile(end, 50));
+      row.end99.push_back(percentile(end, 99));
+      row.hello50.push_back(percentile(hello, 50));
+      row.hello99.push_back(percentile(hello, 99));
+      row.growth.push_back(double(r.rss_connected_kib - r.rss_idle_kib) / double(n));
+      row.peak_mib = std::max(row.peak_mib, double(r.hwm_kib) / 1024.0);
+      row.errors += r.errors;
+      std::fprintf(stderr,
+                   "load_bench: %zu clients: %.1f MB/s, first chunk p50 %.2f p99 %.2f ms, end "
+                   "p50 %.2f p99 %.2f ms, errors %zu\n",
+                   n, row.mbps.back(), row.first50.back(), row.first99.back(), row.end50.back(),
+                   row.end99.back(), r.errors);
     }
-    std::fprintf(stderr,
-                 "  %zu clients: %.1f MB/s, first chunk p50 %.2f p99 %.2f ms, end p50 %.2f p99 "
-                 "%.2f ms, errors %zu\n",
-                 n, double(r.bytes) / 1e6 / std::max(r.seconds, 1e-9), percentile(first, 50),
-                 percentile(first, 99), percentile(end, 50), percentile(end, 99), r.errors);
+    rows.push_back(row);
   }
 
   std::string md;
@@ -331,38 +362,41 @@ int main(int argc, char** argv) {
   md += "## Server under load (load_bench)\n\n";
   md += "N clients on loopback each open a connection and say Hello; once all are connected "
         "they request the same model at once and read it to the end. Every stream is checked "
-        "byte-exact against the model's bytes (offsets contiguous, memcmp of every chunk). Server: `meshstream-server` with its "
-        "defaults (one io thread per core, 2 cores shared with the clients), separate process "
-        "per row.\n\n";
-  std::snprintf(line, sizeof line, "Model: %s; %zu bytes per stream. Open files limit: %llu.\n\n",
-                model_text.c_str(), model_bytes.size(),
+        "byte-exact against the model's bytes (offsets contiguous, memcmp of every chunk). "
+        "Server: `meshstream-server` with its defaults (one io thread per core), a fresh process "
+        "per run; the clients are one Asio thread in the bench process, on the same 2 cores "
+        "(shared with other work on this machine).\n\n";
+  std::snprintf(line, sizeof line,
+                "Model: %s; %zu bytes per stream. Each row is the median over %u runs. Open "
+                "files limit: %llu.\n\n",
+                model_text.c_str(), model_bytes.size(), repeat,
                 static_cast<unsigned long long>(limit.rlim_cur));
   md += line;
   md += "| clients | aggregate MB/s | first chunk p50 / p99 ms | end p50 / p99 ms | connect+hello "
         "p50 / p99 ms | server peak RSS MiB | RSS growth per open connection KiB | errors |\n";
   md += "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const Scenario& r : results) {
-    std::vector<double> first, end, hello;
-    for (const auto& t : r.times) {
-      first.push_back(t.first_chunk_ms);
-      end.push_back(t.end_ms);
-      hello.push_back(t.connect_hello_ms);
-    }
-    const double growth =
-        r.clients ? double(r.rss_connected_kib - r.rss_idle_kib) / double(r.clients) : 0;
+  size_t errors = 0;
+  for (const Row& r : rows) {
+    errors += r.errors;
     std::snprintf(line, sizeof line,
                   "| %zu | %.1f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1f | %.1f | %zu |\n",
-                  r.clients, double(r.bytes) / 1e6 / std::max(r.seconds, 1e-9),
-                  percentile(first, 50), percentile(first, 99), percentile(end, 50),
-                  percentile(end, 99), percentile(hello, 50), percentile(hello, 99),
-                  double(r.hwm_kib) / 1024.0, growth, r.errors);
+                  r.clients, median(r.mbps), median(r.first50), median(r.first99),
+                  median(r.end50), median(r.end99), median(r.hello50), median(r.hello99),
+                  r.peak_mib, median(r.growth), r.errors);
     md += line;
   }
-  md += "\nTimes to first chunk and to the end count from each client's stream request (all "
-        "requests are sent in the same instant, so p99 includes queueing behind the other N-1 "
-        "streams on 2 cores). RSS growth per connection = (server anonymous RSS with all N "
-        "sessions open - with none) / N. Target from issue 6: 1000 clients with 0 errors, p99 "
-        "first chunk < 50 ms, < 64 KiB per connection.\n\n";
+  md += "\nTimes to first chunk and to the end count from each client's stream request; all N "
+        "requests leave in the same instant, so p99 includes queueing behind the other N-1 "
+        "streams (the server and the clients share 2 cores). RSS growth per connection = (server "
+        "anonymous RSS with all N sessions open - with none) / N. Issue 6 targets: 1000 clients "
+        "with 0 errors, p99 first chunk < 50 ms, < 64 KiB per connection.\n\n"
+        "Why it is cheap: chunks go from the shared memory map to the socket with a 10-30 byte "
+        "hand-encoded frame head (scatter-gather write, no copy), each session has one write in "
+        "flight and no send queue of data, and a session's own state is a few KiB (2 KiB read "
+        "buffer, three coroutine frames). What bounds p99 at 1000 clients: every write waits one "
+        "round of its worker's queue, where the other sessions' writes are; chunks therefore "
+        "start at 8 KiB and double per chunk (every stream's prefix and base mesh go out before "
+        "bulk data) and a stream's header leaves in the same write as its first chunk.\n\n";
   std::cout << md;
   if (!report_dir.empty()) {
     fs::create_directories(report_dir);
@@ -370,7 +404,5 @@ int main(int argc, char** argv) {
   }
   std::error_code ec;
   fs::remove_all(work, ec);
-  size_t errors = 0;
-  for (const Scenario& r : results) errors += r.errors;
   return errors == 0 ? 0 : 1;
 }
