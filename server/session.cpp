@@ -63,6 +63,7 @@ Session::Session(net::tcp::socket socket, const ServerShared& shared, SessionReg
 
 Session::~Session() {
   registry_.sessions.erase(this);
+  registry_.starting_streams -= starting_;
   if (counted_) --*shared_.active_sessions;
   if (reject_) --*shared_.rejecting_sessions;
   const double seconds = std::chrono::duration<double>(Clock::now() - started_).count();
@@ -244,6 +245,8 @@ void Session::handle_stream(const v1::StreamRequest& request) {
     chunk = std::min<size_t>(chunk, std::max<uint64_t>(kMinChunkBytes,
                                                        shared_.options->rate_bytes_per_s / 20));
   }
+  ++starting_;
+  ++registry_.starting_streams;
   push(StartStream{model, *plan, chunk}, 0);
 }
 
@@ -324,6 +327,14 @@ std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& p
 
 awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
   while (!closed_) {
+    if (!pending_header_.empty() && (!queue_.empty() || !stream_ || stream_->position >= stream_->plan.end)) {
+      // Something else must follow the header: send it on its own.
+      const std::vector<uint8_t> header = std::move(pending_header_);
+      pending_header_.clear();
+      started_one();
+      if (!co_await write(asio::buffer(header))) break;
+      continue;
+    }
     if (!queue_.empty()) {
       Item item = std::move(queue_.front());
       queue_.pop_front();
@@ -352,8 +363,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
         if (models_.find(model.name) == std::string::npos) {
           models_ += models_.empty() ? model.name : "," + model.name;
         }
-        const std::vector<uint8_t> header = header_frame(model, start->plan, start->chunk_bytes);
-        if (!co_await write(asio::buffer(header))) break;
+        pending_header_ = header_frame(model, start->plan, start->chunk_bytes);
       } else {  // CancelStream
         if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
       }
@@ -367,6 +377,14 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       }
       const size_t limit =
           std::min(s.chunk_bytes, kFirstChunkBytes << std::min<uint32_t>(s.chunks_sent, 20));
+      if (s.chunks_sent > 0 && registry_.starting_streams > 0 && !s.yielded) {
+        // Let this worker's new streams write their first chunk before our
+        // bulk: one trip to the back of the queue, at most once per chunk.
+        s.yielded = true;
+        co_await asio::post(socket_.get_executor(), use_awaitable);
+        continue;
+      }
+      s.yielded = false;
       const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
       const size_t size = static_cast<size_t>(cut.end - s.position);
       const auto delay = s.bucket.take(size, Clock::now());
@@ -378,10 +396,14 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       }
       const proto::ChunkFrameHead head =
           proto::encode_chunk_frame_head(s.position, cut.records_complete, size);
-      const std::array<asio::const_buffer, 2> buffers{
+      const std::array<asio::const_buffer, 3> buffers{
+          asio::buffer(pending_header_),  // empty except before the first chunk
           asio::buffer(head.bytes, head.size),
           asio::buffer(s.model->stream().data() + s.position, size)};
-      if (!co_await write(buffers)) break;
+      if (!pending_header_.empty()) started_one();
+      const bool written = co_await write(buffers);
+      pending_header_.clear();
+      if (!written) break;
       // The stream may have been replaced while we waited? No: only this
       // coroutine changes stream_, so `s` is still the stream we wrote.
       s.position = cut.end;

@@ -40,6 +40,10 @@ struct ServerShared {
 // The sessions of one worker thread, touched only from that thread.
 struct SessionRegistry {
   std::unordered_set<Session*> sessions;
+  // Sessions of this worker with a stream requested whose first chunk is not
+  // written yet; while there are any, bulk chunks yield once (first bytes
+  // first).
+  int starting_streams = 0;
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -84,6 +88,7 @@ class Session : public std::enable_shared_from_this<Session> {
     uint32_t records_complete;
     TokenBucket bucket;
     uint32_t chunks_sent = 0;
+    bool yielded = false;  // this chunk already let new streams go first
   };
 
   net::asio::awaitable<void> read_loop(std::shared_ptr<Session> self);
@@ -116,6 +121,17 @@ class Session : public std::enable_shared_from_this<Session> {
   std::deque<Item> queue_;
   size_t queued_bytes_ = 0;
   std::optional<ActiveStream> stream_;
+  // The running stream's header, sent together with its first chunk (one
+  // write instead of two: under load each write waits a full round of the
+  // worker's queue).
+  std::vector<uint8_t> pending_header_;
+  int starting_ = 0;  // this session's share of registry_.starting_streams
+  void started_one() {
+    if (starting_ > 0) {
+      --starting_;
+      --registry_.starting_streams;
+    }
+  }
 
   net::asio::steady_timer writer_wake_;
   net::asio::steady_timer reader_wake_;  // queue has room again
