@@ -404,8 +404,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       const bool written = co_await write(buffers);
       pending_header_.clear();
       if (!written) break;
-      // The stream may have been replaced while we waited? No: only this
-      // coroutine changes stream_, so `s` is still the stream we wrote.
+      // Only this coroutine replaces stream_, so `s` is the stream just written.
       s.position = cut.end;
       s.bytes_sent += size;
       s.records_complete = cut.records_complete;
