@@ -16,8 +16,9 @@ using asio::use_awaitable;
 // costs at most this much).
 constexpr size_t kMaxQueuedBytes = 256 * 1024;
 // After our closing frame: how long we keep draining the client's bytes so
-// the close is a FIN, not a reset that could destroy the error frame.
-constexpr auto kLinger = std::chrono::milliseconds(1000);
+// the close is a FIN, not a reset that could destroy the error frame
+// (Session::linger_; shorter when the whole server is stopping).
+constexpr auto kShutdownLinger = std::chrono::milliseconds(200);
 constexpr size_t kMinChunkBytes = 1024;
 constexpr size_t kMaxChunkBytes = 1 << 20;
 constexpr size_t kReadBufferBytes = 2048;
@@ -93,6 +94,7 @@ void Session::start() {
 }
 
 void Session::shutdown() {
+  linger_ = kShutdownLinger;
   if (closed_ || closing_) return;
   fail(v1::Error::SHUTTING_DOWN, "server is shutting down", "server shutdown");
 }
@@ -347,7 +349,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
           // client still sends until it closes or the linger ends.
           boost::system::error_code ec;
           socket_.shutdown(net::tcp::socket::shutdown_send, ec);
-          linger_deadline_ = Clock::now() + kLinger;
+          linger_deadline_ = Clock::now() + linger_;
           wake(watchdog_timer_);
           break;
         }

@@ -146,6 +146,7 @@ class Session : public std::enable_shared_from_this<Session> {
   Clock::time_point last_activity_;
   Clock::time_point write_started_;
   Clock::time_point linger_deadline_ = Clock::time_point::max();
+  Clock::duration linger_ = std::chrono::milliseconds(1000);
 
   // For the one log line per session.
   std::string models_;
