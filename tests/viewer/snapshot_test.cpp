@@ -103,7 +103,9 @@ TEST(Snapshot, AsaKindsColouringDiffersFromShaded) {
   EXPECT_GT(differing_pixels(a, b), foreground_coverage(a).foreground / 2);
   EXPECT_EQ(testing::orange_pixels(a), 0u);
   EXPECT_GT(testing::orange_pixels(b), 100u);
-  if (bisected > 50) EXPECT_GT(testing::green_pixels(b), 20u);
+  if (bisected > 50) {
+    EXPECT_GT(testing::green_pixels(b), 20u);
+  }
 }
 
 TEST(Snapshot, WireframeAndDistanceModesChangeThePicture) {

@@ -86,6 +86,13 @@ class WindowTest : public ::testing::Test {
   bool had_display_ = false;
 };
 
+ScriptedCommand at(uint64_t frame, ViewerCommand command) {
+  ScriptedCommand c;
+  c.at_frame = frame;
+  c.command = command;
+  return c;
+}
+
 // A stream of ever finer spheres with ASA labels, like the client publishes.
 DisplayFrame make_frame(uint64_t sequence, uint32_t subdivisions, bool final) {
   DisplayFrame frame;
@@ -131,7 +138,9 @@ TEST_F(WindowTest, DrawsFramesWhileAStreamArrivesAndExitsCleanly) {
   EXPECT_EQ(report->frames_drawn, 40u);
   EXPECT_GE(report->meshes_uploaded, 1u);
   EXPECT_LE(report->last_sequence_shown, 4u);
-  if (stream_ended_before_exit) EXPECT_EQ(report->last_sequence_shown, 4u) << "the final frame was missed";
+  if (stream_ended_before_exit) {
+    EXPECT_EQ(report->last_sequence_shown, 4u) << "the final frame was missed";
+  }
   EXPECT_EQ(controls.set_asa_calls, 0) << "no one touched the panel";
 
   // The window really showed a mesh: its last frame is not blank.
@@ -174,11 +183,14 @@ TEST_F(WindowTest, CommandsSteerTheStreamAndTheView) {
   asa.flatness = 0.9f;
   asa.rule = ButterflyRule::kProjection;
   asa.crease_degrees = 30;
+  ScriptedCommand set_asa = at(5, ViewerCommand::kSetAsa);
+  set_asa.asa_enabled = true;
+  set_asa.asa = asa;
   std::vector<ScriptedCommand> script{
-      {2, ViewerCommand::kTogglePause},     {4, ViewerCommand::kTogglePause},
-      {5, ViewerCommand::kSetAsa, true, asa}, {6, ViewerCommand::kColorDistance},
-      {7, ViewerCommand::kToggleWireframe}, {8, ViewerCommand::kScreenshot},
-      {9, ViewerCommand::kFrameModel},      {40, ViewerCommand::kClose},
+      at(2, ViewerCommand::kTogglePause),     at(4, ViewerCommand::kTogglePause),
+      set_asa,                                at(6, ViewerCommand::kColorDistance),
+      at(7, ViewerCommand::kToggleWireframe), at(8, ViewerCommand::kScreenshot),
+      at(9, ViewerCommand::kFrameModel),      at(40, ViewerCommand::kClose),
   };
   ViewerOptions options;
   options.width = 320;
@@ -231,8 +243,8 @@ TEST_F(WindowTest, DistanceColouringShowsWhereTheDisplayLeavesTheFinalMesh) {
   std::vector<ScriptedCommand> script;
   // Screenshots now and then; the distances arrive from the worker within
   // a few frames, the last one must show them.
-  for (uint64_t f = 20; f <= 120; f += 20) script.push_back({f, ViewerCommand::kScreenshot});
-  script.push_back({121, ViewerCommand::kClose});
+  for (uint64_t f = 20; f <= 120; f += 20) script.push_back(at(f, ViewerCommand::kScreenshot));
+  script.push_back(at(121, ViewerCommand::kClose));
   auto report = run_viewer_with_report(options, mailbox, controls, script);
   ASSERT_TRUE(report.has_value()) << report.error().message;
   ASSERT_GE(report->distance_uploads, 1u);
