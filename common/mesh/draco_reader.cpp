@@ -42,6 +42,17 @@ Result<std::unique_ptr<draco::Mesh>> decode(const std::string& path, const std::
   };
   auto mesh = std::make_unique<draco::Mesh>();
   if (ext == "obj") {
+    // Draco's ObjDecoder dereferences a missing position attribute when a
+    // face comes with no `v` line at all (SEGV in MapPointToVertexIndices;
+    // found by tests/fuzz, regression input regressions/mesh_import/).
+    std::ifstream in(path, std::ios::binary);
+    bool has_position = false;
+    for (std::string line; !has_position && std::getline(in, line);) {
+      const size_t at = line.find_first_not_of(" \t");
+      has_position = at != std::string::npos && line.size() > at + 1 && line[at] == 'v' &&
+                     (line[at + 1] == ' ' || line[at + 1] == '\t');
+    }
+    if (!has_position) return make_error(ErrorCode::kParse, "no vertex positions (no 'v' line)");
     draco::ObjDecoder decoder;
     decoder.set_deduplicate_input_values(false);
     if (auto status = decoder.DecodeFromFile(path, mesh.get()); !status.ok()) return fail(status);
