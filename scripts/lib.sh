@@ -16,6 +16,7 @@ MESHSTREAM_PACKAGES=(
   gnuplot-nox  # bench: the codec rate-distortion plot
   libglfw3-dev libimgui-dev libosmesa6-dev libpng-dev  # viewer: window, panel, off-screen, PNG
   xvfb xauth  # viewer tests: a virtual X display for the window
+  clang libclang-rt-14-dev  # fuzz targets (libFuzzer) in tests/fuzz
 )
 
 ms_install_packages() {
