@@ -133,6 +133,10 @@ int main(int argc, char** argv) {
       if (m.name == "icosphere2" && draco) sample_stream = *stream;
       write(out / "hcs_decoder" / (m.name + (draco ? "_draco" : "_own") + ".hcs"),
             with_trailer(*stream, 3));
+      // The same with the target's "fix checksums" flag (last byte odd).
+      std::vector<uint8_t> fixing = with_trailer(*stream, 3);
+      fixing.push_back(1);
+      write(out / "hcs_decoder" / (m.name + (draco ? "_draco" : "_own") + "_fixcrc.hcs"), fixing);
     }
   }
   auto index = read_stream_index(sample_stream);
