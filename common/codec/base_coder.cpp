@@ -1,6 +1,7 @@
 // Base mesh coders: see base_coder.h.
 #include "common/codec/base_coder.h"
 
+#include <optional>
 #include <string>
 
 #include <draco/compression/decode.h>
@@ -148,7 +149,16 @@ Result<BaseMesh> decode_base_draco(std::span<const uint8_t> bytes, uint32_t vert
   draco::DecoderBuffer buffer;
   buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   draco::Decoder decoder;
-  auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
+  std::optional<draco::StatusOr<std::unique_ptr<draco::Mesh>>> attempt;
+  try {
+    attempt.emplace(decoder.DecodeMeshFromBuffer(&buffer));
+  } catch (const std::exception& e) {
+    // Draco sizes vectors from counts in its bitstream (a damaged or hostile
+    // base record made it reserve 5.7 GB in tests/fuzz): bad_alloc or
+    // length_error is a corrupt record, not a crash of the caller.
+    return make_error(ErrorCode::kCorrupt, std::string("Draco could not decode the base mesh: ") + e.what());
+  }
+  auto& decoded = *attempt;
   if (!decoded.ok()) {
     return make_error(ErrorCode::kCorrupt, std::string("Draco could not decode the base mesh: ") +
                                                decoded.status().error_msg_string());
