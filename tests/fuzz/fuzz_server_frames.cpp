@@ -82,7 +82,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                                               : provider.ConsumeIntegralInRange<size_t>(0, 4096);
   proto::ClientFrameReader reader(limit);
   proto::FrameSplitter splitter(limit);  // the raw splitter on the same bytes
-  size_t split_total = 0;
   while (provider.remaining_bytes() > 0) {
     const size_t n = provider.ConsumeIntegralInRange<size_t>(1, 1 + provider.remaining_bytes());
     std::vector<uint8_t> piece = provider.ConsumeBytes<uint8_t>(n);
@@ -96,7 +95,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
       if (!*frame) break;
       check((*frame)->size() <= limit);
-      split_total += (*frame)->size();
     }
     while (true) {
       auto message = reader.next();
