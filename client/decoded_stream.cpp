@@ -52,6 +52,11 @@ Status DecodedStream::resume_at(uint64_t offset) {
   return decoder_.resume_at(offset);
 }
 
+bool DecodedStream::error_is_recoverable() const {
+  std::lock_guard lock(mutex_);
+  return decoder_.error_is_recoverable();
+}
+
 uint64_t DecodedStream::resume_offset() const {
   std::lock_guard lock(mutex_);
   return decoder_.resume_offset();

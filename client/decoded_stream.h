@@ -60,6 +60,9 @@ class DecodedStream {
   // Prepares for bytes starting at `offset` after a reconnect (a record
   // boundary the decoder reached, or 0).
   Status resume_at(uint64_t offset);
+  // The last feed error left the decoded mesh untouched (bytes altered in
+  // transit): reconnecting and resuming may succeed.
+  bool error_is_recoverable() const;
   uint64_t resume_offset() const;
   uint32_t records_decoded() const;
   // From the stream's own index once its prefix arrived: (total bytes,

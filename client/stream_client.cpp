@@ -223,7 +223,10 @@ StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
         auto fed = decoded.feed(std::span<const uint8_t>(bytes + (at - expected), stop_at - at));
         if (!fed) {
           error = fed.error();
-          return Attempt::kFatal;
+          // A record that fails its checksum was altered on the way; it is
+          // fetched again from the last good record. Anything else in the
+          // stream itself is the stream's fault and final.
+          return decoded.error_is_recoverable() ? Attempt::kRetry : Attempt::kFatal;
         }
         at = stop_at;
         decoded.set_bytes_received(at);

@@ -25,6 +25,10 @@ struct IncrementalDecoder::State {
   Mesh mesh;
   std::vector<RecordDelta> deltas;
   std::optional<Error> error;
+  // The error left the decoded state as it was (damaged index, a record
+  // that failed its checksum before being applied): fetching the bytes again
+  // may succeed, so resume_at clears it.
+  bool error_recoverable = false;
 
   uint64_t consumed_end() const {
     if (!index) return 0;
@@ -78,9 +82,7 @@ struct IncrementalDecoder::State {
       return make_error(e.code, "record " + std::to_string(i) + " of " +
                                     std::to_string(index->records.size()) + ": " + e.message);
     };
-    if (!record_intact(rec, payload)) {
-      return where({ErrorCode::kCorrupt, "checksum mismatch (corrupt or altered bytes)"});
-    }
+    // The caller (feed) has checked the record's CRC-32.
     RecordDelta delta;
     delta.record = i;
     if (i == 0) {
@@ -158,6 +160,7 @@ Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
     if (!index) {
       if (index.error().code == ErrorCode::kTruncated) return 0u;
       s.error = index.error();
+      s.error_recoverable = s.error->code == ErrorCode::kCorrupt;
       return tl::unexpected(*s.error);
     }
     s.index = std::move(*index);
@@ -180,6 +183,14 @@ Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
     }
     const size_t at = static_cast<size_t>(rec.offset - s.buffer_start);
     std::span<const uint8_t> payload(s.buffer.data() + at, rec.size);
+    if (!record_intact(rec, payload)) {
+      // Checked before anything is applied, so the state stays good.
+      s.error = Error{ErrorCode::kCorrupt, "record " + std::to_string(s.records_done) + " of " +
+                                               std::to_string(s.index->records.size()) +
+                                               ": checksum mismatch (corrupt or altered bytes)"};
+      s.error_recoverable = true;
+      return tl::unexpected(*s.error);
+    }
     if (auto st = s.apply_record(s.records_done, payload); !st) {
       s.error = st.error();
       return tl::unexpected(*s.error);
@@ -206,9 +217,13 @@ bool IncrementalDecoder::finished() const {
 const Mesh& IncrementalDecoder::mesh() const { return state_->mesh; }
 const std::vector<RecordDelta>& IncrementalDecoder::last_deltas() const { return state_->deltas; }
 
+bool IncrementalDecoder::error_is_recoverable() const {
+  return state_->error && state_->error_recoverable;
+}
+
 Status IncrementalDecoder::resume_at(uint64_t offset) {
   State& s = *state_;
-  if (s.error) return tl::unexpected(*s.error);
+  if (s.error && !s.error_recoverable) return tl::unexpected(*s.error);
   bool boundary = offset == 0;
   if (s.index) {
     boundary = boundary || offset == s.index->payload_offset;
@@ -221,6 +236,8 @@ Status IncrementalDecoder::resume_at(uint64_t offset) {
                       "cannot resume at byte " + std::to_string(offset) +
                           ": not a record boundary this decoder has reached");
   }
+  s.error.reset();
+  s.error_recoverable = false;
   s.buffer.clear();
   s.buffer_start = offset;
   s.stream_pos = offset;

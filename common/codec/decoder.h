@@ -53,8 +53,15 @@ class IncrementalDecoder {
   // What the most recent record changed.
   const std::vector<RecordDelta>& last_deltas() const;
 
+  // True after an error that left the decoded state untouched: a record
+  // that failed its checksum (checked before it is applied) or a damaged
+  // index. Bytes altered in transit are such errors; fetching them again
+  // from resume_offset() may succeed.
+  bool error_is_recoverable() const;
+
   // Starts over from a resume offset: the caller feeds bytes starting at
   // `offset`, which must be a record boundary this decoder has reached.
+  // Clears a recoverable error; any other error is returned again.
   Status resume_at(uint64_t offset);
 
  private:

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/codec/crc32.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/adjacency.h"
@@ -191,6 +192,72 @@ TEST(Codec, ResumeAtRecordBoundary) {
   auto whole = decode_hcs(*bytes);
   EXPECT_EQ(dec.mesh().triangles, whole->triangles);
   EXPECT_FALSE(dec.resume_at(resume + 1));
+}
+
+// A byte altered in transit fails the record's checksum before anything
+// is applied: the decoder keeps its last good mesh, says the error is
+// recoverable, and after resume_at the good bytes finish the stream exactly.
+TEST(Codec, ChecksumFailureIsRecoverableByResuming) {
+  Mesh m = icosphere(3, 0.1f);
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 100;
+  auto bytes = encode_hcs(m, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  ASSERT_GE(index->records.size(), 4u);
+  const RecordEntry& victim = index->records[2];
+  std::vector<uint8_t> damaged = *bytes;
+  damaged[victim.offset + victim.size / 2] ^= 0x10;
+
+  IncrementalDecoder dec;
+  auto fed = dec.feed(damaged);
+  ASSERT_FALSE(fed);
+  EXPECT_EQ(fed.error().code, ErrorCode::kCorrupt);
+  EXPECT_NE(fed.error().message.find("checksum"), std::string::npos) << fed.error().message;
+  EXPECT_TRUE(dec.error_is_recoverable());
+  EXPECT_EQ(dec.records_decoded(), 2u);
+  EXPECT_EQ(dec.resume_offset(), victim.offset);
+  EXPECT_FALSE(dec.feed(std::span<const uint8_t>()));  // sticky until resumed
+
+  ASSERT_TRUE(dec.resume_at(dec.resume_offset()));
+  const uint64_t from = dec.resume_offset();
+  ASSERT_TRUE(dec.feed(std::span<const uint8_t>(bytes->data() + from, bytes->size() - from)));
+  EXPECT_TRUE(dec.finished());
+  auto whole = decode_hcs(*bytes);
+  ASSERT_TRUE(whole);
+  EXPECT_EQ(dec.mesh().triangles, whole->triangles);
+  EXPECT_EQ(dec.mesh().positions, whole->positions);
+}
+
+// A record whose checksum matches but whose content is invalid is the
+// stream's own fault: not recoverable, resume_at repeats the error.
+TEST(Codec, InvalidRecordWithGoodChecksumStaysFatal) {
+  Mesh m = icosphere(3, 0.1f);
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 100;
+  auto bytes = encode_hcs(m, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  const RecordEntry& victim = index->records[1];
+  // Truncate the record's content to nothing valid but keep the CRC right:
+  // zero its bytes and rewrite the stream with a recomputed index.
+  std::vector<uint8_t> damaged = *bytes;
+  std::fill(damaged.begin() + victim.offset, damaged.begin() + victim.offset + victim.size, 0xFF);
+  StreamIndex rewritten = *index;
+  rewritten.records[1].crc32 = crc32(0, damaged.data() + victim.offset, victim.size);
+  const std::vector<uint8_t> prefix = write_container_prefix(rewritten.header, rewritten.records);
+  ASSERT_EQ(prefix.size(), index->payload_offset);
+  std::copy(prefix.begin(), prefix.end(), damaged.begin());
+
+  IncrementalDecoder dec;
+  auto fed = dec.feed(damaged);
+  ASSERT_FALSE(fed);
+  EXPECT_FALSE(dec.error_is_recoverable()) << fed.error().message;
+  EXPECT_FALSE(dec.resume_at(dec.resume_offset()));
 }
 
 TEST(Codec, BudgetsSelectTheRightPrefix) {
