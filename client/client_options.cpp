@@ -19,17 +19,23 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("model", o.model, "model name to stream (see --list)");
   app.add_flag("--list", o.list, "list the server's models and exit");
   app.add_option("--out", o.out_dir, "write NNNN.ply per display update (NNNN = record index) and final.ply");
-  app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")->check(CLI::Range(0, 8));
+  app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")
+      ->check(CLI::Range(0, 8))
+      ->capture_default_str();
   app.add_option("--flatness", o.asa.flatness, "ASA flatness t: an edge is flat when t < N1.N2")
-      ->check(CLI::Range(-1.0, 1.0));
+      ->check(CLI::Range(-1.0, 1.0))
+      ->capture_default_str();
   app.add_option("--rule", rule, "Butterfly rule: zorin or projection")
-      ->check(CLI::IsMember({"zorin", "projection"}));
+      ->check(CLI::IsMember({"zorin", "projection"}))
+      ->capture_default_str();
   app.add_option("--crease", o.asa.crease_degrees, "edges bending more than DEG degrees stay sharp (0 = off)")
-      ->check(CLI::Range(0.0, 180.0));
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
   bool no_asa = false;
   app.add_flag("--no-asa", no_asa, "show the decoded mesh without ASA");
   app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
-      ->check(CLI::IsMember({"auto", "full", "incremental"}));
+      ->check(CLI::IsMember({"auto", "full", "incremental"}))
+      ->capture_default_str();
   auto* b = app.add_option("--bytes", bytes, "stop at the last record boundary within N stream bytes");
   auto* v = app.add_option("--vertices", vertices, "stop after the last record with at most N vertices");
   auto* p = app.add_option("--percent", percent, "stop at P percent of the stream's bytes (0 < P <= 100)")
@@ -39,13 +45,14 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_flag("--json", o.json, "print one JSON event per line on stdout");
   app.add_flag("--view", o.view, "open a window that shows the model as it refines");
   app.add_option("--snapshot", o.snapshot_png, "render the final (or --snapshot-at) display mesh to a PNG");
-  app.add_option("--width", o.width, "snapshot/window width")->check(CLI::Range(16, 16384));
-  app.add_option("--height", o.height, "snapshot/window height")->check(CLI::Range(16, 16384));
+  app.add_option("--width", o.width, "snapshot/window width")->check(CLI::Range(16, 16384))->capture_default_str();
+  app.add_option("--height", o.height, "snapshot/window height")->check(CLI::Range(16, 16384))->capture_default_str();
   app.add_option("--snapshot-at", o.snapshot_at, "snapshot the display mesh after record N (0 = base mesh)");
   app.add_option("--exit-after", o.exit_after_frames, "close the window after N frames (tests)");
   app.add_option("--max-chunk-bytes", o.max_chunk_bytes, "largest chunk to ask the server for");
   app.add_option("--reconnect-attempts", reconnect_attempts, "consecutive reconnects before giving up")
-      ->check(CLI::Range(0, 1000));
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   app.add_flag("--quiet", o.quiet, "no progress line");
   try {
     app.parse(argc, argv);
