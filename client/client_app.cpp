@@ -98,6 +98,9 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
   uint32_t display_updates = 0, coalesced = 0;
   bool snapshot_done = false;
   std::optional<DisplayFrame> final_frame;
+  // The newest frame shown: what the summary reports when the stream is
+  // cancelled (window closed) before a final frame.
+  std::optional<DisplayFrame> last_frame;
 
   PipelineSettings settings;
   settings.asa_enabled = o.asa_enabled;
@@ -106,6 +109,7 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
   // Runs on the pipeline thread after each published frame.
   auto observer = [&](const DisplayFrame& frame, const FrameInfo& info) {
     if (info.new_records) {
+      last_frame = frame;
       ++display_updates;
       coalesced += frame.coalesced_updates;
       log.refinement(frame, info, elapsed(), client.rate_bytes_per_s());
@@ -184,13 +188,13 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
   s.reconnects = client.reconnects();
   s.display_updates = display_updates;
   s.coalesced = coalesced;
-  if (final_frame) {
-    s.records = final_frame->records_decoded;
-    s.bytes = final_frame->bytes_received;
-    s.vertices = final_frame->decoded->vertex_count();
-    s.faces = final_frame->decoded->face_count();
-    s.display_vertices = final_frame->display->vertex_count();
-    s.display_faces = final_frame->display->face_count();
+  if (const auto& shown = final_frame ? final_frame : last_frame) {
+    s.records = shown->records_decoded;
+    s.bytes = shown->bytes_received;
+    s.vertices = shown->decoded->vertex_count();
+    s.faces = shown->decoded->face_count();
+    s.display_vertices = shown->display->vertex_count();
+    s.display_faces = shown->display->face_count();
   }
   log.done(s);
   return 0;

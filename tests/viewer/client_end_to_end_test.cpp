@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "client/viewer/rgba_image.h"
 #include "common/mesh/export.h"
 #include "common/mesh/procedural.h"
@@ -150,6 +152,44 @@ TEST_F(ClientEndToEnd, WindowFollowsAThrottledStreamUnderXvfb) {
   int code = run_client({"--view", "--exit-after", "45", "--width", "400", "--height", "300"});
   if (old) ::setenv("DISPLAY", saved.c_str(), 1); else ::unsetenv("DISPLAY");
   EXPECT_EQ(code, 0) << client_log();
+}
+
+// Closing the window while the stream still runs cancels it; the summary
+// then reports what was shown, not zeros.
+TEST_F(ClientEndToEnd, ClosingTheWindowEarlyReportsWhatWasShown) {
+  if (testing::XvfbDisplay::find_xvfb().empty()) {
+    GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb): window test skipped";
+  }
+  testing::XvfbDisplay xvfb;
+  std::string display = xvfb.start();
+  ASSERT_FALSE(display.empty()) << "Xvfb did not start";
+  testing::ChildProcess server;
+  address_ = start_server(server, {"--rate", "3000"});  // several seconds per stream
+  ASSERT_FALSE(address_.empty()) << "server did not start";
+  const char* old = std::getenv("DISPLAY");
+  std::string saved = old ? old : "";
+  ::setenv("DISPLAY", display.c_str(), 1);
+  std::vector<std::string> args{client_binary(), address_, "knot", "--view", "--exit-after", "20",
+                                "--width", "200", "--height", "150", "--json"};
+  testing::ChildProcess client;
+  ASSERT_TRUE(client.start(args, path("client.log")));
+  std::string done_line;
+  while (auto line = client.read_line(60s)) {
+    if (line->find("\"event\":\"done\"") != std::string::npos) done_line = *line;
+  }
+  const int code = client.wait(30s).value_or(-1);
+  if (old) ::setenv("DISPLAY", saved.c_str(), 1); else ::unsetenv("DISPLAY");
+  ASSERT_EQ(code, 0) << client_log();
+  ASSERT_FALSE(done_line.empty()) << "no done event; stderr: " << client_log();
+  auto j = nlohmann::json::parse(done_line, nullptr, false);
+  ASSERT_FALSE(j.is_discarded()) << done_line;
+  const std::string& log = done_line;
+  EXPECT_EQ(j["reason"], "cancelled") << log;
+  EXPECT_GE(j["records"].get<int>(), 1) << log;
+  EXPECT_LT(j["records"].get<int>(), j["records_total"].get<int>()) << log;
+  EXPECT_GT(j["bytes"].get<int64_t>(), 0) << log;
+  EXPECT_GT(j["faces"].get<int64_t>(), 0) << log;
+  EXPECT_GT(j["display_faces"].get<int64_t>(), 0) << log;
 }
 
 }  // namespace
