@@ -1,10 +1,12 @@
-// OBJ, STL and .drc through Draco's io (PLY has its own reader: Draco's
-// merges equal positions and drops texture coordinates; see ply_reader.cpp).
+// Binary STL and .drc through Draco's io (PLY and OBJ have their own
+// readers: Draco's PLY reader merges equal positions and drops texture
+// coordinates; its OBJ reader writes outside a heap block on malformed face
+// tokens — see ply_reader.cpp, obj_reader.cpp).
 //
-// Checked against ../shared/meshes (MANIFEST.md): Draco's OBJ reader keeps
-// degenerate faces, fan-triangulates polygons like the manifest does, and
-// loses nothing we count, so we use it rather than a parser of our own.
-// Two Draco habits would hide what the file holds, and are undone here:
+// Draco's ObjDecoder is still here, behind read_trusted_obj_with_draco, as
+// the peer tests/mesh/obj_reader_test.cpp and the benchmarks compare our OBJ
+// reader with on well-formed files; nothing reads untrusted files with it.
+// Two Draco habits would hide what a file holds, and are undone here:
 //  - the OBJ reader merges equal attribute values by default: we turn that
 //    off so `vertices_in_file` is the number of `v` lines;
 //  - points (Draco's per-corner records) are not vertices: a vertex is the
@@ -127,10 +129,8 @@ bool gather(const draco::Mesh& dm, const draco::PointAttribute& attribute,
   return true;
 }
 
-}  // namespace
-
-Result<RawMesh> read_with_draco(const std::string& path) {
-  const std::string ext = lower_extension(path);
+// Draco's decode and the conversion of its mesh to ours.
+Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext) {
   Result<std::unique_ptr<draco::Mesh>> decoded = make_error(ErrorCode::kParse, "not decoded");
   try {
     decoded = decode(path, ext);
@@ -204,6 +204,18 @@ Result<RawMesh> read_with_draco(const std::string& path) {
   optional(draco::GeometryAttribute::TEX_COORD, "texture coordinates", mesh.texcoords,
            std::integral_constant<int, 2>{}, 0.0f);
   return raw;
+}
+
+}  // namespace
+
+Result<RawMesh> read_with_draco(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == "obj") return read_obj(path);
+  return read_draco_mesh(path, ext);
+}
+
+Result<RawMesh> read_trusted_obj_with_draco(const std::string& path) {
+  return read_draco_mesh(path, "obj");
 }
 
 }  // namespace meshstream

@@ -19,6 +19,8 @@ bool has_extension(const std::string& path, const char* wanted) {
 Result<RawMesh> read_by_format(const std::string& path) {
   if (has_extension(path, ".off")) return read_off(path);
   if (has_extension(path, ".ply")) return read_ply(path);
+  // Never Draco's ObjDecoder: it corrupts the heap on malformed face tokens.
+  if (has_extension(path, ".obj")) return read_obj(path);
   return read_with_draco(path);
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/base/result.h"
@@ -39,10 +40,35 @@ Result<RawMesh> read_ply(const std::string& path);
 // welded here). Draco reads binary STL only. O(file size).
 Result<RawMesh> read_ascii_stl(const std::string& path);
 
-// OBJ, binary STL and .drc through Draco's io. Positions are read per face
-// corner through the point-to-value mapping, so Draco's own de-duplication
-// does not hide what the file holds. Normals, colours and texture
-// coordinates are kept when every vertex has one consistent value.
+// OBJ: `v x y z [w]` (or `v x y z r g b`: per-vertex colours when every
+// vertex has one; 0..255 values are scaled to 0..1), `vn`, `vt`, faces `f`
+// with corners `i`, `i/j`, `i//k`, `i/j/k` (negative = relative to the
+// elements so far; positive ones may point forward), polygons
+// fan-triangulated (c0, c(k-1), ck). One vertex per `v` line; normals and
+// texture coordinates are kept per vertex when all corners of a vertex agree,
+// else dropped with a note (as the Draco path did). `#` comments, CRLF, `\`
+// continuation; o/g/s/usemtl/mtllib and free-form lines are ignored, `l`/`p`
+// elements skipped and counted in a note. Strict: malformed numbers or
+// corner tokens (kParse), NaN/Inf positions and indices out of range
+// (kInvalidMesh) are errors naming the line and the token. Never hands the
+// text to Draco (its ObjDecoder corrupts the heap on malformed corners).
+// O(file size), one read, no allocation per token.
+Result<RawMesh> read_obj(const std::string& path);
+
+// read_obj on text already in memory (tests, fuzzing). Same rules.
+Result<RawMesh> parse_obj_text(std::string_view text);
+
+// Binary STL and .drc through Draco's io (an .obj path goes to read_obj).
+// Positions are read per face corner through the point-to-value mapping, so
+// Draco's own de-duplication does not hide what the file holds. Normals,
+// colours and texture coordinates are kept when every vertex has one
+// consistent value.
 Result<RawMesh> read_with_draco(const std::string& path);
+
+// Draco's ObjDecoder, kept ONLY as the peer that tests and benchmarks compare
+// read_obj with, on well-formed files. Never call it on untrusted input:
+// Debian's Draco 1.5 writes outside a heap block on malformed face tokens
+// (tests/fuzz/regressions/mesh_import/obj-malformed-corner-heap-corruption).
+Result<RawMesh> read_trusted_obj_with_draco(const std::string& path);
 
 }  // namespace meshstream
