@@ -141,7 +141,9 @@ class ObjParser {
   Status parse_normal(std::string_view rest);
   Status parse_texcoord(std::string_view rest);
   Status parse_face(std::string_view rest);
-  Status parse_corner(std::string_view token, Corner& corner);
+  Status parse_corner(const char*& p, const char* end, Corner& corner);
+  void reserve_for(std::string_view text);
+  void add_triangle(const Corner& a, const Corner& b, const Corner& c);
   Status resolve(int64_t written, std::string_view token, const char* what, size_t count,
                  LargestIndex& largest, uint32_t& out);
   Status check_largest(const LargestIndex& largest, const char* what, const char* keyword,
@@ -153,7 +155,11 @@ class ObjParser {
   std::vector<Vec3f> colors_;  // of the vertices that have one, in order
   std::vector<Vec3f> normals_;
   std::vector<Vec2f> texcoords_;
-  std::vector<Corner> corners_;  // three per triangle
+  // Triangles (fan-triangulated polygons) and, once any corner has one, the
+  // texture coordinate / normal index of every triangle corner (kAbsent
+  // where a corner has none).
+  std::vector<Triangle> triangles_;
+  std::vector<uint32_t> corner_vt_, corner_vn_;
   std::vector<Corner> polygon_;  // reused per face line
   LargestIndex largest_v_, largest_vt_, largest_vn_;
   uint32_t vertices_with_color_ = 0;
@@ -166,16 +172,29 @@ class ObjParser {
 Status ObjParser::parse_vertex(std::string_view rest) {
   float values[7];
   int n = 0;
-  for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest)) {
+  const char* p = rest.data();
+  const char* const end = p + rest.size();
+  for (;;) {
+    while (p != end && is_blank(*p)) ++p;
+    if (p == end) break;
     if (n == 7) {
       n = 8;
       break;
     }
-    if (!parse_float(token, values[n])) {
-      return make_error(ErrorCode::kParse, at_line(line_) + "vertex " +
-                                               std::to_string(positions_.size()) + ": " +
-                                               quoted(token) + " is not a number");
+    // Fast path: a plain number followed by a blank; anything else (a '+',
+    // out of float range, garbage) through parse_float on the whole token.
+    auto [ptr, ec] = std::from_chars(p, end, values[n]);
+    if (ec != std::errc() || (ptr != end && !is_blank(*ptr))) {
+      std::string_view tail(p, static_cast<size_t>(end - p));
+      const std::string_view token = next_token(tail);
+      if (!parse_float(token, values[n])) {
+        return make_error(ErrorCode::kParse, at_line(line_) + "vertex " +
+                                                 std::to_string(positions_.size()) + ": " +
+                                                 quoted(token) + " is not a number");
+      }
+      ptr = token.data() + token.size();
     }
+    p = ptr;
     ++n;
   }
   if (n != 3 && n != 4 && n != 6) {
@@ -271,12 +290,17 @@ Status ObjParser::resolve(int64_t written, std::string_view token, const char* w
   return {};
 }
 
-// `i`, `i/j`, `i//k` or `i/j/k`: each a non-zero signed integer, nothing else.
-Status ObjParser::parse_corner(std::string_view token, Corner& corner) {
-  const char* p = token.data();
-  const char* const end = p + token.size();
+// `i`, `i/j`, `i//k` or `i/j/k`: each a non-zero signed integer, nothing
+// else, starting at `p` (not a blank) and ending at a blank or `end`.
+Status ObjParser::parse_corner(const char*& p, const char* end, Corner& corner) {
+  const char* const start = p;
+  auto token = [&] {
+    const char* e = start;
+    while (e != end && !is_blank(*e)) ++e;
+    return std::string_view(start, static_cast<size_t>(e - start));
+  };
   auto malformed = [&] {
-    return make_error(ErrorCode::kParse, at_line(line_) + "face corner " + quoted(token) +
+    return make_error(ErrorCode::kParse, at_line(line_) + "face corner " + quoted(token()) +
                                              " is malformed (expected i, i/j, i//k or i/j/k with "
                                              "integer indices)");
   };
@@ -286,10 +310,11 @@ Status ObjParser::parse_corner(std::string_view token, Corner& corner) {
     p = ptr;
     return true;
   };
+  auto at_token_end = [&] { return p == end || is_blank(*p); };
   int64_t v = 0, vt = 0, vn = 0;
   bool has_vt = false, has_vn = false;
   if (!number(v)) return malformed();
-  if (p != end) {
+  if (!at_token_end()) {
     if (*p++ != '/') return malformed();
     if (p != end && *p == '/') {
       ++p;
@@ -298,31 +323,57 @@ Status ObjParser::parse_corner(std::string_view token, Corner& corner) {
     } else {
       if (!number(vt)) return malformed();
       has_vt = true;
-      if (p != end) {
+      if (!at_token_end()) {
         if (*p++ != '/' || !number(vn)) return malformed();
         has_vn = true;
       }
     }
-    if (p != end) return malformed();
+    if (!at_token_end()) return malformed();
   }
   corner = Corner{};
-  if (auto s = resolve(v, token, "vertex", positions_.size(), largest_v_, corner.v); !s) return s;
+  // Resolution of positive indices cannot fail but the rare cases; the
+  // token is only materialized for messages.
+  if (v > 0 && v < static_cast<int64_t>(kAbsent)) {
+    if (static_cast<uint64_t>(v) > largest_v_.index) largest_v_ = {static_cast<uint64_t>(v), line_};
+    corner.v = static_cast<uint32_t>(v - 1);
+  } else if (auto s = resolve(v, token(), "vertex", positions_.size(), largest_v_, corner.v); !s) {
+    return s;
+  }
   if (has_vt) {
-    if (auto s = resolve(vt, token, "texture coordinate", texcoords_.size(), largest_vt_, corner.vt); !s) {
+    if (auto s = resolve(vt, token(), "texture coordinate", texcoords_.size(), largest_vt_, corner.vt); !s) {
       return s;
     }
   }
   if (has_vn) {
-    if (auto s = resolve(vn, token, "normal", normals_.size(), largest_vn_, corner.vn); !s) return s;
+    if (auto s = resolve(vn, token(), "normal", normals_.size(), largest_vn_, corner.vn); !s) return s;
   }
   return {};
 }
 
+void ObjParser::add_triangle(const Corner& a, const Corner& b, const Corner& c) {
+  auto attribute = [&](std::vector<uint32_t>& indices, uint32_t Corner::*member) {
+    if (indices.empty()) {
+      if (a.*member == kAbsent && b.*member == kAbsent && c.*member == kAbsent) return;
+      indices.assign(3 * triangles_.size(), kAbsent);  // first corner with one: earlier had none
+    }
+    indices.push_back(a.*member);
+    indices.push_back(b.*member);
+    indices.push_back(c.*member);
+  };
+  attribute(corner_vt_, &Corner::vt);
+  attribute(corner_vn_, &Corner::vn);
+  triangles_.push_back({a.v, b.v, c.v});
+}
+
 Status ObjParser::parse_face(std::string_view rest) {
   polygon_.clear();
-  for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest)) {
+  const char* p = rest.data();
+  const char* const end = p + rest.size();
+  for (;;) {
+    while (p != end && is_blank(*p)) ++p;
+    if (p == end) break;
     Corner corner;
-    if (auto s = parse_corner(token, corner); !s) return s;
+    if (auto s = parse_corner(p, end, corner); !s) return s;
     polygon_.push_back(corner);
   }
   if (polygon_.size() < 3) {
@@ -330,11 +381,7 @@ Status ObjParser::parse_face(std::string_view rest) {
                                              std::to_string(polygon_.size()));
   }
   // Fan from the first corner, as Draco and the manifest's tool triangulate.
-  for (size_t k = 2; k < polygon_.size(); ++k) {
-    corners_.push_back(polygon_[0]);
-    corners_.push_back(polygon_[k - 1]);
-    corners_.push_back(polygon_[k]);
-  }
+  for (size_t k = 2; k < polygon_.size(); ++k) add_triangle(polygon_[0], polygon_[k - 1], polygon_[k]);
   return {};
 }
 
@@ -368,21 +415,22 @@ Status ObjParser::check_largest(const LargestIndex& largest, const char* what, c
 // when every corner of a vertex has the same value (bit for bit), else
 // dropped with a note. Unreferenced vertices get zeros.
 template <class V>
-bool gather(const std::vector<Corner>& corners, uint32_t Corner::*index, const std::vector<V>& values,
-            uint32_t vertex_count, std::vector<V>& out, bool& some_missing) {
+bool gather(const std::vector<Triangle>& triangles, const std::vector<uint32_t>& corner_index,
+            const std::vector<V>& values, uint32_t vertex_count, std::vector<V>& out, bool& some_missing) {
   out.assign(vertex_count, V{});
   std::vector<uint8_t> set(vertex_count, 0);
   some_missing = false;
-  for (const Corner& c : corners) {
-    const uint32_t i = c.*index;
+  for (size_t c = 0; c < corner_index.size(); ++c) {
+    const uint32_t i = corner_index[c];
+    const uint32_t v = triangles[c / 3][c % 3];
     if (i == kAbsent) {
       some_missing = true;
       return false;
     }
-    if (!set[c.v]) {
-      out[c.v] = values[i];
-      set[c.v] = 1;
-    } else if (std::memcmp(&out[c.v], &values[i], sizeof(V)) != 0) {
+    if (!set[v]) {
+      out[v] = values[i];
+      set[v] = 1;
+    } else if (std::memcmp(&out[v], &values[i], sizeof(V)) != 0) {
       return false;
     }
   }
@@ -392,12 +440,10 @@ bool gather(const std::vector<Corner>& corners, uint32_t Corner::*index, const s
 void ObjParser::gather_attributes(RawMesh& raw) {
   Mesh& mesh = raw.mesh;
   const uint32_t n = mesh.vertex_count();
-  auto attribute = [&](auto& values, uint32_t Corner::*index, auto& target, const char* name,
-                       const char* keyword, uint32_t bad_line) {
+  auto attribute = [&](auto& values, const std::vector<uint32_t>& corner_index, auto& target,
+                       const char* name, const char* keyword, uint32_t bad_line) {
     if (values.empty()) return;
-    bool referenced = false;
-    for (const Corner& c : corners_) referenced |= c.*index != kAbsent;
-    if (!referenced) {
+    if (corner_index.empty()) {
       raw.notes.push_back(std::string(name) + " dropped: the file has '" + keyword +
                           "' lines but no face refers to them");
       return;
@@ -407,7 +453,7 @@ void ObjParser::gather_attributes(RawMesh& raw) {
       return;
     }
     bool some_missing = false;
-    if (!gather(corners_, index, values, n, target, some_missing)) {
+    if (!gather(mesh.triangles, corner_index, values, n, target, some_missing)) {
       target.clear();
       raw.notes.push_back(std::string(name) +
                           (some_missing ? " dropped: some face corners have none"
@@ -415,8 +461,8 @@ void ObjParser::gather_attributes(RawMesh& raw) {
                                           "(per-face values)"));
     }
   };
-  attribute(normals_, &Corner::vn, mesh.normals, "normals", "vn", first_bad_normal_line_);
-  attribute(texcoords_, &Corner::vt, mesh.texcoords, "texture coordinates", "vt", first_bad_texcoord_line_);
+  attribute(normals_, corner_vn_, mesh.normals, "normals", "vn", first_bad_normal_line_);
+  attribute(texcoords_, corner_vt_, mesh.texcoords, "texture coordinates", "vt", first_bad_texcoord_line_);
 
   if (vertices_with_color_ == n && n > 0) {
     // 0..1 floats, or 0..255 integers when any value exceeds 1 (both occur).
@@ -433,7 +479,29 @@ void ObjParser::gather_attributes(RawMesh& raw) {
   }
 }
 
+// Counts `v` and `f` lines in one memchr pass so the arrays are allocated
+// once (the reallocations cost more than the scan); a polygon counts as a
+// triangle, vectors grow past that as usual.
+void ObjParser::reserve_for(std::string_view text) {
+  size_t vertices = 0, faces = 0;
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  while (p < end) {
+    while (p < end && (*p == ' ' || *p == '\t')) ++p;
+    if (end - p >= 2 && p[1] == ' ') {
+      vertices += p[0] == 'v';
+      faces += p[0] == 'f';
+    }
+    const void* nl = std::memchr(p, '\n', static_cast<size_t>(end - p));
+    if (nl == nullptr) break;
+    p = static_cast<const char*>(nl) + 1;
+  }
+  positions_.reserve(vertices);
+  triangles_.reserve(faces);
+}
+
 Result<RawMesh> ObjParser::parse(std::string_view text) {
+  reserve_for(text);
   size_t pos = 0;
   while (pos < text.size()) {
     // One logical line: physical lines joined while they end in '\'.
@@ -487,10 +555,7 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
   RawMesh raw;
   raw.vertices_in_file = static_cast<uint32_t>(positions_.size());
   raw.mesh.positions = std::move(positions_);
-  raw.mesh.triangles.resize(corners_.size() / 3);
-  for (size_t f = 0; f < raw.mesh.triangles.size(); ++f) {
-    raw.mesh.triangles[f] = {corners_[3 * f].v, corners_[3 * f + 1].v, corners_[3 * f + 2].v};
-  }
+  raw.mesh.triangles = std::move(triangles_);
   gather_attributes(raw);
   if (line_elements_ + point_elements_ > 0) {
     raw.notes.push_back(std::to_string(line_elements_) + " line elements ('l') and " +
