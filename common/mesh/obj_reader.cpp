@@ -280,7 +280,7 @@ Status ObjParser::resolve(int64_t written, std::string_view token, const char* w
     return make_error(ErrorCode::kParse, at_line(line_) + "face corner " + quoted(token) +
                                              " has index 0 (OBJ counts from 1, or back from -1)");
   }
-  if (-written > static_cast<int64_t>(count)) {
+  if (written < -static_cast<int64_t>(count)) {  // not -written: INT64_MIN has no negation
     return make_error(ErrorCode::kInvalidMesh,
                       at_line(line_) + "face corner " + quoted(token) + ": relative index " +
                           std::to_string(written) + " reaches before the first " + what + " (" +

@@ -274,6 +274,9 @@ TEST(ObjReader, MalformedFilesAreRefusedWithLineAndToken) {
        "far beyond"},
       {"relative", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", ErrorCode::kInvalidMesh,
        "line 4: face corner '-4': relative index -4 reaches before the first vertex (3 defined so far)"},
+      // Found by fuzz_mesh_import: negating INT64_MIN was undefined behaviour.
+      {"int64_min", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9223372036854775808\n", ErrorCode::kInvalidMesh,
+       "relative index -9223372036854775808 reaches before the first vertex"},
       {"texcoord_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n", ErrorCode::kInvalidMesh,
        "line 5: a face refers to texture coordinate 2 but the file has 1 'vt' lines"},
       {"normal_missing", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n", ErrorCode::kInvalidMesh,
