@@ -502,7 +502,8 @@ void ObjParser::reserve_for(std::string_view text) {
 
 Result<RawMesh> ObjParser::parse(std::string_view text) {
   reserve_for(text);
-  size_t pos = 0;
+  // A UTF-8 byte order mark (some Windows tools write one) is not a keyword.
+  size_t pos = text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
   while (pos < text.size()) {
     // One logical line: physical lines joined while they end in '\'.
     ++line_;

@@ -241,6 +241,13 @@ TEST(ObjReader, PerFaceAttributesAreDroppedWithANote) {
   EXPECT_THAT(partial->notes[0], HasSubstr("some face corners have none"));
 }
 
+TEST(ObjReader, ByteOrderMarkIsSkipped) {
+  auto raw = parse("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  ASSERT_TRUE(raw) << raw.error().message;
+  EXPECT_EQ(raw->vertices_in_file, 3u);
+  EXPECT_TRUE(raw->notes.empty());
+}
+
 TEST(ObjReader, ForwardReferencesAreAllowed) {
   auto raw = parse("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
   ASSERT_TRUE(raw) << raw.error().message;
