@@ -5,7 +5,7 @@
 // distance to the original before and after ASA on simplified meshes.
 // Writes bench/report/asa.md (or DIR/asa.md with --report-dir DIR).
 //
-// Usage: asa_bench [--report-dir DIR] [--quick]
+// Usage: asa_bench [--report-dir DIR] [--quick] [--profile MESH LEVEL uniform|T REPS]
 #include <malloc.h>
 #include <time.h>
 
@@ -171,7 +171,39 @@ size_t output_bytes(const Mesh& m, size_t faces) {
 struct Options {
   std::string report_dir;
   bool quick = false;
+  // --profile MESH LEVEL MODE REPS: only time subdivide_into on one mesh
+  // (MODE "uniform" or a flatness t), for perf and quick before/after checks.
+  std::string profile_mesh, profile_mode;
+  int profile_level = 1, profile_reps = 0;
 };
+
+// Times one configuration warm (REPS calls) and prints the median; with
+// OpenMesh's time on the same input for the uniform mode.
+int run_profile(const Options& opt) {
+  auto imported = import_mesh(testing::test_mesh(opt.profile_mesh));
+  if (!imported) {
+    std::fprintf(stderr, "asa_bench: %s: %s\n", opt.profile_mesh.c_str(), imported.error().message.c_str());
+    return 1;
+  }
+  const Mesh& mesh = imported->mesh;
+  AsaOptions o;
+  o.levels = opt.profile_level;
+  o.uniform = opt.profile_mode == "uniform";
+  if (!o.uniform) o.flatness = std::strtof(opt.profile_mode.c_str(), nullptr);
+  AsaWorkspace ws;
+  AsaResult result;
+  if (!subdivide_into(mesh, o, ws, result)) return 1;
+  std::vector<double> t;
+  for (int r = 0; r < opt.profile_reps; ++r) {
+    const double t0 = now_ms();
+    (void)subdivide_into(mesh, o, ws, result);
+    t.push_back(now_ms() - t0);
+  }
+  std::printf("%s L%d %s: %u faces, median %.3f ms (%.1f M tri/s) over %d runs\n", opt.profile_mesh.c_str(),
+              o.levels, opt.profile_mode.c_str(), result.mesh.face_count(), median(t),
+              result.mesh.face_count() / median(t) / 1e3, opt.profile_reps);
+  return 0;
+}
 
 }  // namespace
 }  // namespace meshstream::bench
@@ -184,14 +216,21 @@ int main(int argc, char** argv) {
     std::string a = argv[i];
     if (a == "--report-dir" && i + 1 < argc) opt.report_dir = argv[++i];
     else if (a == "--quick") opt.quick = true;
+    else if (a == "--profile" && i + 4 < argc) {
+      opt.profile_mesh = argv[++i];
+      opt.profile_level = std::atoi(argv[++i]);
+      opt.profile_mode = argv[++i];
+      opt.profile_reps = std::atoi(argv[++i]);
+    }
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: asa_bench [--report-dir DIR] [--quick]\n");
+      std::printf("usage: asa_bench [--report-dir DIR] [--quick] [--profile MESH LEVEL uniform|T REPS]\n");
       return 0;
     } else {
       std::fprintf(stderr, "asa_bench: unknown argument %s\n", a.c_str());
       return 2;
     }
   }
+  if (!opt.profile_mesh.empty()) return run_profile(opt);
   if (opt.report_dir.empty()) {
 #ifdef MESHSTREAM_SOURCE_DIR
     opt.report_dir = std::string(MESHSTREAM_SOURCE_DIR) + "/bench/report";
@@ -233,11 +272,11 @@ int main(int argc, char** argv) {
     double table_ms = 0;
     {
       asa::CornerTableScratch scratch;
-      std::vector<uint32_t> opposite;
+      std::vector<uint32_t> opposite, across;
       std::vector<double> t;
       for (int r = 0; r < 9; ++r) {
         double t0 = now_ms();
-        (void)asa::build_opposites(mesh, opposite, scratch);
+        (void)asa::build_opposites(mesh, opposite, across, scratch);
         t.push_back(now_ms() - t0);
       }
       table_ms = median(t);

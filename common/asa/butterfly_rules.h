@@ -119,13 +119,19 @@ inline Vec3f unit_face_normal(const LevelView& m, uint32_t f) {
 }
 
 
-[[gnu::always_inline]] inline Vec3f edge_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt, EdgePlacement placement) {
-  const Vec3f s = zorin_point(m, c, wt);
-  if (placement == EdgePlacement::kZorin || m.feature_edge[c]) return s;
+// Projection placement of an interior edge's Butterfly point s (the thesis):
+// only its offset along the averaged normal of the edge's two faces is kept.
+inline Vec3f project_point(const LevelView& m, uint32_t c, Vec3f s) {
   const uint32_t o = m.opposite[c];
   const Vec3f mid = (P(m, m.corner_vertex[next_corner(c)]) + P(m, m.corner_vertex[prev_corner(c)])) * 0.5f;
   const Vec3f normal = normalized(unit_face_normal(m, c / 3) + unit_face_normal(m, o / 3));
   return mid + normal * dot(normal, s - mid);
+}
+
+[[gnu::always_inline]] inline Vec3f edge_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt, EdgePlacement placement) {
+  const Vec3f s = zorin_point(m, c, wt);
+  if (placement == EdgePlacement::kZorin || m.feature_edge[c]) return s;
+  return project_point(m, c, s);
 }
 
 }  // namespace meshstream::asa::rules

@@ -18,6 +18,17 @@ namespace meshstream::asa {
 inline uint32_t next_corner(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
 inline uint32_t prev_corner(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
 
+// across[c] = vertex of opposite[c] (kNone where there is none), for
+// `corners` corners. O(corners).
+inline void fill_across(const uint32_t* corner_vertex, const uint32_t* opposite, uint32_t corners,
+                        std::vector<uint32_t>& across) {
+  across.resize(corners);
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t o = opposite[c];
+    across[c] = o == kNone ? kNone : corner_vertex[o];
+  }
+}
+
 // Green (bisected) faces come in consecutive pairs made from a parent
 // (A, B, C) split at M on BC: first = (A, B, M), second = (A, M, C). The apex
 // A is local corner 0 of both; the shared edge A-M is internal to the pair.
@@ -28,6 +39,7 @@ struct LevelView {
   const Vec3f* positions = nullptr;
   const uint32_t* corner_vertex = nullptr;  // 3 per face
   const uint32_t* opposite = nullptr;       // 3 per face
+  const uint32_t* across = nullptr;         // per corner: vertex of the opposite corner (kNone on a boundary)
   const uint8_t* feature_edge = nullptr;    // per corner: the faced edge is boundary or crease
   const uint8_t* vertex_features = nullptr; // per vertex: feature edges at it (saturating)
   const uint32_t* valence = nullptr;        // per vertex: faces around it (= valence if interior)
@@ -41,6 +53,7 @@ struct LevelMesh {
   std::vector<Vec3f> positions;
   std::vector<Triangle> triangles;
   std::vector<uint32_t> opposite;
+  std::vector<uint32_t> across;
   std::vector<uint8_t> feature_edge;
   std::vector<uint8_t> vertex_features;
   std::vector<uint32_t> valence;
@@ -54,6 +67,7 @@ struct LevelMesh {
     v.positions = positions.data();
     v.corner_vertex = triangles.empty() ? nullptr : triangles.front().data();
     v.opposite = opposite.data();
+    v.across = across.empty() ? nullptr : across.data();
     v.feature_edge = feature_edge.data();
     v.vertex_features = vertex_features.data();
     v.valence = valence.data();

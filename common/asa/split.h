@@ -8,6 +8,7 @@
 
 #include "common/asa/butterfly_stencils.h"
 #include "common/asa/closure.h"
+#include "common/asa/edge_points.h"
 #include "common/asa/level_mesh.h"
 #include "common/asa/subdivide.h"
 
@@ -26,6 +27,7 @@ struct SplitInput {
 struct SplitScratch {
   std::vector<uint32_t> edge_vertex;  // per corner: new vertex on the faced edge or kNone
   std::vector<uint32_t> slot_a, slot_b;
+  EdgePointScratch points;
 };
 
 // Uniform 1-to-4 split of every face (classic modified Butterfly).

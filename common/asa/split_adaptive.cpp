@@ -10,7 +10,7 @@
 #include <array>
 #include <cstring>
 
-#include "common/asa/butterfly_rules.h"
+#include "common/asa/edge_points.h"
 #include "common/asa/split.h"
 
 namespace meshstream::asa {
@@ -138,10 +138,10 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   } else {
     out.texcoords.clear();
   }
-  for (uint32_t c = 0; c < corners; ++c) {
+  compute_edge_points(m, s.edge_vertex.data(), V, E, *in.weights, in.placement, out.positions.data(), s.points);
+  for (uint32_t c = 0; (colors || texcoords) && c < corners; ++c) {
     const uint32_t id = s.edge_vertex[c];
     if (id == kNone || (opp[c] != kNone && opp[c] < c)) continue;
-    out.positions[id] = rules::edge_point(m, c, *in.weights, in.placement);
     const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
     if (colors) {
       const Vec4f ca = in.colors[a], cb = in.colors[b];
@@ -276,6 +276,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     out.opposite[s.slot_a[c]] = s.slot_b[o];
     out.opposite[s.slot_b[c]] = s.slot_a[o];
   }
+  fill_across(out.triangles.front().data(), out.opposite.data(), 3 * e.count, out.across);
   // Vertex data for the next level: faces per vertex are recounted by the
   // caller; features: old vertices keep theirs, new ones have two when their
   // edge was a feature edge.

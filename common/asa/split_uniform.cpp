@@ -4,7 +4,7 @@
 // is what makes chaining levels cheap.
 #include <cstring>
 
-#include "common/asa/butterfly_rules.h"
+#include "common/asa/edge_points.h"
 #include "common/asa/split.h"
 
 namespace meshstream::asa {
@@ -49,7 +49,10 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
     std::memcpy(out.vertex_features.data(), m.vertex_features, V);
   }
 
+  // Name the edges (the first corner of an edge in corner order names it),
+  // with the per-vertex data of the new vertices.
   uint32_t next_id = V;
+  const uint8_t* parent_feature = m.feature_edge;
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t o = opp[c];
     if (o != kNone && o < c) {
@@ -57,11 +60,10 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       continue;
     }
     const uint32_t id = next_id++;
-    edge_of[c] = id - V;
-    pos[id] = rules::edge_point(m, c, *in.weights, in.placement);
+    edge_of[c] = id;
     if (topology) {
       out.valence[id] = o == kNone ? 3 : 6;
-      out.vertex_features[id] = m.feature_edge[c] ? 2 : 0;
+      out.vertex_features[id] = parent_feature[c] ? 2 : 0;
     }
     if (colors | texcoords) {
       const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
@@ -75,12 +77,13 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       }
     }
   }
+  compute_edge_points(m, edge_of.data(), V, E, *in.weights, in.placement, pos, scratch.points);
 
   out.triangles.resize(4 * static_cast<size_t>(F));
   uint32_t* t = out.triangles.front().data();
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t v0 = cv[3 * f], v1 = cv[3 * f + 1], v2 = cv[3 * f + 2];
-    const uint32_t m0 = V + edge_of[3 * f], m1 = V + edge_of[3 * f + 1], m2 = V + edge_of[3 * f + 2];
+    const uint32_t m0 = edge_of[3 * f], m1 = edge_of[3 * f + 1], m2 = edge_of[3 * f + 2];
     uint32_t* q = t + 12 * static_cast<size_t>(f);
     q[0] = v0; q[1] = m2; q[2] = m1;
     q[3] = v1; q[4] = m0; q[5] = m2;
@@ -99,13 +102,18 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
   if (!in.want_topology) return;
   out.opposite.resize(12 * static_cast<size_t>(F));
   out.feature_edge.resize(12 * static_cast<size_t>(F));
+  out.across.resize(12 * static_cast<size_t>(F));
   uint32_t* oo = out.opposite.data();
+  uint32_t* ax = out.across.data();
   uint8_t* fe = out.feature_edge.data();
+  const uint32_t* mid = edge_of.data();
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t base = 12 * f;  // first corner of child 4f
     for (uint32_t i = 0; i < 3; ++i) {
       oo[base + 3 * i] = base + 9 + i;  // corner child's inner edge <-> middle child
       oo[base + 9 + i] = base + 3 * i;
+      ax[base + 3 * i] = mid[3 * f + i];
+      ax[base + 9 + i] = cv[3 * f + i];
       fe[base + 3 * i] = 0;
       fe[base + 9 + i] = 0;
     }
@@ -118,10 +126,15 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       const uint32_t o = opp[c];
       if (o == kNone) {
         oo[near_next] = oo[near_prev] = kNone;
+        ax[near_next] = ax[near_prev] = kNone;
       } else {
+        // Across each half lies a midpoint of the neighbour g: corner 1 of
+        // its child j+2 is m_{j+1}, corner 2 of its child j+1 is m_{j+2}.
         const uint32_t g = o / 3, j = o % 3;
         oo[near_next] = 12 * g + 3 * ((j + 2) % 3) + 1;
         oo[near_prev] = 12 * g + 3 * ((j + 1) % 3) + 2;
+        ax[near_next] = mid[3 * g + (j + 1) % 3];
+        ax[near_prev] = mid[3 * g + (j + 2) % 3];
       }
       fe[near_next] = fe[near_prev] = m.feature_edge[c];
     }

@@ -76,11 +76,12 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
 
   // Level 0: the caller's arrays plus our corner table and feature flags.
   asa::LevelMesh& base = ws.base;
-  if (auto built = asa::build_opposites(mesh, base.opposite, ws.corner_scratch); !built) return built;
+  if (auto built = asa::build_opposites(mesh, base.opposite, base.across, ws.corner_scratch); !built) return built;
   asa::LevelView view;
   view.positions = mesh.positions.data();
   view.corner_vertex = F ? mesh.triangles.front().data() : nullptr;
   view.opposite = base.opposite.data();
+  view.across = base.across.data();
   view.vertex_count = V;
   view.face_count = F;
   // Normals: for crease tagging and flatness (the uniform scheme needs none).

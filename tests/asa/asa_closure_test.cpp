@@ -76,6 +76,11 @@ void expect_topology_consistent(const LevelMesh& out) {
   for (uint32_t c = 0; c < out.opposite.size(); ++c) ASSERT_EQ(out.opposite[c], adj->opposite(c)) << c;
   for (uint32_t c = 0; c < out.opposite.size(); ++c)
     ASSERT_EQ(out.feature_edge[c] != 0, adj->opposite(c) == kNone) << c;
+  // across (vertex of the opposite corner), derived by the split as well.
+  ASSERT_EQ(out.across.size(), out.opposite.size());
+  for (uint32_t c = 0; c < out.across.size(); ++c)
+    ASSERT_EQ(out.across[c], adj->opposite(c) == kNone ? kNone : m.triangles[adj->opposite(c) / 3][adj->opposite(c) % 3])
+        << c;
 }
 
 // In the grid, face 2 * (j * n + i) is the lower triangle of square (i, j).

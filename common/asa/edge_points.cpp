@@ -1,0 +1,195 @@
+// Edge points of one level (see edge_points.h). The classification is the
+// one of rules::zorin_point; an edge with an extraordinary endpoint is left
+// pending in the first pass and finished at its centre(s): one centre gives
+// the point, two are averaged ((e_a + e_b) / 2 is the same bits in either
+// arrival order, float addition being commutative). The stencil sum at a
+// centre adds the same terms in the same order as rules::extraordinary_point
+// (centre first, then the ring from the edge's other endpoint on), so every
+// bit agrees with the per-edge evaluation.
+#include "common/asa/edge_points.h"
+
+#include "common/asa/butterfly_rules.h"
+
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
+namespace meshstream::asa {
+namespace {
+
+// Arrival states of a pending edge's new vertex.
+enum : uint8_t { kOneCentre = 1, kTwoCentres = 2, kSecondOfTwo = 3 };
+
+inline bool extraordinary(const LevelView& m, uint32_t v) {
+  const uint32_t K = m.valence[v];
+  return m.vertex_features[v] == 0 && K != 6 && K >= 3;
+}
+
+inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
+  if (s.vertex_corner[v] != kNone) return;
+  s.vertex_corner[v] = corner;
+  s.centres.push_back(v);
+}
+
+// Pass 2: every centre's stencil for each of its split edges. The ring is
+// gathered once into coordinate arrays, and the K sums are accumulated
+// together, term by term: each sum still adds its terms in the order of
+// rules::extraordinary_point (same bits), but the K independent sums
+// vectorize.
+[[gnu::noinline]] void centre_points(const LevelView& m, const uint32_t* edge_vertex, uint32_t first_new,
+                                     const ButterflyWeights& wt, Vec3f* pos, EdgePointScratch& s) {
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
+  for (const uint32_t v : s.centres) {
+    const uint32_t K = m.valence[v];
+    const float* weights = wt.extraordinary(K);
+    uint32_t x = s.vertex_corner[v];
+    s.vertex_corner[v] = kNone;
+    const size_t need = 9 * static_cast<size_t>(K) + 24;
+    if (s.ring.size() < need) {
+      s.ring.assign(need, 0.0f);  // the padding stays zero
+      s.ring_ids.resize(K);
+    }
+    // Layout: ring x, y, z (2K + 4 each: the ring twice, so rotations are
+    // contiguous, then zero padding for the last vector), then sums x, y, z
+    // (K + 4 each).
+    const uint32_t stride = 2 * K + 4;
+    float* rx = s.ring.data();
+    float* ry = rx + stride;
+    float* rz = ry + stride;
+    float* sx = rz + stride;
+    float* sy = sx + K + 4;
+    float* sz = sy + K + 4;
+    uint32_t* ids = s.ring_ids.data();
+    for (uint32_t j = 0; j < K; ++j) {
+      const uint32_t nx = next_corner(x);
+      const Vec3f p = m.positions[cv[nx]];
+      rx[j] = rx[j + K] = p.x;
+      ry[j] = ry[j + K] = p.y;
+      rz[j] = rz[j + K] = p.z;
+      ids[j] = edge_vertex[prev_corner(x)];
+      x = next_corner(opp[nx]);
+    }
+    for (uint32_t j = 2 * K; j < stride; ++j) rx[j] = ry[j] = rz[j] = 0.0f;
+    const Vec3f centre = m.positions[v] * weights[K];
+#if defined(__SSE2__)
+    // Four sums at a time; each lane adds exactly the scalar terms in order
+    // (a vector multiply/add rounds each lane like the scalar operation).
+    for (uint32_t g = 0; g < K; g += 4) {
+      __m128 ax = _mm_set1_ps(centre.x), ay = _mm_set1_ps(centre.y), az = _mm_set1_ps(centre.z);
+      for (uint32_t i = 0; i < K; ++i) {
+        const __m128 wi = _mm_set1_ps(weights[i]);
+        ax = _mm_add_ps(ax, _mm_mul_ps(_mm_loadu_ps(rx + i + g), wi));
+        ay = _mm_add_ps(ay, _mm_mul_ps(_mm_loadu_ps(ry + i + g), wi));
+        az = _mm_add_ps(az, _mm_mul_ps(_mm_loadu_ps(rz + i + g), wi));
+      }
+      _mm_storeu_ps(sx + g, ax);
+      _mm_storeu_ps(sy + g, ay);
+      _mm_storeu_ps(sz + g, az);
+    }
+#else
+    for (uint32_t j = 0; j < K; ++j) {
+      sx[j] = centre.x;
+      sy[j] = centre.y;
+      sz[j] = centre.z;
+    }
+    for (uint32_t i = 0; i < K; ++i) {
+      const float wi = weights[i];
+      for (uint32_t j = 0; j < K; ++j) {
+        sx[j] += rx[i + j] * wi;
+        sy[j] += ry[i + j] * wi;
+        sz[j] += rz[i + j] * wi;
+      }
+    }
+#endif
+    for (uint32_t j = 0; j < K; ++j) {
+      const uint32_t id = ids[j];
+      if (id == kNone) continue;
+      const Vec3f sum{sx[j], sy[j], sz[j]};
+      uint8_t& state = s.arrivals[id - first_new];
+      if (state == kTwoCentres) {
+        pos[id] = sum;
+        state = kSecondOfTwo;
+      } else if (state == kSecondOfTwo) {
+        pos[id] = (pos[id] + sum) * 0.5f;
+      } else {
+        pos[id] = sum;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32_t first_new,
+                         uint32_t new_count, const ButterflyWeights& wt, EdgePlacement placement,
+                         Vec3f* pos, EdgePointScratch& s) {
+  const uint32_t corners = 3 * m.face_count;
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
+  const uint8_t* fe = m.feature_edge;
+  const bool project = placement == EdgePlacement::kProjection;
+  const float w = wt.tension();
+  if (s.vertex_corner.size() < m.vertex_count) s.vertex_corner.resize(m.vertex_count, kNone);
+  s.arrivals.resize(new_count);
+  s.centres.clear();
+  s.pending.clear();
+
+  // Per vertex: is it an extraordinary centre (one byte, read twice per edge).
+  s.irregular.resize(m.vertex_count);
+  uint8_t* irregular = s.irregular.data();
+  for (uint32_t v = 0; v < m.vertex_count; ++v) irregular[v] = extraordinary(m, v);
+  const uint32_t* across = m.across;
+  if (!across) {  // a level built by hand (tests): derive it
+    fill_across(cv, opp, corners, s.across);
+    across = s.across.data();
+  }
+
+  // Pass 1: curve and regular stencils; extraordinary edges wait.
+  for (uint32_t c = 0; c < corners; ++c) {
+    const uint32_t id = edge_vertex[c];
+    const uint32_t o = opp[c];
+    if (id == kNone || (o != kNone && o < c)) continue;
+    if (fe[c]) {
+      pos[id] = rules::curve_point(m, c);
+      continue;
+    }
+    const uint32_t n = next_corner(c), p = prev_corner(c);
+    const uint32_t a = cv[n], b = cv[p];
+    const bool irregular_a = irregular[a], irregular_b = irregular[b];
+    if (!irregular_a && !irregular_b) {
+      Vec3f q;
+      if (w == 0.0f) {
+        // rules::regular_point with w = 0, reading the wing vertices from
+        // `across` (one line of the neighbour instead of four lookups).
+        const uint32_t no = next_corner(o), po = prev_corner(o);
+        const Vec3f A = m.positions[a], B = m.positions[b];
+        const Vec3f b0 = m.positions[cv[c]], b1 = m.positions[across[c]];
+        const Vec3f wA0 = fe[p] ? A + b0 - B : m.positions[across[p]];
+        const Vec3f wB0 = fe[n] ? B + b0 - A : m.positions[across[n]];
+        const Vec3f wA1 = fe[no] ? A + b1 - B : m.positions[across[no]];
+        const Vec3f wB1 = fe[po] ? B + b1 - A : m.positions[across[po]];
+        const Vec3f wings = (wA0 + wB1) + (wB0 + wA1);
+        q = (A + B) * 0.5f + (b0 + b1) * 0.125f - wings * 0.0625f;
+      } else {
+        q = rules::regular_point(m, c, w);
+      }
+      pos[id] = project ? rules::project_point(m, c, q) : q;
+      continue;
+    }
+    s.arrivals[id - first_new] = irregular_a && irregular_b ? kTwoCentres : kOneCentre;
+    if (irregular_a) note_centre(a, n, s);
+    if (irregular_b) note_centre(b, next_corner(o), s);
+    if (project) s.pending.push_back(c);
+  }
+
+  centre_points(m, edge_vertex, first_new, wt, pos, s);
+
+  // Projection placement of the extraordinary edges, now that they are known.
+  for (const uint32_t c : s.pending) {
+    const uint32_t id = edge_vertex[c];
+    pos[id] = rules::project_point(m, c, pos[id]);
+  }
+}
+
+}  // namespace meshstream::asa

@@ -1,0 +1,40 @@
+// All new edge points of one level in two passes: edges whose endpoints are
+// regular (or on a boundary/crease) get their stencil directly; edges at an
+// extraordinary vertex are computed around that vertex, which gathers its
+// one-ring once and evaluates the K rotations of its stencil from that local
+// copy (the per-edge way walks the fan again for every one of its K edges).
+// Results are bit-identical to rules::edge_point. Uses mesh.across (derived
+// when null).
+// Internal to common/asa.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/asa/butterfly_stencils.h"
+#include "common/asa/level_mesh.h"
+
+namespace meshstream::asa {
+
+struct EdgePointScratch {
+  std::vector<uint32_t> vertex_corner;  // per vertex: a corner at it, kNone between calls
+  std::vector<uint32_t> centres;        // extraordinary vertices met this call
+  std::vector<uint32_t> pending;        // naming corners of edges done at their centres
+  std::vector<uint32_t> across;         // only when the level has none
+  std::vector<uint8_t> irregular;       // per vertex: an extraordinary centre
+  std::vector<uint8_t> arrivals;        // per new vertex (minus first_new): stencils still expected
+  std::vector<float> ring;              // one centre's one-ring (twice over) and sums, per coordinate
+  std::vector<uint32_t> ring_ids;       // new vertex on each ring edge (or kNone)
+};
+
+// For every corner c with edge_vertex[c] != kNone that names its edge
+// (boundary, or c < opposite[c]): pos[edge_vertex[c]] = the Butterfly point of
+// the edge faced by c. edge_vertex holds absolute vertex ids >= first_new for
+// both corners of a split edge (kNone for the rest). Preconditions as
+// butterfly_point. O(split edges + sum over extraordinary centres of K^2),
+// the same order as the per-edge stencils.
+void compute_edge_points(const LevelView& mesh, const uint32_t* edge_vertex, uint32_t first_new,
+                         uint32_t new_count, const ButterflyWeights& weights, EdgePlacement placement,
+                         Vec3f* pos, EdgePointScratch& scratch);
+
+}  // namespace meshstream::asa
