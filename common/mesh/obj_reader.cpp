@@ -79,10 +79,24 @@ bool parse_float(std::string_view token, float& value) {
     auto [wide_ptr, wide_ec] = std::from_chars(token.data(), end, wide);
     if (wide_ptr != end) return false;
     if (wide_ec == std::errc::result_out_of_range) {
-      // Beyond double range too: decide by the exponent's sign.
+      // Beyond double range too: 0 or Inf by the decimal exponent of the
+      // first non-zero digit ("0.<400 zeros>1" is tiny, "1e400" huge).
       const size_t e = token.find_first_of("eE");
-      const bool tiny = e != std::string_view::npos && e + 1 < token.size() && token[e + 1] == '-';
-      wide = tiny ? 0.0 : HUGE_VAL;
+      const std::string_view mantissa = token.substr(0, e);
+      const size_t dot = std::min(mantissa.find('.'), mantissa.size());
+      const size_t first = mantissa.find_first_of("123456789");
+      int64_t magnitude = first == std::string_view::npos ? 0
+                          : first < dot ? static_cast<int64_t>(dot - first) - 1
+                                        : -static_cast<int64_t>(first - dot);
+      if (e != std::string_view::npos) {
+        std::string_view exponent = token.substr(e + 1);
+        if (!exponent.empty() && exponent[0] == '+') exponent.remove_prefix(1);
+        int64_t value10 = 0;
+        auto [eptr, eec] = std::from_chars(exponent.data(), exponent.data() + exponent.size(), value10);
+        if (eec == std::errc::result_out_of_range) value10 = exponent[0] == '-' ? -(1ll << 40) : (1ll << 40);
+        magnitude += std::clamp<int64_t>(value10, -(1ll << 40), 1ll << 40);
+      }
+      wide = magnitude < 0 ? 0.0 : HUGE_VAL;
       if (token[0] == '-') wide = -wide;
     } else if (wide_ec != std::errc()) {
       return false;

@@ -331,6 +331,18 @@ TEST(ObjReader, NumberSyntaxOfStrtofExceptHex) {
   EXPECT_EQ(ok->mesh.positions[2].x, 0.0f);
   EXPECT_TRUE(std::signbit(ok->mesh.positions[2].y));
   EXPECT_EQ(ok->mesh.positions[2].z, 700.0f);
+  // Beyond double range: tiny values become 0, huge ones Inf (refused).
+  const std::string tiny = "0." + std::string(400, '0') + "1";
+  auto small = parse("v " + tiny + " 1000e-500 -1e-99999999999999999999\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  ASSERT_TRUE(small) << small.error().message;
+  EXPECT_EQ(small->mesh.positions[0].x, 0.0f);
+  EXPECT_EQ(small->mesh.positions[0].y, 0.0f);
+  EXPECT_TRUE(std::signbit(small->mesh.positions[0].z));
+  for (const std::string huge : {"1" + std::string(400, '0'), std::string("0.001e500"), std::string("1e99999999999999999999")}) {
+    auto big = parse("v 0 0 " + huge + "\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    ASSERT_FALSE(big) << huge;
+    EXPECT_THAT(big.error().message, HasSubstr("(0.000000, 0.000000, Inf)")) << huge;
+  }
 }
 
 TEST(ObjReader, FuzzRegressionInputsAreRefusedCleanly) {
