@@ -1,7 +1,8 @@
-// Reading mesh files: OBJ, binary STL and Draco .drc through Draco's io;
+// Reading mesh files: binary STL and Draco .drc through Draco's io; OBJ,
 // OFF, PLY and ASCII STL through our own readers (Draco has no OFF or ASCII
-// STL reader, and its PLY reader merges equal positions and drops texture
-// coordinates — see mesh_readers.h). Import cleans the mesh into what the
+// STL reader, its PLY reader merges equal positions and drops texture
+// coordinates, and its OBJ reader corrupts the heap on malformed corners —
+// see mesh_readers.h). Import cleans the mesh into what the
 // codec and ASA need and reports every change it made.
 #pragma once
 
