@@ -25,6 +25,8 @@ struct IncrementalDecoder::State {
   Mesh mesh;
   std::vector<RecordDelta> deltas;
   std::optional<Error> error;
+  uint8_t format = kRefinementFormat;
+  int base_shift = 0;
   // The error left the decoded state as it was (damaged index, a record
   // that failed its checksum before being applied): fetching the bytes again
   // may succeed, so resume_at clears it.
@@ -46,11 +48,20 @@ struct IncrementalDecoder::State {
     if (h.base_coder != kBaseCoderOwn && h.base_coder != kBaseCoderDraco) {
       return make_error(ErrorCode::kUnsupported, "unknown base mesh coder " + std::to_string(h.base_coder));
     }
-    if (h.structure_coder != kStructureCoderRange || h.geometry_coder != kGeometryCoderRangeAverage) {
+    if (h.extra.empty() || (h.extra[0] != kRefinementFormatPlain && h.extra[0] != kRefinementFormat)) {
+      return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
+    }
+    format = h.extra[0];
+    const uint8_t geometry_id = format == kRefinementFormat ? kGeometryCoderEmbedded : kGeometryCoderRangeAverage;
+    if (h.structure_coder != kStructureCoderRange || h.geometry_coder != geometry_id) {
       return make_error(ErrorCode::kUnsupported, "unknown refinement coder ids");
     }
-    if (h.extra.empty() || h.extra[0] != kRefinementFormat) {
-      return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
+    base_shift = 0;
+    if (format == kRefinementFormat) {
+      if (h.extra.size() < 2 || h.extra[1] > kMaxBaseShift || h.extra[1] >= h.quant_bits) {
+        return make_error(ErrorCode::kCorrupt, "stream header has no valid base shift");
+      }
+      base_shift = h.extra[1];
     }
     for (float f : {h.bounds.min.x, h.bounds.min.y, h.bounds.min.z, h.bounds.max.x, h.bounds.max.y,
                     h.bounds.max.z}) {
@@ -86,13 +97,15 @@ struct IncrementalDecoder::State {
     RecordDelta delta;
     delta.record = i;
     if (i == 0) {
+      const int coarse_bits = h.quant_bits - base_shift;
       auto base = h.base_coder == kBaseCoderDraco
-                      ? decode_base_draco(payload, rec.vertices, rec.faces, h.quant_bits)
-                      : decode_base_own(payload, rec.vertices, rec.faces, h.quant_bits);
+                      ? decode_base_draco(payload, rec.vertices, rec.faces, coarse_bits)
+                      : decode_base_own(payload, rec.vertices, rec.faces, coarse_bits);
       if (!base) return where(base.error());
-      auto state = RefinementState::from_base(base->positions, base->faces, h.quant_bits);
+      auto state = RefinementState::from_coarse_base(base->positions, base->faces, h.quant_bits, base_shift);
       if (!state) return where(state.error());
       refine = std::move(*state);
+      refine->format = format;
       // Reserve for the final size, but never more than the stream's bytes
       // could describe (every inserted vertex costs well over a bit), so a
       // hostile header cannot make us allocate gigabytes.
@@ -105,7 +118,9 @@ struct IncrementalDecoder::State {
       mesh.positions.reserve(nv);
       mesh.triangles.reserve(nf);
       mesh.positions.resize(base->positions.size());
-      for (size_t v = 0; v < base->positions.size(); ++v) mesh.positions[v] = grid.dequantize(base->positions[v]);
+      for (size_t v = 0; v < base->positions.size(); ++v) {
+        mesh.positions[v] = grid.dequantize(refine->mesh.positions()[v]);
+      }
       mesh.triangles = base->faces;
       delta.full_rebuild = true;
       delta.added_vertices.resize(mesh.positions.size());
@@ -125,10 +140,12 @@ struct IncrementalDecoder::State {
         if (v >= mesh.positions.size()) mesh.positions.resize(v + 1);
         mesh.positions[v] = grid.dequantize(positions[v]);
       }
+      for (uint32_t v : applied.moved_vertices) mesh.positions[v] = grid.dequantize(positions[v]);
       mesh.triangles.resize(refine->mesh.face_slot_count());
       for (uint32_t f : applied.touched_faces) mesh.triangles[f] = refine->mesh.faces()[f];
       delta.added_vertices = std::move(applied.added_vertices);
       delta.touched_faces = std::move(applied.touched_faces);
+      delta.moved_vertices = std::move(applied.moved_vertices);
     }
     deltas.push_back(std::move(delta));
     return {};

@@ -24,6 +24,10 @@ struct RecordDelta {
   std::vector<uint32_t> added_vertices;
   std::vector<uint32_t> touched_faces;  // faces created or rewritten
   bool full_rebuild = false;            // e.g. the base mesh: everything changed
+  // Existing vertices whose position changed (a plane record of an embedded
+  // stream sharpened them): refresh their positions and the faces around
+  // them. Empty for records that only insert.
+  std::vector<uint32_t> moved_vertices;
 };
 
 class IncrementalDecoder {

@@ -82,6 +82,9 @@ class EditableMesh {
   uint32_t insert_vertex(const std::vector<uint32_t>& ring, const std::vector<uint32_t>& fan_corners,
                          uint32_t open, Vec3i position, std::vector<uint32_t>* touched);
 
+  // Moves vertex v (successive approximation: a plane record sharpened it).
+  void set_position(uint32_t v, Vec3i p) { positions_[v] = p; }
+
   // Reserves room for a mesh of this size (avoids regrowth while decoding).
   void reserve(uint32_t vertices, uint32_t faces) {
     positions_.reserve(vertices);

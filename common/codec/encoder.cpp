@@ -9,6 +9,9 @@
 #include "common/codec/encoder.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -131,140 +134,478 @@ std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std
   return out;
 }
 
-class RecordWriter {
+// What only the encoder knows about each decoder vertex: its true position
+// (and residual against its anchor), a unit normal of the original surface
+// there, and the weight of its error in the distortion estimate.
+struct EncoderTruth {
+  std::vector<Vec3i> position;
+  std::vector<Vec3i> residual;
+  std::vector<Vec3f> normal;
+  // Star area when the vertex got its geometry x vertex count then: the area
+  // its error spreads over shrinks about like 1 / vertex count as the mesh
+  // refines around it, so area(now) ~ weight / vertices(now).
+  std::vector<double> weight;
+  std::vector<Vec3f> input_normal;  // by input id
+};
+
+// Squared error of a displaced vertex as surface distance sees it: the
+// normal component fully, tangential slip (which mostly slides the surface
+// within itself) at a quarter.
+double surface_error2(Vec3i recon, Vec3i truth, Vec3f n) {
+  const double e[3] = {double(recon.x) - truth.x, double(recon.y) - truth.y, double(recon.z) - truth.z};
+  const double en = e[0] * n.x + e[1] * n.y + e[2] * n.z;
+  const double all = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+  return en * en + 0.25 * (all - en * en);
+}
+
+// Area of the fan/star polygon `ring` (sum of triangle areas from ring[0]).
+double ring_area(const std::vector<Vec3i>& p, const std::vector<uint32_t>& ring) {
+  double total = 0;
+  const Vec3i o = p[ring[0]];
+  for (size_t i = 1; i + 1 < ring.size(); ++i) {
+    const Vec3i a = p[ring[i]], b = p[ring[i + 1]];
+    const double ax = a.x - o.x, ay = a.y - o.y, az = a.z - o.z;
+    const double bx = b.x - o.x, by = b.y - o.y, bz = b.z - o.z;
+    const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+    total += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+  }
+  return total;
+}
+
+struct Finished {
+  std::vector<uint8_t> payload;
+  uint32_t vertices = 0, faces = 0;
+  bool plane = false;
+  double drop = 0;
+};
+
+// Structure records of one layer at a time, by replaying the decoder (see
+// the file comment). Each record is a run of the layer's walk.
+class StructureWriter {
  public:
-  RecordWriter(RefinementState& state, uint32_t record_bytes) : s_(state), record_bytes_(record_bytes) {}
+  StructureWriter(RefinementState& state, EncoderTruth& truth, uint8_t format)
+      : s_(state), t_(truth), format_(format) {}
 
-  struct Finished {
-    std::vector<uint8_t> payload;
-    uint32_t vertices = 0, faces = 0;
-  };
-  std::vector<Finished> records;
-  std::vector<std::pair<uint32_t, uint32_t>> inserted;  // (input id, decoder id)
+  bool layer_open() const { return remaining_ > 0; }
 
-  // Writes one layer; `removals` are in decoder vertex ids.
-  Status write_layer(const std::vector<Removal>& removals) {
+  // `removals` are in decoder vertex ids.
+  void start_layer(std::vector<Removal> removals) {
+    removals_ = std::move(removals);
     const uint32_t n = s_.mesh.vertex_count();
     first_.assign(n, kNone);
-    next_.assign(removals.size(), kNone);
-    for (uint32_t i = 0; i < removals.size(); ++i) {
-      const uint32_t apex = removals[i].ring[0];
+    next_.assign(removals_.size(), kNone);
+    for (uint32_t i = 0; i < removals_.size(); ++i) {
+      const uint32_t apex = removals_[i].ring[0];
       next_[i] = first_[apex];
       first_[apex] = i;
     }
     s_.layer += 1;
     s_.cursor = s_.order_head;
     s_.last_count = 0;
-    size_t remaining = removals.size();
-    begin_record(true);
-    std::vector<uint32_t> star_ring, star_corners, at_apex;
-    std::vector<std::pair<uint32_t, uint32_t>> order;  // (r, removal)
-    std::vector<ResolvedPatch> patches;
-    while (remaining > 0) {
+    remaining_ = removals_.size();
+    starts_layer_ = true;
+    layer_vertices_ = n;
+  }
+
+  // Writes the next record of the open layer, about `target` bytes.
+  // `inserted` gets (input id, decoder id) of every vertex it put back.
+  Status write_record(uint32_t target, int min_shift, Finished& out,
+                      std::vector<std::pair<uint32_t, uint32_t>>& inserted) {
+    RangeEncoder enc;
+    uint32_t walk_steps = 0, insertions = 0;
+    double drop = 0;
+    const uint32_t n = layer_vertices_;
+    while (remaining_ > 0) {
       while (s_.cursor != kNone && s_.vertices[s_.cursor].layer == s_.layer) s_.cursor = s_.vertices[s_.cursor].next;
       if (s_.cursor == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: walk ended with patches left");
       const uint32_t u = s_.cursor;
       s_.cursor = s_.vertices[u].next;
-      ++walk_steps_;
-      s_.mesh.star(u, star_ring, star_corners);
-      const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
-      const uint32_t faces = static_cast<uint32_t>(star_corners.size());
-      order.clear();
+      ++walk_steps;
+      s_.mesh.star(u, star_ring_, star_corners_);
+      const uint32_t ring_size = static_cast<uint32_t>(star_ring_.size());
+      const uint32_t faces = static_cast<uint32_t>(star_corners_.size());
+      order_.clear();
       for (uint32_t i = u < n ? first_[u] : kNone; i != kNone; i = next_[i]) {
-        const Removal& r = removals[i];
+        const Removal& r = removals_[i];
         uint32_t pos = kNone;
         for (uint32_t f = 0; f < faces; ++f) {
-          if (star_ring[f] == r.ring[1] && star_ring[(f + 1) % ring_size] == r.ring[2]) pos = f;
+          if (star_ring_[f] == r.ring[1] && star_ring_[(f + 1) % ring_size] == r.ring[2]) pos = f;
         }
         if (pos == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: patch not found at its apex");
-        order.push_back({pos, i});
+        order_.push_back({pos, i});
       }
-      std::sort(order.begin(), order.end());
-      const uint32_t count = static_cast<uint32_t>(order.size());
+      std::sort(order_.begin(), order_.end());
+      const uint32_t count = static_cast<uint32_t>(order_.size());
       RefinementModels& m = s_.models;
-      const uint32_t free_faces = mark_taken_faces(s_, star_ring, faces, used_);
+      const uint32_t free_faces = mark_taken_faces(s_, star_ring_, faces, used_);
       if (free_faces != free_face_count(s_, u)) {
         return make_error(ErrorCode::kInvalidMesh, "internal: free face counts disagree");
       }
       if (free_faces > 0) {
-        m.patch_count[count_context(s_, u, free_faces)].encode(enc_, std::min(count, 3u));
-        if (count >= 3) m.patch_count_extra.encode(enc_, count - 3);
+        m.patch_count[count_context(s_, u, free_faces)].encode(enc, std::min(count, 3u));
+        if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
       } else if (count > 0) {
         return make_error(ErrorCode::kInvalidMesh, "internal: patch at a vertex without free faces");
       }
       s_.last_count = count;
-      patches.resize(count);
+      patches_.resize(count);
+      geometry_.resize(count);
       for (uint32_t j = 0; j < count; ++j) {
-        const Removal& r = removals[order[j].second];
+        const Removal& r = removals_[order_[j].second];
         const uint32_t k = static_cast<uint32_t>(r.ring.size());
-        m.valence[std::min(ring_size, 12u)].encode(enc_, k - 3);
-        rank_patch_starts(s_.mesh, u, star_ring, used_, k, candidates_);
-        const auto it = std::find(candidates_.begin(), candidates_.end(), order[j].first);
+        m.valence[std::min(ring_size, 12u)].encode(enc, k - 3);
+        rank_patch_starts(s_.mesh, u, star_ring_, used_, k, candidates_);
+        const auto it = std::find(candidates_.begin(), candidates_.end(), order_[j].first);
         if (it == candidates_.end()) return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
-        encode_start_rank(m, enc_, k, static_cast<uint32_t>(it - candidates_.begin()));
-        for (uint32_t f = 0; f + 2 < k; ++f) used_[(order[j].first + f) % faces] = 1;
-        if (!resolve_patch(s_.mesh, u, star_ring, star_corners, order[j].first, k, patches[j]) ||
-            patches[j].ring != r.ring) {
+        encode_start_rank(m, enc, k, static_cast<uint32_t>(it - candidates_.begin()));
+        for (uint32_t f = 0; f + 2 < k; ++f) used_[(order_[j].first + f) % faces] = 1;
+        if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k, patches_[j]) ||
+            patches_[j].ring != r.ring) {
           return make_error(ErrorCode::kInvalidMesh, "internal: patch does not resolve to its ring");
         }
-        patch_boundary_edges(s_.mesh, patches[j], open_edges_);
+        patch_boundary_edges(s_.mesh, patches_[j], open_edges_);
         if (!open_edges_.empty()) {
           uint32_t choice = 0;
           for (uint32_t e = 0; e < open_edges_.size(); ++e)
             if (open_edges_[e] == r.open) choice = e + 1;
           if (r.open != kNone && choice == 0)
             return make_error(ErrorCode::kInvalidMesh, "internal: open edge of a boundary patch not on the boundary");
-          m.open_edge.encode(enc_, choice);
+          m.open_edge.encode(enc, choice);
         } else if (r.open != kNone) {
           return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
         }
-        const Vec3i pred = predict_position(s_.mesh, patches[j].ring);
-        encode_residual(m, enc_, residual_context(s_.mesh, patches[j].ring), r.position, pred);
+        const Vec3i pred = predict_position(s_.mesh, patches_[j].ring);
+        const int shift = format_ >= 2 ? insertion_shift(s_, patches_[j].ring, min_shift) : 0;
+        encode_coarse_residual(m, enc, residual_context(s_.mesh, patches_[j].ring), r.position, pred, shift,
+                               geometry_[j]);
       }
+      const uint32_t vertices_before = s_.mesh.vertex_count();
       for (uint32_t j = 0; j < count; ++j) {
-        const Removal& r = removals[order[j].second];
-        const uint32_t v = apply_patch(s_, patches[j], r.open, r.position, nullptr);
+        const Removal& r = removals_[order_[j].second];
+        const VertexGeometry& g = geometry_[j];
+        // Distortion estimate: before, the true point lies off the fan by
+        // about its normal offset from the prediction; after, by the error of
+        // its reconstruction; both spread over the patch as a hat (integral
+        // of a hat of height h over area A: A h^2 / 6).
+        const double area = ring_area(s_.mesh.positions(), patches_[j].ring);
+        const Vec3f nrm = t_.input_normal[r.vertex];
+        const Vec3i pred = g.anchor;
+        const double d[3] = {double(r.position.x) - pred.x, double(r.position.y) - pred.y,
+                             double(r.position.z) - pred.z};
+        const double dn = d[0] * nrm.x + d[1] * nrm.y + d[2] * nrm.z;
+        const Vec3i recon = reconstruct(g, s_.max_coordinate);
+        drop += area * (dn * dn - surface_error2(recon, r.position, nrm)) / 6.0;
+        const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
         inserted.push_back({r.vertex, v});
+        t_.position.push_back(r.position);
+        t_.residual.push_back({r.position.x - pred.x, r.position.y - pred.y, r.position.z - pred.z});
+        t_.normal.push_back(nrm);
+        t_.weight.push_back(area * double(vertices_before + count));
       }
-      insertions_ += count;
-      remaining -= count;
-      if (remaining == 0) {
-        end_record();
-      } else if (enc_.bytes_so_far() >= record_bytes_) {
-        end_record();
-        begin_record(false);
-      }
+      insertions += count;
+      remaining_ -= count;
+      if (enc.bytes_so_far() >= target) break;
     }
+    out = Finished{};
+    write_record_header({starts_layer_, walk_steps, insertions, uint32_t(min_shift)}, out.payload, format_);
+    starts_layer_ = false;
+    std::vector<uint8_t> coded = enc.finish();
+    out.payload.insert(out.payload.end(), coded.begin(), coded.end());
+    out.vertices = s_.mesh.vertex_count();
+    out.faces = s_.mesh.face_slot_count();
+    out.drop = drop;
     return {};
   }
 
  private:
-  void begin_record(bool starts_layer) {
-    enc_ = RangeEncoder();
-    starts_layer_ = starts_layer;
-    walk_steps_ = 0;
-    insertions_ = 0;
-  }
-  void end_record() {
-    Finished f;
-    write_record_header({starts_layer_, walk_steps_, insertions_}, f.payload);
-    std::vector<uint8_t> coded = enc_.finish();
-    f.payload.insert(f.payload.end(), coded.begin(), coded.end());
-    f.vertices = s_.mesh.vertex_count();
-    f.faces = s_.mesh.face_slot_count();
-    records.push_back(std::move(f));
-  }
-
   RefinementState& s_;
-  uint32_t record_bytes_;
-  RangeEncoder enc_;
+  EncoderTruth& t_;
+  uint8_t format_;
+  std::vector<Removal> removals_;
+  size_t remaining_ = 0;
   bool starts_layer_ = false;
-  uint32_t walk_steps_ = 0, insertions_ = 0;
-  std::vector<uint32_t> first_, next_, open_edges_, candidates_;
+  uint32_t layer_vertices_ = 0;
+  std::vector<uint32_t> first_, next_, open_edges_, candidates_, star_ring_, star_corners_;
+  std::vector<std::pair<uint32_t, uint32_t>> order_;  // (r, removal)
+  std::vector<ResolvedPatch> patches_;
+  std::vector<VertexGeometry> geometry_;
   std::vector<uint8_t> used_;
 };
 
+// A plane step's true bits without coding them (for estimates).
+struct PlaneBitOracle {
+  Vec3i residual;
+  uint32_t bit(BitModel&, int axis, int below) { return (uint32_t(std::abs(residual[axis])) >> below) & 1u; }
+  uint32_t sign(BitModel&, int axis) { return residual[axis] < 0 ? 1u : 0u; }
+};
+
+// A run of vertex ids refined together by plane records (a batch).
+struct PlaneGroup {
+  uint32_t first = 0, count = 0;
+  bool started = false;      // a plane record was written for it
+  uint32_t pending = 0;      // vertices with shift > 0
+  int top_plane = 0;         // largest shift - 1 among them
+  double scaled_drop = 0;    // estimated drop of its next plane x vertex count
+};
+
+void evaluate_group(const RefinementState& s, const EncoderTruth& t, PlaneGroup& g) {
+  g.pending = 0;
+  g.top_plane = 0;
+  g.scaled_drop = 0;
+  GeometryModels scratch;  // the oracle ignores models
+  for (uint32_t v = g.first; v < g.first + g.count; ++v) {
+    VertexGeometry geo = s.geometry[v];
+    if (geo.shift == 0) continue;
+    ++g.pending;
+    g.top_plane = std::max(g.top_plane, geo.shift - 1);
+    const Vec3i before = s.mesh.positions()[v];
+    PlaneBitOracle io{t.residual[v]};
+    uint8_t prev_new = 0;
+    plane_step(scratch, io, geo, prev_new, s.max_coordinate);
+    const Vec3i after = reconstruct(geo, s.max_coordinate);
+    g.scaled_drop += t.weight[v] *
+                     (surface_error2(before, t.position[v], t.normal[v]) -
+                      surface_error2(after, t.position[v], t.normal[v])) / 6.0;
+  }
+}
+
+// Area-weighted vertex normals of the (quantized) input, unit length.
+std::vector<Vec3f> vertex_normals(const std::vector<Vec3i>& q, const std::vector<Triangle>& faces) {
+  std::vector<Vec3f> n(q.size(), Vec3f{0, 0, 0});
+  for (const Triangle& t : faces) {
+    const Vec3i a = q[t[0]], b = q[t[1]], c = q[t[2]];
+    const double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+    const double wx = c.x - a.x, wy = c.y - a.y, wz = c.z - a.z;
+    const Vec3f cr{float(uy * wz - uz * wy), float(uz * wx - ux * wz), float(ux * wy - uy * wx)};
+    for (uint32_t v : t) n[v] = n[v] + cr;
+  }
+  for (Vec3f& x : n) {
+    const float len = std::sqrt(x.x * x.x + x.y * x.y + x.z * x.z);
+    x = len > 0 ? Vec3f{x.x / len, x.y / len, x.z / len} : Vec3f{0, 0, 1};
+  }
+  return n;
+}
+
+struct EncodedStream {
+  std::vector<uint8_t> bytes;
+  size_t largest_refinement = 0;
+  size_t records = 0;
+};
+
+Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
+                                  const DecimationResult& dec, const EncodeOptions& options,
+                                  uint32_t record_bytes, EncodeReport* report) {
+  const int bits = grid.bits;
+  const uint8_t format = kRefinementFormat;
+  const int base_shift =
+      options.embedded ? std::clamp(options.base_shift < 0 ? bits - 8 : options.base_shift, 0,
+                                    std::min(kMaxBaseShift, bits - 1))
+                       : 0;
+  std::vector<Vec3i> coarse(q.size());
+  for (size_t v = 0; v < q.size(); ++v)
+    for (int a = 0; a < 3; ++a) coarse[v][a] = q[v][a] >> base_shift;
+
+  ChosenBase base = code_base_own(dec, coarse, bits - base_shift);
+  if (options.allow_draco_base) {
+    if (auto draco = code_base_draco(dec, coarse, bits - base_shift);
+        draco && draco->bytes.size() < base.bytes.size()) {
+      base = std::move(*draco);
+    }
+  }
+  auto state = RefinementState::from_coarse_base(base.decoded.positions, base.decoded.faces, bits, base_shift);
+  if (!state) return tl::unexpected(state.error());
+  state->format = format;
+  const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
+
+  // Encoder-side truth, in decoder ids.
+  EncoderTruth truth;
+  truth.input_normal = vertex_normals(q, mesh.triangles);
+  const std::vector<Vec3f>& normals = truth.input_normal;
+  {
+    std::vector<double> star_area(base_n, 0.0);
+    for (const Triangle& f : base.decoded.faces) {
+      const double a = ring_area(state->mesh.positions(), {f[0], f[1], f[2]});
+      for (uint32_t v : f) star_area[v] += a;
+    }
+    for (uint32_t d = 0; d < base_n; ++d) {
+      const uint32_t in = base.to_input[d];
+      truth.position.push_back(q[in]);
+      const Vec3i anchor = state->geometry[d].anchor;
+      truth.residual.push_back({q[in].x - anchor.x, q[in].y - anchor.y, q[in].z - anchor.z});
+      truth.normal.push_back(normals[in]);
+      truth.weight.push_back(star_area[d] * base_n);
+    }
+  }
+  // Input id -> decoder id, growing as the replay inserts vertices.
+  std::vector<uint32_t> to_decoder(mesh.vertex_count(), kNone);
+  for (uint32_t d = 0; d < base.to_input.size(); ++d) to_decoder[base.to_input[d]] = d;
+
+  std::vector<Finished> records;
+  Finished base_record;
+  base_record.payload = base.bytes;
+  base_record.vertices = base_n;
+  base_record.faces = static_cast<uint32_t>(base.decoded.faces.size());
+  records.push_back(std::move(base_record));
+
+  auto hash_state = [&](const RefinementState& s) {
+    std::vector<Vec3f> p(s.mesh.vertex_count());
+    for (uint32_t v = 0; v < p.size(); ++v) p[v] = grid.dequantize(s.mesh.positions()[v]);
+    return position_hash(p);
+  };
+  if (report) {
+    report->records.clear();
+    report->base_shift = static_cast<uint32_t>(base_shift);
+    report->plane_bits_raw = report->plane_bytes_coded = report->structure_bytes = 0;
+    report->records.push_back({false, base_n, uint32_t(base.bytes.size()), hash_state(*state), 0});
+  }
+
+  // Plane groups: about a record's worth of plane bits each.
+  const uint32_t group_vertices = std::max<uint32_t>(16, record_bytes * 8 / 4);
+  std::vector<PlaneGroup> groups;
+  auto add_range = [&](uint32_t first, uint32_t count) {
+    while (count > 0) {
+      if (!groups.empty() && !groups.back().started && groups.back().first + groups.back().count == first &&
+          groups.back().count < group_vertices) {
+        const uint32_t take = std::min(count, group_vertices - groups.back().count);
+        groups.back().count += take;
+        first += take;
+        count -= take;
+        evaluate_group(*state, truth, groups.back());
+        continue;
+      }
+      PlaneGroup g;
+      g.first = first;
+      g.count = std::min(count, group_vertices);
+      first += g.count;
+      count -= g.count;
+      evaluate_group(*state, truth, g);
+      groups.push_back(g);
+    }
+  };
+  add_range(0, base_n);
+
+  StructureWriter writer(*state, truth, format);
+  size_t next_layer = dec.layers.size();  // layers restore from the last one
+  double structure_slope = std::numeric_limits<double>::infinity();
+  double plane_bits_per_step[kMaxShift + 1];
+  std::fill(std::begin(plane_bits_per_step), std::end(plane_bits_per_step), 3.0);
+  std::vector<std::pair<uint32_t, uint32_t>> inserted;
+  const double record_overhead = 6.0;  // header and range coder flush, bytes
+
+  while (true) {
+    const bool structure_left = writer.layer_open() || next_layer > 0;
+    // The best plane group by estimated drop per byte.
+    int best = -1;
+    double best_slope = -std::numeric_limits<double>::infinity();
+    const double n_now = state->mesh.vertex_count();
+    for (size_t i = 0; i < groups.size(); ++i) {
+      const PlaneGroup& g = groups[i];
+      if (g.pending == 0) continue;
+      const double bytes = g.pending * plane_bits_per_step[g.top_plane] / 8.0 + record_overhead;
+      double slope = g.scaled_drop / n_now / bytes;
+      if (!std::isfinite(slope)) slope = 0;
+      if (best < 0 || slope > best_slope) {
+        best_slope = slope;
+        best = static_cast<int>(i);
+      }
+    }
+    if (structure_left && (best < 0 || structure_slope >= best_slope)) {
+      if (!writer.layer_open()) {
+        --next_layer;
+        std::vector<Removal> layer = dec.layers[next_layer];
+        for (Removal& r : layer)
+          for (uint32_t& u : r.ring) u = to_decoder[u];
+        writer.start_layer(std::move(layer));
+      }
+      const uint32_t first_new = state->mesh.vertex_count();
+      Finished f;
+      inserted.clear();
+      if (auto st = writer.write_record(record_bytes, 0, f, inserted); !st) return tl::unexpected(st.error());
+      for (const auto& [input, decoded] : inserted) to_decoder[input] = decoded;
+      structure_slope = std::isfinite(f.drop) ? std::max(f.drop, 0.0) / double(f.payload.size()) : 0.0;
+      if (report) {
+        report->structure_bytes += f.payload.size();
+        report->records.push_back(
+            {false, f.vertices, uint32_t(f.payload.size()), hash_state(*state), f.drop});
+      }
+      records.push_back(std::move(f));
+      add_range(first_new, state->mesh.vertex_count() - first_new);
+      continue;
+    }
+    if (best < 0) break;
+    PlaneGroup& g = groups[best];
+    Finished f;
+    f.plane = true;
+    const uint32_t steps = g.pending;
+    const int plane = g.top_plane;
+    f.payload = write_plane_record(*state, g.first, g.count, truth.residual);
+    f.vertices = state->mesh.vertex_count();
+    f.faces = state->mesh.face_slot_count();
+    f.drop = g.scaled_drop / n_now;
+    const size_t head = 1 + (g.first >= 128 ? 3 : 1) + (g.count >= 128 ? 2 : 1);
+    const double coded_bits = 8.0 * (double(f.payload.size()) - double(std::min(head, f.payload.size())));
+    plane_bits_per_step[plane] = 0.7 * plane_bits_per_step[plane] + 0.3 * coded_bits / std::max(1u, steps);
+    g.started = true;
+    if (report) {
+      report->plane_bits_raw += 3ull * steps;
+      report->plane_bytes_coded += f.payload.size() - std::min(head, f.payload.size());
+      report->records.push_back({true, f.vertices, uint32_t(f.payload.size()), hash_state(*state), f.drop});
+    }
+    evaluate_group(*state, truth, g);
+    records.push_back(std::move(f));
+  }
+
+  StreamHeader header;
+  header.vertex_count = mesh.vertex_count();
+  header.face_count = mesh.face_count();
+  header.base_vertex_count = base_n;
+  header.base_face_count = static_cast<uint32_t>(base.decoded.faces.size());
+  header.bounds = grid.bounds;
+  header.quant_bits = static_cast<uint8_t>(bits);
+  header.base_coder = base.coder;
+  header.structure_coder = kStructureCoderRange;
+  header.geometry_coder = kGeometryCoderEmbedded;
+  header.layer_count = static_cast<uint32_t>(dec.layers.size());
+  header.extra = {format, static_cast<uint8_t>(base_shift)};
+
+  EncodedStream out;
+  std::vector<RecordEntry> entries;
+  for (size_t i = 0; i < records.size(); ++i) {
+    const Finished& r = records[i];
+    RecordEntry e;
+    e.size = static_cast<uint32_t>(r.payload.size());
+    e.vertices = r.vertices;
+    e.faces = r.faces;
+    e.crc32 = crc32(0, r.payload.data(), r.payload.size());
+    entries.push_back(e);
+    if (i > 0) out.largest_refinement = std::max(out.largest_refinement, r.payload.size());
+  }
+  if (entries.back().vertices != header.vertex_count || entries.back().faces != header.face_count) {
+    return make_error(ErrorCode::kInvalidMesh, "internal: the records do not rebuild the whole mesh");
+  }
+  out.records = records.size();
+  out.bytes = write_container_prefix(header, entries);
+  for (const Finished& r : records) out.bytes.insert(out.bytes.end(), r.payload.begin(), r.payload.end());
+  return out;
+}
+
 }  // namespace
+
+uint64_t position_hash(const std::vector<Vec3f>& positions) {
+  uint64_t h = 1469598103934665603ull;
+  for (const Vec3f& p : positions) {
+    for (float f : {p.x, p.y, p.z}) {
+      uint32_t b;
+      std::memcpy(&b, &f, 4);
+      for (int i = 0; i < 4; ++i) {
+        h ^= (b >> (8 * i)) & 0xFF;
+        h *= 1099511628211ull;
+      }
+    }
+  }
+  return h;
+}
+
 
 Result<Mesh> quantized_reference(const Mesh& mesh, int quant_bits) {
   auto grid = make_grid(mesh, quant_bits);
@@ -279,6 +620,11 @@ Result<Mesh> quantized_reference(const Mesh& mesh, int quant_bits) {
 }
 
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
+  return encode_hcs(mesh, options, nullptr);
+}
+
+Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,
+                                        EncodeReport* report) {
   auto grid = make_grid(mesh, options.quant_bits);
   if (!grid) return tl::unexpected(grid.error());
   if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
@@ -289,71 +635,27 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
 
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
-  DecimationResult dec = decimate_layers(std::move(*editable), dopt);
+  const DecimationResult dec = decimate_layers(std::move(*editable), dopt);
 
-  ChosenBase base = code_base_own(dec, q, grid->bits);
-  if (options.allow_draco_base) {
-    if (auto draco = code_base_draco(dec, q, grid->bits); draco && draco->bytes.size() < base.bytes.size()) {
-      base = std::move(*draco);
-    }
+  // Granularity (issue II): at least min(n / 50, 200) record boundaries and
+  // no refinement record above 2 % of the stream. Automatic record sizes
+  // start from an estimate of the stream (about 20 bits per vertex) and
+  // shrink when the result misses either bound.
+  const uint32_t n = mesh.vertex_count();
+  const bool automatic = options.record_bytes == 0;
+  double estimate = 20.0 * n / 8.0;
+  uint32_t record_bytes = automatic ? static_cast<uint32_t>(std::clamp(estimate / 250.0, 40.0, 4096.0))
+                                    : std::max<uint32_t>(options.record_bytes, 16);
+  for (int attempt = 0;; ++attempt) {
+    auto encoded = encode_once(mesh, *grid, q, dec, options, record_bytes, report);
+    if (!encoded) return tl::unexpected(encoded.error());
+    const size_t total = encoded->bytes.size();
+    const size_t wanted_records = std::min<size_t>(n / 50, 200) + 1;  // + the base
+    const bool granular =
+        encoded->records >= wanted_records && double(encoded->largest_refinement) <= 0.02 * double(total);
+    if (!automatic || granular || attempt >= 3 || record_bytes <= 16) return std::move(encoded->bytes);
+    record_bytes = std::max<uint32_t>(16, static_cast<uint32_t>(record_bytes * 0.6));
   }
-  auto state = RefinementState::from_base(base.decoded.positions, base.decoded.faces, grid->bits);
-  if (!state) return tl::unexpected(state.error());
-
-  // Input id -> decoder id, growing as the replay inserts vertices.
-  std::vector<uint32_t> to_decoder(mesh.vertex_count(), kNone);
-  for (uint32_t d = 0; d < base.to_input.size(); ++d) to_decoder[base.to_input[d]] = d;
-
-  RecordWriter writer(*state, std::max<uint32_t>(options.record_bytes, 64));
-  std::vector<Removal> layer_dec;
-  for (size_t li = dec.layers.size(); li-- > 0;) {
-    const std::vector<Removal>& layer = dec.layers[li];
-    layer_dec = layer;
-    for (Removal& r : layer_dec) {
-      for (uint32_t& u : r.ring) u = to_decoder[u];
-    }
-    writer.inserted.clear();
-    if (auto s = writer.write_layer(layer_dec); !s) return tl::unexpected(s.error());
-    for (const auto& [input, decoded] : writer.inserted) to_decoder[input] = decoded;
-  }
-
-  StreamHeader header;
-  header.vertex_count = mesh.vertex_count();
-  header.face_count = mesh.face_count();
-  header.base_vertex_count = static_cast<uint32_t>(base.decoded.positions.size());
-  header.base_face_count = static_cast<uint32_t>(base.decoded.faces.size());
-  header.bounds = grid->bounds;
-  header.quant_bits = static_cast<uint8_t>(grid->bits);
-  header.base_coder = base.coder;
-  header.structure_coder = kStructureCoderRange;
-  header.geometry_coder = kGeometryCoderRangeAverage;
-  header.layer_count = static_cast<uint32_t>(dec.layers.size());
-  header.extra = {kRefinementFormat};
-
-  std::vector<RecordEntry> entries;
-  std::vector<const std::vector<uint8_t>*> payloads;
-  RecordEntry e0;
-  e0.size = static_cast<uint32_t>(base.bytes.size());
-  e0.vertices = header.base_vertex_count;
-  e0.faces = header.base_face_count;
-  e0.crc32 = crc32(0, base.bytes.data(), base.bytes.size());
-  entries.push_back(e0);
-  payloads.push_back(&base.bytes);
-  for (const auto& r : writer.records) {
-    RecordEntry e;
-    e.size = static_cast<uint32_t>(r.payload.size());
-    e.vertices = r.vertices;
-    e.faces = r.faces;
-    e.crc32 = crc32(0, r.payload.data(), r.payload.size());
-    entries.push_back(e);
-    payloads.push_back(&r.payload);
-  }
-  if (entries.back().vertices != header.vertex_count || entries.back().faces != header.face_count) {
-    return make_error(ErrorCode::kInvalidMesh, "internal: the records do not rebuild the whole mesh");
-  }
-  std::vector<uint8_t> out = write_container_prefix(header, entries);
-  for (const auto* p : payloads) out.insert(out.end(), p->begin(), p->end());
-  return out;
 }
 
 }  // namespace meshstream

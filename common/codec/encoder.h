@@ -1,6 +1,9 @@
 // Encoding a mesh into one progressive `.hcs` stream (container.h for the
 // layout): quantize, decimate layer by layer, code the base mesh with Draco,
-// then refinement records from coarse to fine.
+// then refinement records from coarse to fine. An embedded stream (the
+// default) also sends positions by successive approximation (bit planes,
+// embedded_geometry.h) and orders structure and plane records by estimated
+// distortion decrease per byte (docs/hcs-format.md).
 #pragma once
 
 #include <cstdint>
@@ -14,22 +17,62 @@ namespace meshstream {
 struct EncodeOptions {
   int quant_bits = 12;                 // 8..20, grid over the bounding box
   uint32_t target_base_vertices = 300; // stop decimating at about this many
-  uint32_t record_bytes = 2048;        // close a refinement record at about this size
+  // Close a refinement record at about this size; 0 = automatic (about
+  // 1/250 of the expected stream, so a stream has a few hundred records and
+  // none beyond the base above 2 % of it).
+  uint32_t record_bytes = 0;
   bool allow_draco_base = true;        // false: always the own base coder (tests)
+  // true: successive-approximation positions and rate-distortion ordering
+  // (issue II). false: issue I's ordering, every position exact at
+  // insertion, no plane records (kept as a peer for the benchmark).
+  bool embedded = true;
+  // Low bits of the base positions sent later as plane records; -1 =
+  // automatic (quant_bits - 8, so the base is an 8-bit mesh). Embedded only.
+  int base_shift = -1;
 };
 
 // Ids written in the stream header (`structure_coder`, `geometry_coder`).
 inline constexpr uint8_t kStructureCoderRange = 1;  // adaptive binary range coder
-inline constexpr uint8_t kGeometryCoderRangeAverage = 1;  // ring average + range-coded residual
-inline constexpr uint8_t kRefinementFormat = 1;     // header extra[0]
+inline constexpr uint8_t kGeometryCoderRangeAverage = 1;  // ring average + range-coded residual (format 1)
+inline constexpr uint8_t kGeometryCoderEmbedded = 2;  // ring average, coarse residual + context-coded bit planes
+inline constexpr uint8_t kRefinementFormatPlain = 1;  // header extra[0]: issue I's records
+inline constexpr uint8_t kRefinementFormat = 2;     // header extra[0]: embedded records; extra[1] = base shift
+inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 1;
+inline constexpr uint32_t kEncoderVersion = 2;
+
+// What the encoder assumed about each record (tests and the benchmark).
+struct EncodedRecord {
+  bool plane = false;          // a plane record (else base or structure)
+  uint32_t vertices = 0;       // mesh vertices after the record
+  uint32_t bytes = 0;          // payload size
+  // FNV-1a of the dequantized float positions (bit patterns, vertex order)
+  // the decoder must show after this record.
+  uint64_t position_hash = 0;
+  // The encoder's estimate of the squared surface distance removed by the
+  // record (grid units^2 x area), used to order records.
+  double distortion_drop = 0;
+};
+struct EncodeReport {
+  std::vector<EncodedRecord> records;
+  uint64_t plane_bits_raw = 0;    // plane-record bits sent as they are would take
+  uint64_t plane_bytes_coded = 0; // their context-coded payload (range-coded blocks)
+  uint64_t structure_bytes = 0;   // structure records
+  uint32_t base_shift = 0;
+};
 
 // Encodes a clean manifold mesh (see import.h). kInvalidArgument for bad
 // options, kNonManifold / kInvalidMesh for a mesh the codec cannot take.
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options = {});
+// The same, also filling `report` (costs O(vertices) per record for the hashes).
+Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,
+                                        EncodeReport* report);
+
+// FNV-1a over the bit patterns of the positions, in vertex order: what
+// EncodedRecord::position_hash holds for a decoder's mesh().
+uint64_t position_hash(const std::vector<Vec3f>& positions);
 
 // The mesh an exact decoder must give back: positions snapped to the
 // quantization grid (dequantized), same triangles.

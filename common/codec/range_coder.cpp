@@ -71,7 +71,9 @@ std::vector<uint8_t> RangeEncoder::finish() {
     }
   }
   for (int i = 0; i < 5; ++i) shift_low();
-  while (!out_.empty() && out_.back() == 0) out_.pop_back();
+  // At most 4: a run of near-certain symbols also ends in zero bytes, and
+  // the decoder refuses a block that reads more than 8 bytes past its end.
+  for (int dropped = 0; dropped < 4 && !out_.empty() && out_.back() == 0; ++dropped) out_.pop_back();
   return std::move(out_);
 }
 

@@ -43,6 +43,30 @@ Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
     s.vertices[v].valence = static_cast<uint32_t>(ring.size());
   }
   s.max_coordinate = (int32_t(1) << quant_bits) - 1;
+  s.geometry.resize(n);
+  for (uint32_t v = 0; v < n; ++v) {
+    s.geometry[v].anchor = s.mesh.positions()[v];
+    s.geometry[v].normal_axis = kBaseVertexAxis;
+  }
+  return s;
+}
+
+Result<RefinementState> RefinementState::from_coarse_base(const std::vector<Vec3i>& coarse,
+                                                          std::vector<Triangle> faces, int quant_bits,
+                                                          int base_shift) {
+  const int32_t max = (int32_t(1) << quant_bits) - 1;
+  std::vector<VertexGeometry> geometry(coarse.size());
+  std::vector<Vec3i> positions(coarse.size());
+  for (size_t v = 0; v < coarse.size(); ++v) {
+    VertexGeometry& g = geometry[v];
+    for (int a = 0; a < 3; ++a) g.anchor[a] = int32_t(uint32_t(coarse[v][a]) << base_shift);
+    g.shift = static_cast<uint8_t>(base_shift);
+    g.normal_axis = kBaseVertexAxis;
+    positions[v] = reconstruct(g, max);
+  }
+  auto s = from_base(std::move(positions), std::move(faces), quant_bits);
+  if (!s) return s;
+  s->geometry = std::move(geometry);
   return s;
 }
 
@@ -113,27 +137,52 @@ ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uin
   return ctx;
 }
 
-void encode_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
-                     Vec3i actual, Vec3i predicted) {
+void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
+                            Vec3i actual, Vec3i predicted, int shift, VertexGeometry& out) {
+  const int bucket = std::max(ctx.scale - shift, 0);
+  out = VertexGeometry{};
+  out.anchor = predicted;
+  out.shift = static_cast<uint8_t>(shift);
+  out.normal_axis = static_cast<uint8_t>(ctx.axis[0]);
   for (int role = 0; role < 3; ++role) {
     const int a = ctx.axis[role];
-    int32_t r = actual[a] - predicted[a];
-    if (role == 0 && ctx.flip) r = -r;
-    models.residual[ctx.scale][role].encode(enc, r);
+    const int32_t r = actual[a] - predicted[a];
+    const uint32_t mag = uint32_t(std::abs(r)) >> shift;
+    int32_t q = r < 0 ? -int32_t(mag) : int32_t(mag);
+    out.mag[a] = mag;
+    if (mag > 0 && r < 0) out.negative |= uint8_t(1u << a);
+    if (role == 0 && ctx.flip) q = -q;
+    models.residual[bucket][role].encode(enc, q);
   }
 }
 
-bool decode_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
-                     Vec3i predicted, int32_t max_coordinate, Vec3i& out) {
+bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
+                            Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out) {
+  const int bucket = std::max(ctx.scale - shift, 0);
+  out = VertexGeometry{};
+  out.anchor = predicted;
+  out.shift = static_cast<uint8_t>(shift);
+  out.normal_axis = static_cast<uint8_t>(ctx.axis[0]);
   for (int role = 0; role < 3; ++role) {
     const int a = ctx.axis[role];
-    int64_t r = models.residual[ctx.scale][role].decode(dec);
-    if (role == 0 && ctx.flip) r = -r;
-    const int64_t value = int64_t(predicted[a]) + r;
-    if (value < 0 || value > max_coordinate) return false;
-    out[a] = static_cast<int32_t>(value);
+    int64_t q = models.residual[bucket][role].decode(dec);
+    if (role == 0 && ctx.flip) q = -q;
+    const int64_t mag = q < 0 ? -q : q;
+    if ((mag << shift) > int64_t(max_coordinate)) return false;
+    if (shift == 0) {
+      const int64_t value = int64_t(predicted[a]) + q;
+      if (value < 0 || value > max_coordinate) return false;
+    }
+    out.mag[a] = static_cast<uint32_t>(mag);
+    if (q < 0) out.negative |= uint8_t(1u << a);
   }
   return true;
+}
+
+int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift) {
+  int shift = min_shift;
+  for (uint32_t u : ring) shift = std::max<int>(shift, s.geometry[u].shift);
+  return shift;
 }
 
 uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>& star_ring,
@@ -278,15 +327,89 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
   return v;
 }
 
-void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out) {
-  out.push_back(header.starts_layer ? 1 : 0);
-  for (uint32_t v : {header.walk_steps, header.insertions}) {
-    while (v >= 0x80) {
-      out.push_back(uint8_t(v | 0x80));
-      v >>= 7;
-    }
-    out.push_back(uint8_t(v));
+uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
+                     const VertexGeometry& geometry, std::vector<uint32_t>* touched) {
+  state.geometry.push_back(geometry);
+  return apply_patch(state, patch, open, reconstruct(geometry, state.max_coordinate), touched);
+}
+
+void write_varint(uint32_t v, std::vector<uint8_t>& out) {
+  while (v >= 0x80) {
+    out.push_back(uint8_t(v | 0x80));
+    v >>= 7;
   }
+  out.push_back(uint8_t(v));
+}
+
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format) {
+  out.push_back(header.starts_layer ? kRecordStartsLayer : 0);
+  write_varint(header.walk_steps, out);
+  write_varint(header.insertions, out);
+  if (format >= 2) write_varint(header.min_shift, out);
+}
+
+Status apply_plane_record(RefinementState& state, std::span<const uint8_t> payload,
+                          AppliedRecord& applied) {
+  applied.added_vertices.clear();
+  applied.touched_faces.clear();
+  applied.moved_vertices.clear();
+  size_t pos = 1;
+  uint32_t first = 0, count = 0;
+  if (state.format < 2) return bad("plane record in a stream of refinement format 1");
+  if (!read_varint(payload, pos, first) || !read_varint(payload, pos, count)) {
+    return bad("plane record header is cut short or malformed");
+  }
+  const uint32_t n = state.mesh.vertex_count();
+  if (count == 0 || first >= n || count > n - first) {
+    return bad("plane record covers vertices " + std::to_string(first) + " + " + std::to_string(count) +
+               " of a mesh of " + std::to_string(n));
+  }
+  RangeDecoder dec(payload.subspan(pos));
+  PlaneBitReader io{dec};
+  uint8_t prev_new = 0;
+  for (uint32_t v = first; v < first + count; ++v) {
+    VertexGeometry& g = state.geometry[v];
+    if (g.shift == 0) continue;
+    if (!plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate)) {
+      return bad("plane record gives vertex " + std::to_string(v) + " a residual beyond the grid");
+    }
+    if (g.shift == 0 && g.normal_axis != kBaseVertexAxis) {
+      for (int a = 0; a < 3; ++a) {
+        const int64_t value = int64_t(g.anchor[a]) + ((g.negative >> a) & 1 ? -int64_t(g.mag[a]) : int64_t(g.mag[a]));
+        if (value < 0 || value > state.max_coordinate) {
+          return bad("plane record puts vertex " + std::to_string(v) + " outside the quantization grid");
+        }
+      }
+    }
+    if (dec.exhausted_badly()) return bad("plane record data ends early");
+    const Vec3i p = reconstruct(g, state.max_coordinate);
+    if (!(p == state.mesh.positions()[v])) {
+      state.mesh.set_position(v, p);
+      applied.moved_vertices.push_back(v);
+    }
+  }
+  if (dec.exhausted_badly()) return bad("plane record data ends early");
+  return {};
+}
+
+std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, uint32_t count,
+                                        const std::vector<Vec3i>& residuals) {
+  std::vector<uint8_t> out;
+  out.push_back(kRecordPlane);
+  write_varint(first, out);
+  write_varint(count, out);
+  RangeEncoder enc;
+  uint8_t prev_new = 0;
+  for (uint32_t v = first; v < first + count; ++v) {
+    VertexGeometry& g = state.geometry[v];
+    if (g.shift == 0) continue;
+    PlaneBitWriter io{enc, residuals[v]};
+    plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate);
+    state.mesh.set_position(v, reconstruct(g, state.max_coordinate));
+  }
+  const std::vector<uint8_t> coded = enc.finish();
+  out.insert(out.end(), coded.begin(), coded.end());
+  return out;
 }
 
 Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
@@ -294,14 +417,26 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
                                AppliedRecord& applied) {
   applied.added_vertices.clear();
   applied.touched_faces.clear();
+  applied.moved_vertices.clear();
   if (payload.empty()) return bad("empty refinement record");
   const uint8_t flags = payload[0];
+  if (flags == kRecordPlane) {
+    if (auto st = apply_plane_record(state, payload, applied); !st) return st;
+    if (state.mesh.vertex_count() != expected_vertices || state.mesh.face_slot_count() != expected_faces) {
+      return bad("plane record where the index says the mesh grows");
+    }
+    return {};
+  }
   if (flags > 1) return bad("unknown refinement record flags " + std::to_string(flags));
   size_t pos = 1;
   RecordHeader h;
   h.starts_layer = flags & 1;
   if (!read_varint(payload, pos, h.walk_steps) || !read_varint(payload, pos, h.insertions)) {
     return bad("refinement record header is cut short or malformed");
+  }
+  if (state.format >= 2) {
+    if (!read_varint(payload, pos, h.min_shift)) return bad("refinement record header is cut short or malformed");
+    if (h.min_shift > kMaxShift) return bad("refinement record shift " + std::to_string(h.min_shift) + " too large");
   }
   const uint32_t vertices_before = state.mesh.vertex_count();
   // Each insertion needs at least one walk step's worth of bits; refuse
@@ -327,7 +462,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   EditableMesh& mesh = state.mesh;
   std::vector<uint32_t> star_ring, star_corners;
   std::vector<ResolvedPatch> patches;
-  std::vector<Vec3i> positions;
+  std::vector<VertexGeometry> positions;
   std::vector<uint32_t> opens, open_edges, candidates;
   std::vector<uint8_t> used_faces;
   uint32_t inserted = 0;
@@ -389,7 +524,8 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       }
       const Vec3i pred = predict_position(mesh, patches[i].ring);
       const ResidualContext ctx = residual_context(mesh, patches[i].ring);
-      if (!decode_residual(m, dec, ctx, pred, state.max_coordinate, positions[i])) {
+      const int shift = insertion_shift(state, patches[i].ring, static_cast<int>(h.min_shift));
+      if (!decode_coarse_residual(m, dec, ctx, pred, shift, state.max_coordinate, positions[i])) {
         return fail("vertex position outside the quantization grid at vertex " +
                                std::to_string(u));
       }

@@ -31,6 +31,7 @@
 
 #include "common/base/result.h"
 #include "common/codec/editable_mesh.h"
+#include "common/codec/embedded_geometry.h"
 #include "common/codec/range_coder.h"
 
 namespace meshstream {
@@ -67,10 +68,22 @@ struct RefinementState {
   int32_t max_coordinate = 4095;
   uint32_t last_count = 0;              // patches at the previous walk vertex
   RefinementModels models;
+  // Successive-approximation state of every vertex (embedded_geometry.h);
+  // mesh.positions() holds reconstruct() of each entry.
+  std::vector<VertexGeometry> geometry;
+  GeometryModels geometry_models;
+  // Refinement record format (header extra[0]): 1 = issue I's records (no
+  // shift field, no plane records), 2 = embedded geometry.
+  uint8_t format = 2;
 
   // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
   static Result<RefinementState> from_base(std::vector<Vec3i> positions, std::vector<Triangle> faces,
                                            int quant_bits);
+  // Same from the coarse base points of an embedded stream: vertex v starts
+  // at coarse[v] << base_shift with its low base_shift bits unknown.
+  static Result<RefinementState> from_coarse_base(const std::vector<Vec3i>& coarse,
+                                                  std::vector<Triangle> faces, int quant_bits,
+                                                  int base_shift);
 };
 
 // One patch resolved against the current mesh.
@@ -144,11 +157,21 @@ struct ResidualContext {
   bool flip = false;
 };
 ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
-void encode_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
-                     Vec3i actual, Vec3i predicted);
-// Returns false when the decoded position leaves the grid [0, max_coordinate].
-bool decode_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
-                     Vec3i predicted, int32_t max_coordinate, Vec3i& out);
+// The residual of an inserted vertex at insertion, with its `shift` low
+// bits left to plane records: per role the value sign * (|r| >> shift)
+// through the model of scale bucket max(scale - shift, 0). `out` becomes the
+// vertex's geometry (anchor = predicted). shift 0 codes exactly as format 1.
+void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
+                            Vec3i actual, Vec3i predicted, int shift, VertexGeometry& out);
+// Returns false when the decoded residual cannot belong to a grid position
+// (shift 0: the position leaves the grid [0, max_coordinate]).
+bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
+                            Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out);
+
+// The precision a vertex inserted into `ring` starts with: the coarsest of
+// its ring vertices' (a finer residual would be below the prediction's own
+// uncertainty), at least the record's `min_shift`.
+int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift);
 
 // Inserts a vertex into a resolved patch and links it after the apex in the
 // order list. Returns its id; appends written face slots to `touched`.
@@ -158,17 +181,27 @@ uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k);
 
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
                      Vec3i position, std::vector<uint32_t>* touched);
+// The same for an embedded vertex: records its geometry and inserts it at
+// reconstruct(geometry).
+uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
+                     const VertexGeometry& geometry, std::vector<uint32_t>* touched);
 
 struct RecordHeader {
   bool starts_layer = false;
   uint32_t walk_steps = 0;
   uint32_t insertions = 0;
+  uint32_t min_shift = 0;  // format 2 only
 };
-void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out);
+// Record flags (first payload byte).
+inline constexpr uint8_t kRecordStartsLayer = 1;
+inline constexpr uint8_t kRecordPlane = 2;
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format = 2);
+void write_varint(uint32_t value, std::vector<uint8_t>& out);
 
 struct AppliedRecord {
   std::vector<uint32_t> added_vertices;
   std::vector<uint32_t> touched_faces;
+  std::vector<uint32_t> moved_vertices;  // plane records: positions that changed
 };
 
 // Decodes one refinement record and applies it to `state`. Every count,
@@ -179,8 +212,21 @@ struct AppliedRecord {
 // O(record size + touched faces).
 // `expected_vertices`/`expected_faces` are the index's counts after the
 // record; a mismatch is an error (and rolls back) like any other.
+// Plane records (flag kRecordPlane) are dispatched to apply_plane_record.
 Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
                                uint32_t expected_vertices, uint32_t expected_faces,
                                AppliedRecord& applied);
+
+// A plane record: u8 flags (kRecordPlane), varint first vertex, varint
+// vertex count, then one range-coded block with one plane step
+// (embedded_geometry.h) for every vertex of [first, first + count) whose
+// shift is not 0. The range must lie inside the mesh. The record's positions
+// go to the mesh and `applied.moved_vertices`. O(count).
+Status apply_plane_record(RefinementState& state, std::span<const uint8_t> payload,
+                          AppliedRecord& applied);
+// Encoder of the same; `residuals[v]` is vertex v's true residual against
+// its anchor. Applies the step to `state` as the decoder will.
+std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, uint32_t count,
+                                        const std::vector<Vec3i>& residuals);
 
 }  // namespace meshstream
