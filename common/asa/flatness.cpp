@@ -83,4 +83,24 @@ uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, flo
   return count;
 }
 
+uint32_t mark_targets_near_fresh(const LevelView& m, const std::vector<Vec3f>& normals,
+                                 const std::vector<uint8_t>& fresh, float t, std::vector<uint8_t>& target) {
+  target.assign(m.face_count, 0);
+  uint32_t count = 0;
+  for (uint32_t f = 0; f < m.face_count; ++f) {
+    if (!fresh[f]) continue;
+    const Vec3f n = normals[f];
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
+      const uint32_t o = m.opposite[c];
+      if (o == kNone || m.feature_edge[c]) continue;
+      if (dot(n, normals[o / 3]) <= t) {
+        const uint32_t g = o / 3;
+        count += !target[f] + !target[g];
+        target[f] = target[g] = 1;
+      }
+    }
+  }
+  return count;
+}
+
 }  // namespace meshstream::asa

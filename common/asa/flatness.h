@@ -34,4 +34,12 @@ uint32_t count_vertex_faces(const LevelView& mesh, std::vector<uint32_t>& faces)
 uint32_t mark_targets(const LevelView& mesh, const std::vector<Vec3f>& normals, float t,
                       std::vector<uint8_t>& target);
 
+// mark_targets after an adaptive split, testing only the edges of fresh faces
+// (fresh[f] != 0): an edge between two unchanged faces was flat at the level
+// before (else both would have been refined) and still is. Same targets as
+// mark_targets (the dot product is symmetric bit for bit). Returns the number
+// of targets. O(F) for the flags plus O(fresh faces).
+uint32_t mark_targets_near_fresh(const LevelView& mesh, const std::vector<Vec3f>& normals,
+                                 const std::vector<uint8_t>& fresh, float t, std::vector<uint8_t>& target);
+
 }  // namespace meshstream::asa

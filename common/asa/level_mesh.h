@@ -61,6 +61,8 @@ struct LevelMesh {
   std::vector<Vec4f> colors;
   std::vector<Vec2f> texcoords;
   std::vector<uint32_t> source;  // per face: the input face it descends from (when tracked)
+  std::vector<Vec3f> normals;    // per face: unit normal (adaptive levels after the first)
+  std::vector<uint8_t> fresh;    // per face: new at this level (not a copy of a parent face)
 
   LevelView view() const {
     LevelView v;

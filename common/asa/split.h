@@ -22,11 +22,15 @@ struct SplitInput {
   EdgePlacement placement = EdgePlacement::kZorin;
   bool want_topology = true;  // fill opposite/feature/valence data for another level
   const uint32_t* source = nullptr;  // per face: input face it descends from; null = untracked
+  // Adaptive split with want_topology: the level's unit face normals; the
+  // output then gets its own (out.normals, out.fresh). Null: none written.
+  const Vec3f* normals = nullptr;
 };
 
 struct SplitScratch {
   std::vector<uint32_t> edge_vertex;  // per corner: new vertex on the faced edge or kNone
   std::vector<uint32_t> slot_a, slot_b;
+  std::vector<uint32_t> kept_base;  // per face: first output corner of a kept face, else kNone
   EdgePointScratch points;
 };
 
@@ -39,6 +43,9 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
 
 // Adaptive split following the closure's per-face actions and split edges.
 // Output faces appear in input face order (each face's children together).
+// With in.normals and want_topology, out.normals holds every output face's
+// unit normal (bit-identical to compute_face_normals) and out.fresh marks the
+// faces that are not unchanged copies of a parent face.
 void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitScratch& scratch,
                     LevelMesh& out, std::vector<FaceKind>* face_kind);
 

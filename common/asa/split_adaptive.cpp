@@ -2,65 +2,84 @@
 // for a green pair whose parent must be refined, replaced by the parent's
 // 1-to-4 split (red-green refinement: a green triangle is never split again).
 //
-// The result's corner table is built without hashing: each parent corner
-// records which output corner(s) face its edge (two when the edge was split:
-// slot_a near vertex(next(c)), slot_b near vertex(prev(c))); a final pass pairs
-// the slots of opposite parent corners. Edges inside one parent are linked
-// while its children are written.
+// The result's corner table is built without hashing. A kept face (most
+// faces, from the second level on) lands at a known output face, so its
+// corners map one to one; every other parent corner records which output
+// corner(s) face its edge (two when the edge was split: slot_a near
+// vertex(next(c)), slot_b near vertex(prev(c))). A final pass pairs the two
+// sides of every parent edge. Edges inside one parent are linked while its
+// children are written. `across` (the vertex of the opposite corner) is
+// written with every link; between two kept faces it is the parent's.
+//
+// For the next level, the split also writes each output face's unit normal
+// (copied for a kept face: same three positions, same bits) and whether the
+// face is new ("fresh"): flatness is re-tested only where a face changed.
 #include <array>
 #include <cstring>
 
+#include "common/asa/butterfly_rules.h"
 #include "common/asa/edge_points.h"
 #include "common/asa/split.h"
 
 namespace meshstream::asa {
 namespace {
 
-// Writes output faces into arrays pre-sized to the 4F upper bound (no
-// push_back in the loop); finish() trims them.
+// Writes output faces into arrays pre-sized to the exact output size (no
+// push_back in the loop).
 struct Emitter {
   LevelMesh& out;
   std::vector<FaceKind>* face_kind;
   bool topology;
   bool track_source = false;
-  uint32_t source = 0;  // input face of the parent being split
-  uint32_t count = 0;   // faces written
+  bool normals = false;  // write next-level normals and fresh flags
+  uint32_t source = 0;   // input face of the parent being split
+  uint32_t count = 0;    // faces written
+  uint32_t* tri = nullptr;
 
-  void start(size_t capacity) {
-    out.triangles.resize(capacity);
-    if (face_kind) face_kind->resize(capacity);
-    if (track_source) out.source.resize(capacity);
+  void start(size_t total) {
+    out.triangles.resize(total);
+    tri = total ? out.triangles.front().data() : nullptr;
+    if (face_kind) face_kind->resize(total);
+    if (track_source) out.source.resize(total);
     if (topology) {
-      out.opposite.resize(3 * capacity);
-      out.feature_edge.resize(3 * capacity);
-      out.green.resize(capacity);
+      out.opposite.resize(3 * total);
+      out.across.resize(3 * total);
+      out.feature_edge.resize(3 * total);
+      out.green.resize(total);
+    }
+    if (normals) {
+      out.normals.resize(total);
+      out.fresh.resize(total);
     }
   }
+  // A new face: its internal corners are linked by the caller; the corners
+  // on parent edges get their links in the final pass.
   uint32_t emit(uint32_t a, uint32_t b, uint32_t c, uint8_t green, FaceKind kind) {
     const uint32_t f = count++;
-    out.triangles[f] = {a, b, c};
+    tri[3 * f] = a;
+    tri[3 * f + 1] = b;
+    tri[3 * f + 2] = c;
     if (face_kind) (*face_kind)[f] = kind;
     if (track_source) out.source[f] = source;
     if (topology) {
-      for (uint32_t i = 0; i < 3; ++i) {
-        out.opposite[3 * f + i] = kNone;
-        out.feature_edge[3 * f + i] = 0;
-      }
+      for (uint32_t i = 0; i < 3; ++i) out.feature_edge[3 * f + i] = 0;
       out.green[f] = green;
+    }
+    if (normals) {
+      const Vec3f* p = out.positions.data();
+      out.normals[f] = normalized(cross(p[b] - p[a], p[c] - p[a]));
+      out.fresh[f] = 1;
     }
     return f;
   }
-  void finish() {
-    out.triangles.resize(count);
-    if (face_kind) face_kind->resize(count);
-    if (track_source) out.source.resize(count);
-    if (topology) {
-      out.opposite.resize(3 * static_cast<size_t>(count));
-      out.feature_edge.resize(3 * static_cast<size_t>(count));
-      out.green.resize(count);
-    }
+  uint32_t vertex(uint32_t corner) const { return tri[corner]; }
+  // Corners x and y face each other.
+  void link(uint32_t x, uint32_t y) {
+    out.opposite[x] = y;
+    out.opposite[y] = x;
+    out.across[x] = tri[y];
+    out.across[y] = tri[x];
   }
-  uint32_t vertex(uint32_t corner) const { return out.triangles[corner / 3][corner % 3]; }
 };
 
 // A parent edge seen from one side: from p to q, split at s (or kNone),
@@ -85,7 +104,10 @@ void link_local(Emitter& e, uint32_t first, uint32_t count, const std::array<Bor
   if (e.topology) {
     for (uint32_t c = c0; c < c1; ++c) {
       const uint32_t o = find(to(c), from(c));
-      if (o != kNone) e.out.opposite[c] = o;
+      if (o != kNone) {
+        e.out.opposite[c] = o;
+        e.out.across[c] = e.vertex(o);
+      }
     }
   }
   for (const BorderEdge& b : border) {
@@ -111,6 +133,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
   const uint8_t* split = closure.edge_split.data();
+  const uint8_t* action = closure.action.data();
 
   // New vertices, one per split edge, numbered in corner order.
   s.edge_vertex.resize(corners);
@@ -154,17 +177,19 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   }
 
   const bool topo = in.want_topology;
+  // Exact output size first, so the arrays are written in place; a kept
+  // face's first output corner is known from it (kNone for other faces).
   if (topo) {
     s.slot_a.resize(corners);
     s.slot_b.resize(corners);
+    s.kept_base.resize(F);
   }
-  Emitter e{out, face_kind, topo};
-  e.track_source = in.source != nullptr;
-  if (!e.track_source) out.source.clear();
-  // Exact output size first, so the arrays are written in place.
+  uint32_t* kept_base = topo ? s.kept_base.data() : nullptr;
   size_t total = 0;
   for (uint32_t f = 0; f < F; ++f) {
-    switch (closure.action[f]) {
+    const uint8_t a = action[f];
+    if (topo) kept_base[f] = a == kKeep ? static_cast<uint32_t>(3 * total) : kNone;
+    switch (a) {
       case kKeep: total += 1; break;
       case kBisect: total += 2; break;
       case kRed: total += 4; break;
@@ -172,6 +197,14 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
         if (m.green[f] == kGreenFirst) total += 4 + (split[3 * f] ? 1 : 0) + (split[3 * f + 3] ? 1 : 0);
         break;
     }
+  }
+  Emitter e{out, face_kind, topo};
+  e.track_source = in.source != nullptr;
+  e.normals = topo && in.normals != nullptr;
+  if (!e.track_source) out.source.clear();
+  if (!e.normals) {
+    out.normals.clear();
+    out.fresh.clear();
   }
   e.start(total);
   const uint8_t* fe = m.feature_edge;
@@ -185,11 +218,22 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t v[3] = {cv[3 * f], cv[3 * f + 1], cv[3 * f + 2]};
     if (e.track_source) e.source = in.source[f];
-    switch (closure.action[f]) {
+    switch (action[f]) {
       case kKeep: {
-        const uint32_t g = e.emit(v[0], v[1], v[2], m.green ? m.green[f] : static_cast<uint8_t>(kNotGreen), FaceKind::kUntouched);
+        // Unchanged face: copied; its links are made in the final pass.
+        const uint32_t g = e.count++;
+        e.tri[3 * g] = v[0];
+        e.tri[3 * g + 1] = v[1];
+        e.tri[3 * g + 2] = v[2];
+        if (face_kind) (*face_kind)[g] = FaceKind::kUntouched;
+        if (e.track_source) out.source[g] = e.source;
         if (topo) {
-          for (uint32_t i = 0; i < 3; ++i) set_slot(3 * f + i, 3 * g + i, 3 * g + i);
+          for (uint32_t i = 0; i < 3; ++i) out.feature_edge[3 * g + i] = fe[3 * f + i];
+          out.green[g] = m.green ? m.green[f] : static_cast<uint8_t>(kNotGreen);
+        }
+        if (e.normals) {
+          out.normals[g] = in.normals[f];
+          out.fresh[g] = 0;
         }
         break;
       }
@@ -201,10 +245,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
         e.emit(mid[0], mid[1], mid[2], kNotGreen, FaceKind::kTarget);
         if (topo) {
           const uint32_t b = 3 * base;
-          for (uint32_t i = 0; i < 3; ++i) {
-            out.opposite[b + 3 * i] = b + 9 + i;
-            out.opposite[b + 9 + i] = b + 3 * i;
-          }
+          for (uint32_t i = 0; i < 3; ++i) e.link(b + 3 * i, b + 9 + i);
           for (uint32_t k = 0; k < 3; ++k) {
             set_slot(3 * f + k, b + 3 * ((k + 1) % 3) + 2, b + 3 * ((k + 2) % 3) + 1);
           }
@@ -219,8 +260,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
         const uint32_t g1 = e.emit(A, B, X, kGreenFirst, FaceKind::kBisected);
         const uint32_t g2 = e.emit(A, X, C, kGreenSecond, FaceKind::kBisected);
         if (topo) {
-          out.opposite[3 * g1 + 1] = 3 * g2 + 2;
-          out.opposite[3 * g2 + 2] = 3 * g1 + 1;
+          e.link(3 * g1 + 1, 3 * g2 + 2);
           set_slot(3 * f + k, 3 * g1, 3 * g2);
           set_slot(3 * f + (k + 2) % 3, 3 * g1 + 2, 3 * g1 + 2);  // A-B
           set_slot(3 * f + (k + 1) % 3, 3 * g2 + 1, 3 * g2 + 1);  // C-A
@@ -267,16 +307,58 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
       }
     }
   }
-
-  e.finish();
   if (!topo) return;
-  for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t o = opp[c];
-    if (o == kNone || s.slot_a[c] == kNone) continue;
-    out.opposite[s.slot_a[c]] = s.slot_b[o];
-    out.opposite[s.slot_b[c]] = s.slot_a[o];
+
+  // Pair the two sides of every parent edge.
+  uint32_t* oo = out.opposite.data();
+  uint32_t* ax = out.across.data();
+  const uint32_t* tri = e.tri;
+  const uint32_t* parent_across = m.across;
+  auto side_a = [&](uint32_t c) {
+    const uint32_t base = kept_base[c / 3];
+    return base != kNone ? base + c % 3 : s.slot_a[c];
+  };
+  auto side_b = [&](uint32_t c) {
+    const uint32_t base = kept_base[c / 3];
+    return base != kNone ? base + c % 3 : s.slot_b[c];
+  };
+  for (uint32_t f = 0; f < F; ++f) {
+    const uint32_t base = kept_base[f];
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t c = 3 * f + k, o = opp[c];
+      if (base != kNone) {
+        // A kept face: one output corner per parent corner.
+        const uint32_t x = base + k;
+        if (o == kNone) {
+          oo[x] = ax[x] = kNone;
+          continue;
+        }
+        const uint32_t other = kept_base[o / 3];
+        if (other != kNone) {
+          oo[x] = other + o % 3;
+          ax[x] = parent_across ? parent_across[c] : tri[other + o % 3];
+        } else {
+          const uint32_t y = s.slot_b[o];  // the edge is not split: slot_a[o] == slot_b[o]
+          oo[x] = y;
+          ax[x] = tri[y];
+        }
+        continue;
+      }
+      const uint32_t a = s.slot_a[c];
+      if (a == kNone) continue;  // the internal edge of an opened pair
+      const uint32_t b = s.slot_b[c];
+      if (o == kNone) {
+        oo[a] = ax[a] = kNone;
+        oo[b] = ax[b] = kNone;
+        continue;
+      }
+      const uint32_t pa = side_a(o), pb = side_b(o);
+      oo[a] = pb;
+      ax[a] = tri[pb];
+      oo[b] = pa;
+      ax[b] = tri[pa];
+    }
   }
-  fill_across(out.triangles.front().data(), out.opposite.data(), 3 * e.count, out.across);
   // Vertex data for the next level: faces per vertex are recounted by the
   // caller; features: old vertices keep theirs, new ones have two when their
   // edge was a feature edge.

@@ -25,6 +25,7 @@ struct AsaWorkspace::Buffers {
   asa::CornerTableScratch corner_scratch;
   std::vector<Vec3f> normals;
   std::vector<uint8_t> target;
+  std::vector<uint8_t> fresh;  // per face of the current level: made by the last split
   std::vector<uint32_t> identity;  // level-0 source faces
   AsaStats stats;
 };
@@ -138,8 +139,11 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
       ws.stats.targets.push_back(view.face_count);
       ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) - view.vertex_count);
     } else {
-      if (level > 0) asa::compute_face_normals(view, ws.normals);
-      const uint32_t targets = asa::mark_targets(view, ws.normals, options.flatness, ws.target);
+      // Level 0 tests every edge; later levels only the edges of faces the
+      // last split made (their normals came with the split).
+      const uint32_t targets =
+          level == 0 ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
+                     : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
       if (targets == 0) {
         // Nothing bends: this and every later level would copy the mesh
         // unchanged (same normals, same verdicts). Stop here.
@@ -163,7 +167,12 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
         return {};
       }
       const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
+      in.normals = ws.normals.data();
       asa::split_adaptive(in, ws.closure, ws.scratch, out, kinds);
+      if (!last) {
+        std::swap(ws.normals, out.normals);
+        std::swap(ws.fresh, out.fresh);
+      }
       ws.stats.targets.push_back(targets);
       ws.stats.split_edges.push_back(split);
     }
