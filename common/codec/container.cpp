@@ -30,6 +30,24 @@ void put_f32(std::vector<uint8_t>& out, float f) {
 uint32_t get_u32(const uint8_t* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
 }
+void put_varint(std::vector<uint8_t>& out, uint32_t v) {
+  while (v >= 0x80) {
+    out.push_back(uint8_t(v | 0x80));
+    v >>= 7;
+  }
+  out.push_back(uint8_t(v));
+}
+bool get_varint(const uint8_t* p, size_t end, size_t& pos, uint32_t& value) {
+  value = 0;
+  for (int shift = 0; shift < 35; shift += 7) {
+    if (pos >= end) return false;
+    const uint8_t b = p[pos++];
+    if (shift == 28 && (b & 0x70)) return false;
+    value |= uint32_t(b & 0x7F) << shift;
+    if (!(b & 0x80)) return true;
+  }
+  return false;
+}
 uint16_t get_u16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
 uint64_t get_u64(const uint8_t* p) { return uint64_t(get_u32(p)) | uint64_t(get_u32(p + 4)) << 32; }
 float get_f32(const uint8_t* p) {
@@ -71,20 +89,29 @@ std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
   put_u32(out, static_cast<uint32_t>(head.size()));
   out.insert(out.end(), head.begin(), head.end());
   put_u32(out, crc32(0, head.data(), head.size()));
-  const size_t index_start = out.size();  // the index checksum covers its count too
+  // Version 2 index: count, byte length, then per record varint size,
+  // varint vertex and face growth, u32 CRC (about 8 bytes instead of 24:
+  // an embedded stream has hundreds of records and the index comes first).
+  std::vector<uint8_t> entries;
+  uint32_t prev_v = 0, prev_f = 0;
+  for (const RecordEntry& r : records) {
+    put_varint(entries, r.size);
+    put_varint(entries, r.vertices - prev_v);
+    put_varint(entries, r.faces - prev_f);
+    put_u32(entries, r.crc32);
+    prev_v = r.vertices;
+    prev_f = r.faces;
+  }
+  const size_t index_start = out.size();  // the index checksum covers count and length too
   put_u32(out, static_cast<uint32_t>(records.size()));
-
-  uint64_t offset = out.size() + records.size() * kIndexEntryBytes + 4;
+  put_u32(out, static_cast<uint32_t>(entries.size()));
+  out.insert(out.end(), entries.begin(), entries.end());
+  put_u32(out, crc32(0, out.data() + index_start, out.size() - index_start));
+  uint64_t offset = out.size();
   for (RecordEntry& r : records) {
     r.offset = offset;
     offset += r.size;
-    put_u64(out, r.offset);
-    put_u32(out, r.size);
-    put_u32(out, r.vertices);
-    put_u32(out, r.faces);
-    put_u32(out, r.crc32);
   }
-  put_u32(out, crc32(0, out.data() + index_start, out.size() - index_start));
   return out;
 }
 
@@ -102,7 +129,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     return make_error(ErrorCode::kParse, "not an .hcs stream (bad magic bytes)");
   }
   const uint16_t version = get_u16(in.data() + 4);
-  if (version != kContainerVersion) {
+  if (version != kContainerVersion && version != 1) {
     return make_error(ErrorCode::kUnsupported,
                       "unsupported .hcs version " + std::to_string(version) + " (this build reads " +
                           std::to_string(kContainerVersion) + ")");
@@ -144,23 +171,63 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
                       "implausible record count " + std::to_string(record_count));
   }
   const size_t index_start = count_at;  // the index CRC covers the count too
-  const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
-  if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
-  if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
-    return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
-  }
-  index.payload_offset = index_end + 4;
-
   index.records.resize(record_count);
+  if (version == 1) {
+    const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
+    if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
+    if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
+      return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
+    }
+    index.payload_offset = index_end + 4;
+    for (uint32_t i = 0; i < record_count; ++i) {
+      const uint8_t* e = in.data() + count_at + 4 + size_t(i) * kIndexEntryBytes;
+      RecordEntry& r = index.records[i];
+      r.offset = get_u64(e);
+      r.size = get_u32(e + 8);
+      r.vertices = get_u32(e + 12);
+      r.faces = get_u32(e + 16);
+      r.crc32 = get_u32(e + 20);
+    }
+  } else {
+    if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
+    const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
+    if (index_bytes < 7ull * record_count || index_bytes > 19ull * record_count) {
+      return make_error(ErrorCode::kParse, "implausible record index length " + std::to_string(index_bytes));
+    }
+    const size_t entries_at = count_at + 8;
+    const size_t index_end = entries_at + index_bytes;
+    if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
+    if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
+      return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
+    }
+    index.payload_offset = index_end + 4;
+    size_t pos = entries_at;
+    uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
+    for (uint32_t i = 0; i < record_count; ++i) {
+      RecordEntry& r = index.records[i];
+      uint32_t size = 0, dv = 0, df = 0;
+      if (!get_varint(in.data(), index_end, pos, size) || !get_varint(in.data(), index_end, pos, dv) ||
+          !get_varint(in.data(), index_end, pos, df) || pos + 4 > index_end) {
+        return make_error(ErrorCode::kParse, "record index entry " + std::to_string(i) + " is malformed");
+      }
+      vertices += dv;
+      faces += df;
+      if (vertices > UINT32_MAX || faces > UINT32_MAX) {
+        return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " counts overflow");
+      }
+      r.offset = offset;
+      r.size = size;
+      r.vertices = static_cast<uint32_t>(vertices);
+      r.faces = static_cast<uint32_t>(faces);
+      r.crc32 = get_u32(in.data() + pos);
+      pos += 4;
+      offset += size;
+    }
+    if (pos != index_end) return make_error(ErrorCode::kParse, "record index has trailing bytes");
+  }
   uint64_t expected_offset = index.payload_offset;
   for (uint32_t i = 0; i < record_count; ++i) {
-    const uint8_t* e = in.data() + count_at + 4 + size_t(i) * kIndexEntryBytes;
     RecordEntry& r = index.records[i];
-    r.offset = get_u64(e);
-    r.size = get_u32(e + 8);
-    r.vertices = get_u32(e + 12);
-    r.faces = get_u32(e + 16);
-    r.crc32 = get_u32(e + 20);
     if (r.offset != expected_offset) {
       return make_error(ErrorCode::kParse,
                         "record " + std::to_string(i) + " does not start where record " +

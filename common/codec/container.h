@@ -7,9 +7,12 @@
 //          8   u32 header_size H, then H header bytes (StreamHeader, see
 //              container.cpp; fields added later go at the end, so a reader
 //              skips what it does not know), then u32 CRC-32 of those H bytes
-//   12+H+4     record index: record_count entries of 24 bytes each
-//              (u64 offset, u32 size, u32 vertices, u32 faces, u32 crc32)
-//              followed by a u32 CRC-32 of the index bytes
+//   12+H+4     record index (version 2): u32 record_count, u32 L, then L
+//              bytes: per record varint size, varint vertices added, varint
+//              faces added, u32 crc32; then a u32 CRC-32 of count, L and
+//              entries. (Version 1, still read: record_count entries of 24
+//              bytes, u64 offset, u32 size, u32 vertices, u32 faces, u32
+//              crc32, then the CRC.) Offsets follow from the sizes.
 //   ...        record payloads, in index order, contiguous, record 0 first
 // Record 0 is the base mesh. `vertices`/`faces` of a record are the counts of
 // the mesh after applying it and all before it. Any prefix that ends on a
@@ -28,7 +31,7 @@
 namespace meshstream {
 
 inline constexpr char kContainerMagic[4] = {'M', 'H', 'C', 'S'};
-inline constexpr uint16_t kContainerVersion = 1;
+inline constexpr uint16_t kContainerVersion = 2;  // 1 (24-byte index entries) is still read
 // Refuse absurd counts before allocating anything for them.
 inline constexpr uint32_t kMaxRecords = 1u << 22;
 inline constexpr uint32_t kMaxHeaderBytes = 1u << 16;

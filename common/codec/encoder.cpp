@@ -643,8 +643,9 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   // shrink when the result misses either bound.
   const uint32_t n = mesh.vertex_count();
   const bool automatic = options.record_bytes == 0;
-  double estimate = 20.0 * n / 8.0;
-  uint32_t record_bytes = automatic ? static_cast<uint32_t>(std::clamp(estimate / 250.0, 40.0, 4096.0))
+  const double estimate = 20.0 * n / 8.0;
+  const double wanted = std::max(60.0, 1.3 * std::min<double>(n / 50, 200));
+  uint32_t record_bytes = automatic ? static_cast<uint32_t>(std::clamp(estimate / wanted, 32.0, 8192.0))
                                     : std::max<uint32_t>(options.record_bytes, 16);
   for (int attempt = 0;; ++attempt) {
     auto encoded = encode_once(mesh, *grid, q, dec, options, record_bytes, report);
