@@ -44,17 +44,20 @@ constexpr int64_t kMaxRejecting = 256;
 }  // namespace
 
 Server::Server(const ServerOptions& options, const Catalog& catalog)
-    : options_(options), catalog_(catalog) {
+    : options_(options), catalog_(catalog), first_chunks_(options.first_chunk_hold) {
   shared_.options = &options_;
   shared_.catalog = &catalog_;
   shared_.model_list_frame = model_list_frame(catalog_);
   shared_.hello_frame = hello_frame(options_);
   shared_.active_sessions = &active_sessions_;
   shared_.rejecting_sessions = &rejecting_;
+  shared_.first_chunks = &first_chunks_;
   unsigned threads = options_.threads ? options_.threads : std::thread::hardware_concurrency();
   threads = std::max(1u, threads);
   for (unsigned i = 0; i < threads; ++i) {
     workers_.push_back(std::make_unique<Worker>());
+    Worker* w = workers_.back().get();
+    first_chunks_.add_waker([w] { asio::post(w->io, [w] { w->registry.release_held(); }); });
   }
 }
 
@@ -189,6 +192,7 @@ void Server::run(std::chrono::milliseconds grace) {
     for (auto& worker : workers_) worker->io.stop();
   }
   for (auto& t : threads) t.join();
+  first_chunks_.stop_waking();
   spdlog::info("server stopped");
 }
 

@@ -51,6 +51,7 @@ class Server {
 
   const ServerOptions& options_;
   const Catalog& catalog_;
+  FirstChunkGate first_chunks_;
   ServerShared shared_;
   std::atomic<int64_t> active_sessions_{0};
   std::atomic<int64_t> rejecting_{0};

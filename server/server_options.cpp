@@ -42,6 +42,7 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   uint64_t handshake_ms = o.handshake_timeout.count();
   uint64_t idle_ms = o.idle_timeout.count();
   uint64_t stall_ms = o.stall_timeout.count();
+  uint64_t hold_ms = o.first_chunk_hold.count();
   app.add_option("--models", o.models_dir,
                  "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded at start-up")
       ->check(CLI::ExistingDirectory);
@@ -75,6 +76,11 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   app.add_option("--max-chunk-bytes", o.max_chunk_bytes, "default chunk size in bytes")
       ->capture_default_str()
       ->check(CLI::Range(1024u, 1u << 20));
+  app.add_option("--first-chunk-hold-ms", hold_ms,
+                 "longest time streams in bulk transfer wait while new streams' first chunks "
+                 "go out (0 = no wait)")
+      ->capture_default_str()
+      ->check(CLI::Range(uint64_t(0), uint64_t(10000)));
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error or off")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
@@ -98,6 +104,7 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   o.handshake_timeout = std::chrono::milliseconds(handshake_ms);
   o.idle_timeout = std::chrono::milliseconds(idle_ms);
   o.stall_timeout = std::chrono::milliseconds(stall_ms);
+  o.first_chunk_hold = std::chrono::milliseconds(hold_ms);
   return o;
 }
 

@@ -25,6 +25,9 @@ struct ServerOptions {
   std::chrono::milliseconds stall_timeout{30000};
   uint32_t max_frame_bytes = proto::kDefaultMaxClientFrameBytes;  // client frames
   uint32_t max_chunk_bytes = 64 * 1024;  // default Chunk.data size
+  // Longest time bulk chunks wait for a burst of new streams' first chunks
+  // (FirstChunkGate); zero = no hold (bulk only steps back once per chunk).
+  std::chrono::milliseconds first_chunk_hold{50};
   std::string log_level = "info";
 };
 

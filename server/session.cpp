@@ -64,7 +64,8 @@ Session::Session(net::tcp::socket socket, const ServerShared& shared, SessionReg
 
 Session::~Session() {
   registry_.sessions.erase(this);
-  registry_.starting_streams -= starting_;
+  registry_.held.erase(this);
+  while (starting_ > 0) started_one();
   if (counted_) --*shared_.active_sessions;
   if (reject_) --*shared_.rejecting_sessions;
   const double seconds = std::chrono::duration<double>(Clock::now() - started_).count();
@@ -72,9 +73,33 @@ Session::~Session() {
     spdlog::info("session {}: rejected (busy)", peer_);
     return;
   }
-  spdlog::info("session {}: models [{}], {} streams, {} bytes, {:.3f} s, ended: {}", peer_,
-               models_, streams_, bytes_total_, seconds,
+  std::string first_chunk;
+  if (first_chunk_written_) {
+    first_chunk = fmt::format(", first chunk {:.2f} ms after its request",
+                              std::chrono::duration<double, std::milli>(*first_chunk_written_ -
+                                                                        *first_request_read_)
+                                  .count());
+  }
+  spdlog::info("session {}: models [{}], {} streams, {} bytes, {:.3f} s{}, ended: {}", peer_,
+               models_, streams_, bytes_total_, seconds, first_chunk,
                end_reason_.empty() ? "closed" : end_reason_);
+  if (first_chunk_written_ && spdlog::should_log(spdlog::level::debug)) {
+    // Wall-clock times (µs since the epoch), so a load generator on the same
+    // machine can split its clients' latency into the server's and its own.
+    const auto wall = [&](Clock::time_point t) {
+      const auto at = std::chrono::system_clock::now() - (Clock::now() - t);
+      return std::chrono::duration_cast<std::chrono::microseconds>(at.time_since_epoch()).count();
+    };
+    spdlog::debug("session {}: first stream timing: request read at {} us, first chunk written "
+                  "at {} us (unix)",
+                  peer_, wall(*first_request_read_), wall(*first_chunk_written_));
+  }
+}
+
+void Session::note_first_chunk(Clock::time_point requested) {
+  if (first_chunk_written_) return;
+  first_request_read_ = requested;
+  first_chunk_written_ = Clock::now();
 }
 
 void Session::start() {
@@ -248,8 +273,8 @@ void Session::handle_stream(const v1::StreamRequest& request) {
                                                        shared_.options->rate_bytes_per_s / 20));
   }
   ++starting_;
-  ++registry_.starting_streams;
-  push(StartStream{model, *plan, chunk}, 0);
+  shared_.first_chunks->stream_starting(Clock::now());
+  push(StartStream{model, *plan, chunk, Clock::now()}, 0);
 }
 
 // ------------------------------------------------------------------ writer
@@ -360,7 +385,8 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
             &model, model.bytes, start->plan, start->chunk_bytes, start->plan.start, 0,
             records_complete_at(model.index, start->plan.start),
             TokenBucket(double(shared_.options->rate_bytes_per_s), double(start->chunk_bytes),
-                        Clock::now())});
+                        Clock::now()),
+            0, false, start->requested});
         ++streams_;
         if (models_.find(model.name) == std::string::npos) {
           models_ += models_.empty() ? model.name : "," + model.name;
@@ -379,12 +405,16 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       }
       const size_t limit =
           std::min(s.chunk_bytes, kFirstChunkBytes << std::min<uint32_t>(s.chunks_sent, 20));
-      if (s.chunks_sent > 0 && registry_.starting_streams > 0 && !s.yielded) {
-        // Let this worker's new streams write their first chunk before our
-        // bulk: one trip to the back of the queue, at most once per chunk.
-        s.yielded = true;
-        co_await asio::post(socket_.get_executor(), use_awaitable);
-        continue;
+      if (s.chunks_sent > 0) {
+        // Bulk: new streams' first chunks go first (held up to the gate's
+        // bound); past it, still one step back per chunk while any wait.
+        if (!co_await wait_for_first_chunks()) break;
+        if (!queue_.empty()) continue;  // a request came while we waited
+        if (shared_.first_chunks->starting() > 0 && !s.yielded) {
+          s.yielded = true;
+          co_await asio::post(socket_.get_executor(), use_awaitable);
+          continue;
+        }
       }
       s.yielded = false;
       const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
@@ -402,6 +432,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
           asio::buffer(pending_header_),  // empty except before the first chunk
           asio::buffer(head.bytes, head.size),
           asio::buffer(s.model->stream().data() + s.position, size)};
+      if (s.chunks_sent == 0) note_first_chunk(s.requested);
       if (!pending_header_.empty()) started_one();
       const bool written = co_await write(buffers);
       pending_header_.clear();
@@ -418,6 +449,26 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
     boost::system::error_code ignored;
     co_await writer_wake_.async_wait(asio::redirect_error(use_awaitable, ignored));
   }
+}
+
+awaitable<bool> Session::wait_for_first_chunks() {
+  while (!closed_) {
+    const auto until = shared_.first_chunks->hold_bulk_until(Clock::now());
+    if (!until || !queue_.empty()) co_return true;
+    // Woken by the deadline, by the gate (release_bulk) or by push().
+    registry_.held.insert(this);
+    writer_wake_.expires_at(*until);
+    boost::system::error_code ignored;
+    co_await writer_wake_.async_wait(asio::redirect_error(use_awaitable, ignored));
+    registry_.held.erase(this);
+  }
+  co_return false;
+}
+
+void SessionRegistry::release_held() {
+  // release_bulk only cancels a timer (no handler runs here), so `held`
+  // does not change while we walk it.
+  for (Session* s : held) s->release_bulk();
 }
 
 // ---------------------------------------------------------------- watchdog

@@ -19,6 +19,7 @@
 #include "proto/framing.h"
 #include "server/asio.h"
 #include "server/catalog.h"
+#include "server/first_chunk_gate.h"
 #include "server/server_options.h"
 #include "server/stream_plan.h"
 #include "server/token_bucket.h"
@@ -35,15 +36,16 @@ struct ServerShared {
   std::shared_ptr<const std::vector<uint8_t>> hello_frame;       // ServerHello, pre-encoded
   std::atomic<int64_t>* active_sessions = nullptr;     // counted toward --max-connections
   std::atomic<int64_t>* rejecting_sessions = nullptr;  // busy sessions still closing
+  FirstChunkGate* first_chunks = nullptr;              // bulk waits for new streams' first chunks
 };
 
 // The sessions of one worker thread, touched only from that thread.
 struct SessionRegistry {
   std::unordered_set<Session*> sessions;
-  // Sessions of this worker with a stream requested whose first chunk is not
-  // written yet; while there are any, bulk chunks yield once (first bytes
-  // first).
-  int starting_streams = 0;
+  // Sessions whose bulk chunk waits while FirstChunkGate holds bulk; the
+  // gate's waker releases them all when the first chunks are out.
+  std::unordered_set<Session*> held;
+  void release_held();
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -64,6 +66,9 @@ class Session : public std::enable_shared_from_this<Session> {
   // Server stopping: send Error{SHUTTING_DOWN} after the chunk in flight,
   // then close. Call on the socket's executor.
   void shutdown();
+  // The first-chunk hold is over: a held bulk chunk may go. Call on the
+  // socket's executor.
+  void release_bulk() { wake(writer_wake_); }
 
  private:
   struct Frame {
@@ -74,6 +79,7 @@ class Session : public std::enable_shared_from_this<Session> {
     const CatalogModel* model;
     StreamPlan plan;
     size_t chunk_bytes;
+    Clock::time_point requested;  // when its request was read
   };
   struct CancelStream {};
   using Item = std::variant<Frame, StartStream, CancelStream>;
@@ -88,7 +94,8 @@ class Session : public std::enable_shared_from_this<Session> {
     uint32_t records_complete;
     TokenBucket bucket;
     uint32_t chunks_sent = 0;
-    bool yielded = false;  // this chunk already let new streams go first
+    bool yielded = false;  // this chunk already stepped back once for new streams
+    Clock::time_point requested;
   };
 
   net::asio::awaitable<void> read_loop(std::shared_ptr<Session> self);
@@ -125,13 +132,17 @@ class Session : public std::enable_shared_from_this<Session> {
   // write instead of two: under load each write waits a full round of the
   // worker's queue).
   std::vector<uint8_t> pending_header_;
-  int starting_ = 0;  // this session's share of registry_.starting_streams
+  int starting_ = 0;  // this session's share of FirstChunkGate::starting()
   void started_one() {
     if (starting_ > 0) {
       --starting_;
-      --registry_.starting_streams;
+      shared_.first_chunks->stream_started();
     }
   }
+  // Before a bulk chunk: waits while the gate holds bulk for new streams'
+  // first chunks, or until this session has a control item queued (those are
+  // never held). False if the session closed meanwhile.
+  net::asio::awaitable<bool> wait_for_first_chunks();
 
   net::asio::steady_timer writer_wake_;
   net::asio::steady_timer reader_wake_;  // queue has room again
@@ -153,6 +164,11 @@ class Session : public std::enable_shared_from_this<Session> {
   uint64_t bytes_total_ = 0;
   uint32_t streams_ = 0;
   std::string end_reason_;
+  // The first stream's request read and first chunk written: the server's
+  // own share of a client's time to first chunk (logged with the session).
+  std::optional<Clock::time_point> first_request_read_;
+  std::optional<Clock::time_point> first_chunk_written_;
+  void note_first_chunk(Clock::time_point requested);
 };
 
 }  // namespace meshstream::server
