@@ -133,87 +133,105 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
   }
 }
 
+
+// Pass 1 for one edge named by corner c with new vertex id: curve and
+// regular stencils are written; an edge at an extraordinary vertex is noted
+// for its centre(s).
+[[gnu::always_inline]] inline void first_pass_edge(const LevelView& m, uint32_t c, uint32_t id, bool irregular_a,
+                                                   bool irregular_b, const uint32_t* across, float w, bool project,
+                                                   uint32_t first_new, Vec3f* pos, EdgePointScratch& s) {
+  const uint32_t* cv = m.corner_vertex;
+  const uint8_t* fe = m.feature_edge;
+  if (fe[c]) {
+    pos[id] = rules::curve_point(m, c);
+    return;
+  }
+  const uint32_t o = m.opposite[c];
+  const uint32_t n = next_corner(c), p = prev_corner(c);
+  if (!irregular_a && !irregular_b) {
+    Vec3f q;
+    if (w == 0.0f) {
+      // rules::regular_point with w = 0, reading the wing vertices from
+      // `across` (one line of the neighbour instead of four lookups).
+      const uint32_t no = next_corner(o), po = prev_corner(o);
+      const Vec3f A = m.positions[cv[n]], B = m.positions[cv[p]];
+      const Vec3f b0 = m.positions[cv[c]], b1 = m.positions[across[c]];
+      const Vec3f wA0 = fe[p] ? A + b0 - B : m.positions[across[p]];
+      const Vec3f wB0 = fe[n] ? B + b0 - A : m.positions[across[n]];
+      const Vec3f wA1 = fe[no] ? A + b1 - B : m.positions[across[no]];
+      const Vec3f wB1 = fe[po] ? B + b1 - A : m.positions[across[po]];
+      const Vec3f wings = (wA0 + wB1) + (wB0 + wA1);
+      q = (A + B) * 0.5f + (b0 + b1) * 0.125f - wings * 0.0625f;
+    } else {
+      q = rules::regular_point(m, c, w);
+    }
+    pos[id] = project ? rules::project_point(m, c, q) : q;
+    return;
+  }
+  s.arrivals[id - first_new] = irregular_a && irregular_b ? kTwoCentres : kOneCentre;
+  if (irregular_a) note_centre(cv[n], n, s);
+  if (irregular_b) note_centre(cv[p], next_corner(o), s);
+  if (project) s.pending.push_back(c);
+}
+
 }  // namespace
 
 void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32_t first_new,
                          uint32_t new_count, const ButterflyWeights& wt, EdgePlacement placement,
-                         Vec3f* pos, EdgePointScratch& s) {
+                         Vec3f* pos, EdgePointScratch& s, const std::vector<uint32_t>* naming) {
   const uint32_t corners = 3 * m.face_count;
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
-  const uint8_t* fe = m.feature_edge;
   const bool project = placement == EdgePlacement::kProjection;
   const float w = wt.tension();
   if (s.vertex_corner.size() < m.vertex_count) s.vertex_corner.resize(m.vertex_count, kNone);
   s.arrivals.resize(new_count);
   s.centres.clear();
   s.pending.clear();
-
-  // Per vertex: is it an extraordinary centre (one byte, read twice per edge).
-  s.irregular.resize(m.vertex_count);
-  uint8_t* irregular = s.irregular.data();
-  for (uint32_t v = 0; v < m.vertex_count; ++v) irregular[v] = extraordinary(m, v);
   const uint32_t* across = m.across;
   if (!across) {  // a level built by hand (tests): derive it
     fill_across(cv, opp, corners, s.across);
     across = s.across.data();
   }
-
-  // Pass 1: curve and regular stencils; extraordinary edges wait. The
-  // stencil reads are scattered over the mesh; prefetching what corners a
-  // few faces ahead will read keeps several misses in flight (on a mesh in
-  // scan order most of them miss the cache).
   const Vec3f* P = m.positions;
-  for (uint32_t c = 0; c < corners; ++c) {
-    if (c + kAhead < corners) {
-      const uint32_t ahead = c + kAhead, half = c + kAhead / 2;
-      __builtin_prefetch(P + cv[ahead]);
-      const uint32_t o_ahead = opp[ahead];
-      if (o_ahead != kNone) {
-        __builtin_prefetch(across + o_ahead);
-        __builtin_prefetch(P + across[ahead]);
-      }
-      const uint32_t o_half = opp[half];
-      if (o_half != kNone) {
-        const uint32_t w = across[prev_corner(o_half)];
-        if (w != kNone) __builtin_prefetch(P + w);
-        __builtin_prefetch(irregular + across[half]);
-      }
+
+  if (naming) {
+    // Few split edges (adaptive levels): visit only them.
+    for (const uint32_t c : *naming) {
+      const bool irregular_a = extraordinary(m, cv[next_corner(c)]);
+      const bool irregular_b = extraordinary(m, cv[prev_corner(c)]);
+      first_pass_edge(m, c, edge_vertex[c], irregular_a, irregular_b, across, w, project, first_new, pos, s);
     }
-    const uint32_t id = edge_vertex[c];
-    const uint32_t o = opp[c];
-    if (id == kNone || (o != kNone && o < c)) continue;
-    if (fe[c]) {
-      pos[id] = rules::curve_point(m, c);
-      continue;
-    }
-    const uint32_t n = next_corner(c), p = prev_corner(c);
-    const uint32_t a = cv[n], b = cv[p];
-    const bool irregular_a = irregular[a], irregular_b = irregular[b];
-    if (!irregular_a && !irregular_b) {
-      Vec3f q;
-      if (w == 0.0f) {
-        // rules::regular_point with w = 0, reading the wing vertices from
-        // `across` (one line of the neighbour instead of four lookups).
-        const uint32_t no = next_corner(o), po = prev_corner(o);
-        const Vec3f A = m.positions[a], B = m.positions[b];
-        const Vec3f b0 = m.positions[cv[c]], b1 = m.positions[across[c]];
-        const Vec3f wA0 = fe[p] ? A + b0 - B : m.positions[across[p]];
-        const Vec3f wB0 = fe[n] ? B + b0 - A : m.positions[across[n]];
-        const Vec3f wA1 = fe[no] ? A + b1 - B : m.positions[across[no]];
-        const Vec3f wB1 = fe[po] ? B + b1 - A : m.positions[across[po]];
-        const Vec3f wings = (wA0 + wB1) + (wB0 + wA1);
-        q = (A + B) * 0.5f + (b0 + b1) * 0.125f - wings * 0.0625f;
-      } else {
-        q = rules::regular_point(m, c, w);
+  } else {
+    // Per vertex: is it an extraordinary centre (one byte, read twice per edge).
+    s.irregular.resize(m.vertex_count);
+    uint8_t* irregular = s.irregular.data();
+    for (uint32_t v = 0; v < m.vertex_count; ++v) irregular[v] = extraordinary(m, v);
+    // The stencil reads are scattered over the mesh; prefetching what
+    // corners a few faces ahead will read keeps several misses in flight (on
+    // a mesh in scan order most of them miss the cache).
+    for (uint32_t c = 0; c < corners; ++c) {
+      if (c + kAhead < corners) {
+        const uint32_t ahead = c + kAhead, half = c + kAhead / 2;
+        __builtin_prefetch(P + cv[ahead]);
+        const uint32_t o_ahead = opp[ahead];
+        if (o_ahead != kNone) {
+          __builtin_prefetch(across + o_ahead);
+          __builtin_prefetch(P + across[ahead]);
+        }
+        const uint32_t o_half = opp[half];
+        if (o_half != kNone) {
+          const uint32_t wing = across[prev_corner(o_half)];
+          if (wing != kNone) __builtin_prefetch(P + wing);
+          __builtin_prefetch(irregular + across[half]);
+        }
       }
-      pos[id] = project ? rules::project_point(m, c, q) : q;
-      continue;
+      const uint32_t id = edge_vertex[c];
+      const uint32_t o = opp[c];
+      if (id == kNone || (o != kNone && o < c)) continue;
+      first_pass_edge(m, c, id, irregular[cv[next_corner(c)]], irregular[cv[prev_corner(c)]], across, w, project,
+                      first_new, pos, s);
     }
-    s.arrivals[id - first_new] = irregular_a && irregular_b ? kTwoCentres : kOneCentre;
-    if (irregular_a) note_centre(a, n, s);
-    if (irregular_b) note_centre(b, next_corner(o), s);
-    if (project) s.pending.push_back(c);
   }
 
   centre_points(m, edge_vertex, first_new, wt, pos, s);

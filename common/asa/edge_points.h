@@ -33,8 +33,10 @@ struct EdgePointScratch {
 // both corners of a split edge (kNone for the rest). Preconditions as
 // butterfly_point. O(split edges + sum over extraordinary centres of K^2),
 // the same order as the per-edge stencils.
+// With `naming` (the corners naming the split edges, any order), only those
+// corners are visited: O(split edges) instead of O(corners + vertices).
 void compute_edge_points(const LevelView& mesh, const uint32_t* edge_vertex, uint32_t first_new,
                          uint32_t new_count, const ButterflyWeights& weights, EdgePlacement placement,
-                         Vec3f* pos, EdgePointScratch& scratch);
+                         Vec3f* pos, EdgePointScratch& scratch, const std::vector<uint32_t>* naming = nullptr);
 
 }  // namespace meshstream::asa

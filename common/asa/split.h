@@ -31,6 +31,7 @@ struct SplitScratch {
   std::vector<uint32_t> edge_vertex;  // per corner: new vertex on the faced edge or kNone
   std::vector<uint32_t> slot_a, slot_b;
   std::vector<uint32_t> kept_base;  // per face: first output corner of a kept face, else kNone
+  std::vector<uint32_t> naming;     // adaptive: the corner naming each split edge, in id order
   EdgePointScratch points;
 };
 
@@ -45,7 +46,8 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
 // Output faces appear in input face order (each face's children together).
 // With in.normals and want_topology, out.normals holds every output face's
 // unit normal (bit-identical to compute_face_normals) and out.fresh marks the
-// faces that are not unchanged copies of a parent face.
+// faces that are not unchanged copies of a parent face. With want_topology,
+// out.valence (faces per vertex) and out.vertex_features are filled too.
 void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitScratch& scratch,
                     LevelMesh& out, std::vector<FaceKind>* face_kind);
 

@@ -35,6 +35,7 @@ struct Emitter {
   uint32_t source = 0;   // input face of the parent being split
   uint32_t count = 0;    // faces written
   uint32_t* tri = nullptr;
+  uint32_t* valence = nullptr;  // faces per vertex, with topology
 
   void start(size_t total) {
     out.triangles.resize(total);
@@ -64,6 +65,9 @@ struct Emitter {
     if (topology) {
       for (uint32_t i = 0; i < 3; ++i) out.feature_edge[3 * f + i] = 0;
       out.green[f] = green;
+      ++valence[a];
+      ++valence[b];
+      ++valence[c];
     }
     if (normals) {
       const Vec3f* p = out.positions.data();
@@ -135,8 +139,10 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   const uint8_t* split = closure.edge_split.data();
   const uint8_t* action = closure.action.data();
 
-  // New vertices, one per split edge, numbered in corner order.
+  // New vertices, one per split edge, numbered in corner order; the corners
+  // that name them are listed, so later loops touch only split edges.
   s.edge_vertex.resize(corners);
+  s.naming.clear();
   uint32_t E = 0;
   for (uint32_t c = 0; c < corners; ++c) {
     if (!split[c]) {
@@ -144,7 +150,12 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
       continue;
     }
     const uint32_t o = opp[c];
-    s.edge_vertex[c] = (o == kNone || c < o) ? V + E++ : s.edge_vertex[o];
+    if (o == kNone || c < o) {
+      s.edge_vertex[c] = V + E++;
+      s.naming.push_back(c);
+    } else {
+      s.edge_vertex[c] = s.edge_vertex[o];
+    }
   }
   out.positions.resize(static_cast<size_t>(V) + E);
   std::memcpy(out.positions.data(), m.positions, sizeof(Vec3f) * V);
@@ -161,10 +172,10 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   } else {
     out.texcoords.clear();
   }
-  compute_edge_points(m, s.edge_vertex.data(), V, E, *in.weights, in.placement, out.positions.data(), s.points);
-  for (uint32_t c = 0; (colors || texcoords) && c < corners; ++c) {
-    const uint32_t id = s.edge_vertex[c];
-    if (id == kNone || (opp[c] != kNone && opp[c] < c)) continue;
+  compute_edge_points(m, s.edge_vertex.data(), V, E, *in.weights, in.placement, out.positions.data(), s.points,
+                      &s.naming);
+  for (uint32_t k = 0; (colors || texcoords) && k < E; ++k) {
+    const uint32_t c = s.naming[k], id = V + k;
     const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
     if (colors) {
       const Vec4f ca = in.colors[a], cb = in.colors[b];
@@ -207,6 +218,12 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     out.fresh.clear();
   }
   e.start(total);
+  if (topo) {
+    out.valence.resize(static_cast<size_t>(V) + E);
+    std::memcpy(out.valence.data(), m.valence, sizeof(uint32_t) * V);
+    std::memset(out.valence.data() + V, 0, sizeof(uint32_t) * E);
+    e.valence = out.valence.data();
+  }
   const uint8_t* fe = m.feature_edge;
   auto set_slot = [&](uint32_t parent, uint32_t a, uint32_t b) {
     s.slot_a[parent] = a;
@@ -218,6 +235,12 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t v[3] = {cv[3 * f], cv[3 * f + 1], cv[3 * f + 2]};
     if (e.track_source) e.source = in.source[f];
+    if (topo && action[f] != kKeep) {
+      // A replaced face: its faces-per-vertex share goes (its children add theirs).
+      --e.valence[v[0]];
+      --e.valence[v[1]];
+      --e.valence[v[2]];
+    }
     switch (action[f]) {
       case kKeep: {
         // Unchanged face: copied; its links are made in the final pass.
@@ -359,15 +382,13 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
       ax[b] = tri[pa];
     }
   }
-  // Vertex data for the next level: faces per vertex are recounted by the
-  // caller; features: old vertices keep theirs, new ones have two when their
-  // edge was a feature edge.
+  // Vertex data for the next level. Features: old vertices keep theirs, new
+  // ones have two when their edge was a feature edge. Faces per vertex: the
+  // parent's counts, minus every replaced face, plus every new one.
   out.vertex_features.resize(static_cast<size_t>(V) + E);
   std::memcpy(out.vertex_features.data(), m.vertex_features, V);
-  for (uint32_t c = 0; c < corners; ++c) {
-    const uint32_t id = s.edge_vertex[c];
-    if (id != kNone) out.vertex_features[id] = fe[c] ? 2 : 0;
-  }
+  for (uint32_t k = 0; k < E; ++k) out.vertex_features[V + k] = fe[s.naming[k]] ? 2 : 0;
+  // (counted while the faces were written).
 }
 
 }  // namespace meshstream::asa

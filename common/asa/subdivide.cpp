@@ -178,9 +178,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     }
     if (!last) {
       if (!options.uniform) {
-        // Bisections change valences: recount and add any new ones.
-        asa::LevelView counted = out.view();
-        asa::count_vertex_faces(counted, out.valence);
+        // Bisections change valences (the split counted them): add any new ones.
         ws.weights.add_valences(out.valence.data(), out.vertex_features.data(),
                                 static_cast<uint32_t>(out.valence.size()));
       }
