@@ -1,6 +1,7 @@
 // Base mesh coders: see base_coder.h.
 #include "common/codec/base_coder.h"
 
+#include <cstring>
 #include <optional>
 #include <string>
 
@@ -46,6 +47,56 @@ struct OwnModels {
   AdaptiveIntModel first;
   AdaptiveIntModel other;
 };
+
+bool read_draco_varint(std::span<const uint8_t> in, size_t& pos, uint64_t& value) {
+  value = 0;
+  for (int shift = 0; shift < 35; shift += 7) {
+    if (pos >= in.size()) return false;
+    const uint8_t b = in[pos++];
+    value |= uint64_t(b & 0x7F) << shift;
+    if (!(b & 0x80)) return true;
+  }
+  return false;
+}
+
+// Reads the Draco header and the edgebreaker connectivity counts (Draco
+// bitstream 2.2: "DRACO", major, minor, encoder type, method, u16 flags, u8
+// traversal type, varint vertices, varint faces, u8 attribute data, varint
+// symbols, varint split symbols) and refuses a base record whose counts are
+// not the index's or that is not what our encoder writes, before Draco sizes
+// anything from them (a damaged record once made it reserve 5.7 GB).
+Status check_draco_header(std::span<const uint8_t> in, uint32_t vertex_count, uint32_t face_count) {
+  auto refuse = [](const std::string& why) {
+    return make_error(ErrorCode::kCorrupt, "Draco base record refused before decoding: " + why);
+  };
+  if (in.size() < 13 || std::memcmp(in.data(), "DRACO", 5) != 0) return refuse("no Draco header");
+  if (in[5] != 2 || in[6] != 2) {
+    return refuse("bitstream version " + std::to_string(in[5]) + "." + std::to_string(in[6]) + " (2.2 expected)");
+  }
+  if (in[7] != 1 || in[8] != 1) return refuse("not an edgebreaker-coded triangle mesh");
+  if (in[9] != 0 || in[10] != 0) return refuse("header flags set (metadata is never written)");
+  if (in[11] > 2) return refuse("unknown edgebreaker traversal " + std::to_string(in[11]));
+  size_t pos = 12;
+  uint64_t vertices = 0, faces = 0, symbols = 0, splits = 0;
+  if (!read_draco_varint(in, pos, vertices) || !read_draco_varint(in, pos, faces)) {
+    return refuse("connectivity counts cut short");
+  }
+  if (vertices != vertex_count || faces != face_count) {
+    return refuse("it declares " + std::to_string(vertices) + " vertices and " + std::to_string(faces) +
+                  " faces, the record index " + std::to_string(vertex_count) + " and " +
+                  std::to_string(face_count));
+  }
+  if (pos >= in.size()) return refuse("connectivity counts cut short");
+  ++pos;  // attribute data count
+  if (!read_draco_varint(in, pos, symbols) || !read_draco_varint(in, pos, splits)) {
+    return refuse("symbol counts cut short");
+  }
+  if (symbols > faces || splits > symbols) return refuse("more edgebreaker symbols than faces");
+  // Even rANS-coded, every face costs some bits: refuse counts far beyond
+  // what the record's bytes could describe.
+  if (faces > uint64_t(in.size()) * 8 * 64) return refuse("more faces than its bytes can describe");
+  return {};
+}
 
 }  // namespace
 
@@ -146,6 +197,7 @@ Result<std::vector<uint8_t>> encode_base_draco(const BaseMesh& base) {
 
 Result<BaseMesh> decode_base_draco(std::span<const uint8_t> bytes, uint32_t vertex_count,
                                    uint32_t face_count, int quant_bits) {
+  if (auto st = check_draco_header(bytes, vertex_count, face_count); !st) return tl::unexpected(st.error());
   draco::DecoderBuffer buffer;
   buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   draco::Decoder decoder;

@@ -1,10 +1,16 @@
 // Truncated, bit-flipped, re-checksummed and random streams: errors, never
 // crashes, and the decoder keeps the last good mesh.
+#include <chrono>
+#include <fstream>
+#include <iterator>
 #include <random>
 
 #include <gtest/gtest.h>
 
+#include "common/codec/base_coder.h"
 #include "common/codec/crc32.h"
+#include "common/codec/quantize.h"
+#include "common/codec/refinement_codec.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/adjacency.h"
@@ -148,6 +154,129 @@ TEST(HostileStream, RandomBytesAreRefused) {
     }
     EXPECT_FALSE(decode_hcs(junk));
   }
+}
+
+// Plane records (embedded geometry) damaged with valid checksums: an error
+// with the last good mesh kept, or a valid mesh; never a vertex off the grid.
+TEST(HostileStream, ResealedPlaneRecordCorruption) {
+  const std::vector<uint8_t> clean = sample_stream();
+  auto index = read_stream_index(clean);
+  ASSERT_TRUE(index);
+  std::vector<size_t> planes;
+  for (size_t i = 1; i < index->records.size(); ++i)
+    if (clean[index->records[i].offset] == kRecordPlane) planes.push_back(i);
+  ASSERT_GT(planes.size(), 2u) << "the sample stream has plane records";
+  std::mt19937 rng(21);
+  int errors = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<RecordEntry> entries = index->records;
+    std::vector<std::vector<uint8_t>> payloads;
+    for (const RecordEntry& e : entries)
+      payloads.emplace_back(clean.begin() + e.offset, clean.begin() + e.offset + e.size);
+    const size_t victim = planes[rng() % planes.size()];
+    std::vector<uint8_t>& p = payloads[victim];
+    switch (trial % 4) {
+      case 0: p.resize(1 + rng() % p.size()); break;                        // cut short
+      case 1: p[1 + rng() % 3 % (p.size() - 1)] ^= uint8_t(1u << (rng() % 8)); break;  // range header
+      default: p[rng() % p.size()] ^= uint8_t(1u << (rng() % 8)); break;
+    }
+    entries[victim].size = static_cast<uint32_t>(p.size());
+    entries[victim].crc32 = crc32(0, p.data(), p.size());
+    std::vector<uint8_t> stream = write_container_prefix(index->header, entries);
+    for (auto& q : payloads) stream.insert(stream.end(), q.begin(), q.end());
+    IncrementalDecoder dec;
+    auto r = dec.feed(stream);
+    if (!r) {
+      ++errors;
+      if (dec.records_decoded() <= victim) {
+        const Mesh expect = mesh_after(clean, dec.records_decoded());
+        EXPECT_EQ(dec.mesh().positions, expect.positions);
+      }
+    }
+    // The grid spans the box's largest extent on every axis.
+    const BoundingBox box = index->header.bounds;
+    const float extent = std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
+    for (const Vec3f& v : dec.mesh().positions) {
+      for (int a = 0; a < 3; ++a) {
+        const float lo = (&box.min.x)[a], hi = lo + extent;
+        const float slack = 1e-4f * (1 + extent);
+        EXPECT_GE((&v.x)[a], lo - slack);
+        EXPECT_LE((&v.x)[a], hi + slack);
+      }
+    }
+  }
+  EXPECT_GT(errors, 20);
+}
+
+// A plane record naming vertices the mesh does not have is refused.
+TEST(HostileStream, PlaneRecordOutsideTheMeshIsRefused) {
+  const std::vector<uint8_t> clean = sample_stream();
+  auto index = read_stream_index(clean);
+  ASSERT_TRUE(index);
+  for (uint32_t first : {0u, 5u, 1u << 20}) {
+    std::vector<RecordEntry> entries = index->records;
+    std::vector<std::vector<uint8_t>> payloads;
+    for (const RecordEntry& e : entries)
+      payloads.emplace_back(clean.begin() + e.offset, clean.begin() + e.offset + e.size);
+    // Record 1 becomes a plane record over [first, first + 10^6).
+    std::vector<uint8_t> p = {kRecordPlane};
+    write_varint(first, p);
+    write_varint(1000000, p);
+    p.insert(p.end(), 16, 0x55);
+    payloads[1] = p;
+    entries[1].size = static_cast<uint32_t>(p.size());
+    entries[1].crc32 = crc32(0, p.data(), p.size());
+    std::vector<uint8_t> stream = write_container_prefix(index->header, entries);
+    for (auto& q : payloads) stream.insert(stream.end(), q.begin(), q.end());
+    IncrementalDecoder dec;
+    auto r = dec.feed(stream);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(dec.records_decoded(), 1u);
+    EXPECT_NE(r.error().message.find("plane record"), std::string::npos) << r.error().message;
+  }
+}
+
+// Draco base records are checked before Draco allocates anything: counts
+// that differ from the index, or another bitstream version, are refused.
+TEST(HostileStream, DracoBaseCountsAreCheckedBeforeDecoding) {
+  Mesh m = icosphere(2, 0.1f);
+  auto grid = make_grid(m, 12);
+  ASSERT_TRUE(grid);
+  BaseMesh base;
+  base.positions = quantize_positions(m, *grid);
+  base.faces = m.triangles;
+  auto bytes = encode_base_draco(base);
+  ASSERT_TRUE(bytes);
+  const uint32_t nv = uint32_t(base.positions.size()), nf = uint32_t(base.faces.size());
+  ASSERT_TRUE(decode_base_draco(*bytes, nv, nf, 12));
+  auto refused = [](const Result<BaseMesh>& r) {
+    return !r && r.error().message.find("refused before decoding") != std::string::npos;
+  };
+  EXPECT_TRUE(refused(decode_base_draco(*bytes, nv + 1, nf, 12)));
+  EXPECT_TRUE(refused(decode_base_draco(*bytes, nv, nf - 2, 12)));
+  std::vector<uint8_t> v = *bytes;
+  v[5] = 1;  // legacy bitstream version: another parser inside Draco
+  EXPECT_TRUE(refused(decode_base_draco(v, nv, nf, 12)));
+  // A huge declared face count (varint at byte 14) matching a hostile index.
+  std::vector<uint8_t> huge(bytes->begin(), bytes->begin() + 14);
+  for (uint8_t b : {0xFF, 0xFF, 0xFF, 0xFF, 0x0F}) huge.push_back(b);
+  huge.insert(huge.end(), bytes->begin() + 16, bytes->end());
+  EXPECT_TRUE(refused(decode_base_draco(huge, nv, 0xFFFFFFFFu, 12)));
+}
+
+// The fuzzer's reproducer (tests/fuzz/regressions/hcs_decoder): refused
+// quickly, no multi-gigabyte reservation.
+TEST(HostileStream, DracoReservationReproducerIsRefusedQuickly) {
+  const std::string path =
+      std::string(MESHSTREAM_SOURCE_DIR) + "/tests/fuzz/regressions/hcs_decoder/draco-base-reserves-5.7GB";
+  std::ifstream in(path, std::ios::binary);
+  ASSERT_TRUE(in) << path;
+  const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto start = std::chrono::steady_clock::now();
+  auto r = decode_hcs(bytes);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(r);
+  EXPECT_LT(seconds, 0.5) << "the Draco guard should refuse it before decoding";
 }
 
 }  // namespace
