@@ -150,7 +150,7 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
   const uint32_t n = next_corner(c), p = prev_corner(c);
   if (!irregular_a && !irregular_b) {
     Vec3f q;
-    if (w == 0.0f) {
+    if (w == 0.0f && across) {
       // rules::regular_point with w = 0, reading the wing vertices from
       // `across` (one line of the neighbour instead of four lookups).
       const uint32_t no = next_corner(o), po = prev_corner(o);
@@ -189,20 +189,21 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
   s.centres.clear();
   s.pending.clear();
   const uint32_t* across = m.across;
-  if (!across) {  // a level built by hand (tests): derive it
-    fill_across(cv, opp, corners, s.across);
-    across = s.across.data();
-  }
   const Vec3f* P = m.positions;
 
   if (naming) {
-    // Few split edges (adaptive levels): visit only them.
+    // Few split edges (adaptive levels): visit only them. Without `across`
+    // (adaptive levels do not keep it) the stencil looks its wings up.
     for (const uint32_t c : *naming) {
       const bool irregular_a = extraordinary(m, cv[next_corner(c)]);
       const bool irregular_b = extraordinary(m, cv[prev_corner(c)]);
       first_pass_edge(m, c, edge_vertex[c], irregular_a, irregular_b, across, w, project, first_new, pos, s);
     }
   } else {
+    if (!across) {  // a level built by hand (tests): derive it
+      fill_across(cv, opp, corners, s.across);
+      across = s.across.data();
+    }
     // Per vertex: is it an extraordinary centre (one byte, read twice per edge).
     s.irregular.resize(m.vertex_count);
     uint8_t* irregular = s.irregular.data();

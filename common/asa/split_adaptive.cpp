@@ -8,8 +8,8 @@
 // corner(s) face its edge (two when the edge was split: slot_a near
 // vertex(next(c)), slot_b near vertex(prev(c))). A final pass pairs the two
 // sides of every parent edge. Edges inside one parent are linked while its
-// children are written. `across` (the vertex of the opposite corner) is
-// written with every link; between two kept faces it is the parent's.
+// children are written. `across` is not kept on adaptive levels: the few
+// edge points of a level look their wings up instead.
 //
 // For the next level, the split also writes each output face's unit normal
 // (copied for a kept face: same three positions, same bits) and whether the
@@ -44,7 +44,7 @@ struct Emitter {
     if (track_source) out.source.resize(total);
     if (topology) {
       out.opposite.resize(3 * total);
-      out.across.resize(3 * total);
+      out.across.clear();  // not kept on adaptive levels (see edge_points.h)
       out.feature_edge.resize(3 * total);
       out.green.resize(total);
     }
@@ -81,8 +81,6 @@ struct Emitter {
   void link(uint32_t x, uint32_t y) {
     out.opposite[x] = y;
     out.opposite[y] = x;
-    out.across[x] = tri[y];
-    out.across[y] = tri[x];
   }
 };
 
@@ -108,10 +106,7 @@ void link_local(Emitter& e, uint32_t first, uint32_t count, const std::array<Bor
   if (e.topology) {
     for (uint32_t c = c0; c < c1; ++c) {
       const uint32_t o = find(to(c), from(c));
-      if (o != kNone) {
-        e.out.opposite[c] = o;
-        e.out.across[c] = e.vertex(o);
-      }
+      if (o != kNone) e.out.opposite[c] = o;
     }
   }
   for (const BorderEdge& b : border) {
@@ -141,22 +136,30 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
 
   // New vertices, one per split edge, numbered in corner order; the corners
   // that name them are listed, so later loops touch only split edges.
-  s.edge_vertex.resize(corners);
+  // Split flags are sparse on later levels: skipped eight at a time.
+  s.edge_vertex.assign(corners, kNone);
   s.naming.clear();
   uint32_t E = 0;
-  for (uint32_t c = 0; c < corners; ++c) {
-    if (!split[c]) {
-      s.edge_vertex[c] = kNone;
-      continue;
-    }
+  uint32_t* edge_vertex = s.edge_vertex.data();
+  auto name = [&](uint32_t c) {
     const uint32_t o = opp[c];
     if (o == kNone || c < o) {
-      s.edge_vertex[c] = V + E++;
+      edge_vertex[c] = V + E++;
       s.naming.push_back(c);
     } else {
-      s.edge_vertex[c] = s.edge_vertex[o];
+      edge_vertex[c] = edge_vertex[o];
     }
+  };
+  uint32_t c = 0;
+  for (; c + 8 <= corners; c += 8) {
+    uint64_t word;
+    std::memcpy(&word, split + c, 8);
+    if (word == 0) continue;
+    for (uint32_t i = 0; i < 8; ++i)
+      if (split[c + i]) name(c + i);
   }
+  for (; c < corners; ++c)
+    if (split[c]) name(c);
   out.positions.resize(static_cast<size_t>(V) + E);
   std::memcpy(out.positions.data(), m.positions, sizeof(Vec3f) * V);
   const bool colors = in.colors != nullptr, texcoords = in.texcoords != nullptr;
@@ -233,33 +236,39 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   };
 
   for (uint32_t f = 0; f < F; ++f) {
+    if (action[f] == kKeep) {
+      // A run of unchanged faces is copied in bulk; their links are made in
+      // the final pass.
+      uint32_t end = f + 1;
+      while (end < F && action[end] == kKeep) ++end;
+      const uint32_t n = end - f, g = e.count;
+      e.count += n;
+      std::memcpy(e.tri + 3 * static_cast<size_t>(g), cv + 3 * static_cast<size_t>(f), 3 * sizeof(uint32_t) * n);
+      if (face_kind) std::memset(face_kind->data() + g, static_cast<int>(FaceKind::kUntouched), n);
+      if (e.track_source) std::memcpy(out.source.data() + g, in.source + f, sizeof(uint32_t) * n);
+      if (topo) {
+        std::memcpy(out.feature_edge.data() + 3 * static_cast<size_t>(g), fe + 3 * static_cast<size_t>(f), 3 * n);
+        if (m.green) std::memcpy(out.green.data() + g, m.green + f, n);
+        else std::memset(out.green.data() + g, kNotGreen, n);
+      }
+      if (e.normals) {
+        std::memcpy(out.normals.data() + g, in.normals + f, sizeof(Vec3f) * n);
+        std::memset(out.fresh.data() + g, 0, n);
+      }
+      f = end - 1;
+      continue;
+    }
     const uint32_t v[3] = {cv[3 * f], cv[3 * f + 1], cv[3 * f + 2]};
     if (e.track_source) e.source = in.source[f];
-    if (topo && action[f] != kKeep) {
+    if (topo) {
       // A replaced face: its faces-per-vertex share goes (its children add theirs).
       --e.valence[v[0]];
       --e.valence[v[1]];
       --e.valence[v[2]];
     }
     switch (action[f]) {
-      case kKeep: {
-        // Unchanged face: copied; its links are made in the final pass.
-        const uint32_t g = e.count++;
-        e.tri[3 * g] = v[0];
-        e.tri[3 * g + 1] = v[1];
-        e.tri[3 * g + 2] = v[2];
-        if (face_kind) (*face_kind)[g] = FaceKind::kUntouched;
-        if (e.track_source) out.source[g] = e.source;
-        if (topo) {
-          for (uint32_t i = 0; i < 3; ++i) out.feature_edge[3 * g + i] = fe[3 * f + i];
-          out.green[g] = m.green ? m.green[f] : static_cast<uint8_t>(kNotGreen);
-        }
-        if (e.normals) {
-          out.normals[g] = in.normals[f];
-          out.fresh[g] = 0;
-        }
-        break;
-      }
+      case kKeep:
+        break;  // handled above
       case kRed: {
         const uint32_t mid[3] = {s.edge_vertex[3 * f], s.edge_vertex[3 * f + 1], s.edge_vertex[3 * f + 2]};
         const uint32_t base = e.emit(v[0], mid[2], mid[1], kNotGreen, FaceKind::kTarget);
@@ -334,9 +343,6 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
 
   // Pair the two sides of every parent edge.
   uint32_t* oo = out.opposite.data();
-  uint32_t* ax = out.across.data();
-  const uint32_t* tri = e.tri;
-  const uint32_t* parent_across = m.across;
   auto side_a = [&](uint32_t c) {
     const uint32_t base = kept_base[c / 3];
     return base != kNone ? base + c % 3 : s.slot_a[c];
@@ -347,39 +353,26 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   };
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t base = kept_base[f];
+    if (base != kNone) {
+      // A kept face: one output corner per parent corner; the side across
+      // an unsplit edge is a kept face or one corner of a refined one.
+      for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t o = opp[3 * f + k];
+        oo[base + k] = o == kNone ? kNone : side_b(o);
+      }
+      continue;
+    }
     for (uint32_t k = 0; k < 3; ++k) {
       const uint32_t c = 3 * f + k, o = opp[c];
-      if (base != kNone) {
-        // A kept face: one output corner per parent corner.
-        const uint32_t x = base + k;
-        if (o == kNone) {
-          oo[x] = ax[x] = kNone;
-          continue;
-        }
-        const uint32_t other = kept_base[o / 3];
-        if (other != kNone) {
-          oo[x] = other + o % 3;
-          ax[x] = parent_across ? parent_across[c] : tri[other + o % 3];
-        } else {
-          const uint32_t y = s.slot_b[o];  // the edge is not split: slot_a[o] == slot_b[o]
-          oo[x] = y;
-          ax[x] = tri[y];
-        }
-        continue;
-      }
       const uint32_t a = s.slot_a[c];
       if (a == kNone) continue;  // the internal edge of an opened pair
       const uint32_t b = s.slot_b[c];
       if (o == kNone) {
-        oo[a] = ax[a] = kNone;
-        oo[b] = ax[b] = kNone;
+        oo[a] = oo[b] = kNone;
         continue;
       }
-      const uint32_t pa = side_a(o), pb = side_b(o);
-      oo[a] = pb;
-      ax[a] = tri[pb];
-      oo[b] = pa;
-      ax[b] = tri[pa];
+      oo[a] = side_b(o);
+      oo[b] = side_a(o);
     }
   }
   // Vertex data for the next level. Features: old vertices keep theirs, new
