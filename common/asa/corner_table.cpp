@@ -69,47 +69,90 @@ Status fan_error(uint32_t v, const uint32_t* to, const uint32_t* corner, uint32_
                     "vertex " + std::to_string(v) + " joins more than one fan of faces (non-manifold vertex)");
 }
 
-// One bucket of at most kSmallFan entries.
-inline Status match_small(uint32_t v, const uint32_t* to, const uint32_t* third, const uint32_t* corner,
-                          uint32_t n, uint32_t* opposite, uint32_t* across) {
-  uint8_t succ[kSmallFan];
+// Outcome of matching one small bucket (errors are built off the hot path).
+enum MatchCode : uint32_t { kMatched = 0, kTooManyFaces = 1, kSameDirection = 2, kNotOneFan = 3 };
+
+// One bucket of at most kSmallFan entries. With Packed (n < 16) the
+// successor of each entry lives in a 4-bit field of one register, so the
+// fan walk below is register-only. On error, *bad is the entry at fault.
+// Groups > 0: n <= 4 * Groups, the thirds are held in registers.
+template <bool Packed, uint32_t Groups>
+inline uint32_t match_small(const uint32_t* to, const uint32_t* third, const uint32_t* corner, uint32_t n,
+                            uint32_t* opposite, uint32_t* across, uint32_t* bad) {
+  constexpr uint32_t kEnd = Packed ? 15 : kSmallFan;
+  uint8_t succ[Packed ? 1 : kSmallFan];
+  uint64_t packed = ~uint64_t{0};
   uint64_t has_pred = 0;
+  const uint64_t all = n == 64 ? ~uint64_t{0} : (uint64_t{1} << n) - 1;
+#if defined(__SSE2__)
+  __m128i held[Groups > 0 ? Groups : 1];
+  if constexpr (Groups > 0) {
+    for (uint32_t g = 0; g < Groups; ++g) held[g] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(third + 4 * g));
+  }
+#endif
   for (uint32_t i = 0; i < n; ++i) {
-    const uint64_t mask = match_mask(third, n, to[i]);
+    uint64_t mask;
+#if defined(__SSE2__)
+    if constexpr (Groups > 0) {
+      const __m128i key = _mm_set1_epi32(static_cast<int>(to[i]));
+      uint32_t bits = 0;
+      for (uint32_t g = 0; g < Groups; ++g) {
+        bits |= static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(held[g], key)))) << (4 * g);
+      }
+      mask = bits & all;
+    } else {
+      mask = match_mask(third, n, to[i]);
+    }
+#else
+    mask = match_mask(third, n, to[i]);
+#endif
     const uint32_t pc = prev_corner(corner[i]);
     if (mask == 0) {
       opposite[pc] = kNone;
       across[pc] = kNone;
-      succ[i] = kSmallFan;
+      if constexpr (!Packed) succ[i] = kEnd;
       continue;
     }
-    if (mask & (mask - 1)) {
-      return make_error(ErrorCode::kNonManifold, edge_name(v, to[i]) + " has more than two faces");
-    }
+    *bad = i;
+    if (mask & (mask - 1)) return kTooManyFaces;
+    // Two outgoing half-edges v -> to: the same edge twice in one direction.
+    if (has_pred & mask) return kSameDirection;
     const uint32_t j = static_cast<uint32_t>(std::countr_zero(mask));
-    if (has_pred & mask) {
-      // Two outgoing half-edges v -> to: the same edge twice in one direction.
-      return same_direction_error(v, to[i], corner[i] / 3, "another face");
-    }
     has_pred |= mask;
-    succ[i] = static_cast<uint8_t>(j);
+    if constexpr (Packed) {
+      packed &= ~(uint64_t{15} << (4 * i)) | (uint64_t{j} << (4 * i));
+    } else {
+      succ[i] = static_cast<uint8_t>(j);
+    }
     opposite[pc] = next_corner(corner[j]);
     across[pc] = to[j];
   }
   // One fan: at most one entry without predecessor (an open fan's first
   // face); walking successors from it, or from any entry of a closed fan,
   // must visit all n.
-  const uint64_t all = n == 64 ? ~uint64_t{0} : (uint64_t{1} << n) - 1;
   const uint64_t starts = all & ~has_pred;
-  if (starts & (starts - 1)) return fan_error(v, to, corner, n);
+  if (starts & (starts - 1)) return kNotOneFan;
   const uint32_t start = starts ? static_cast<uint32_t>(std::countr_zero(starts)) : 0;
   uint32_t visited = 0, i = start;
   do {
     ++visited;
-    i = succ[i];
-  } while (i != kSmallFan && i != start && visited <= n);
-  if (visited != n) return fan_error(v, to, corner, n);
-  return {};
+    if constexpr (Packed) {
+      i = static_cast<uint32_t>(packed >> (4 * i)) & 15;
+    } else {
+      i = succ[i];
+    }
+  } while (i != kEnd && i != start && visited <= n);
+  return visited == n ? kMatched : kNotOneFan;
+}
+
+// The error for a failed small bucket (cold).
+[[gnu::noinline, gnu::cold]] Status small_bucket_error(uint32_t code, uint32_t v, const uint32_t* to,
+                                                       const uint32_t* corner, uint32_t n, uint32_t bad) {
+  if (code == kTooManyFaces) {
+    return make_error(ErrorCode::kNonManifold, edge_name(v, to[bad]) + " has more than two faces");
+  }
+  if (code == kSameDirection) return same_direction_error(v, to[bad], corner[bad] / 3, "another face");
+  return fan_error(v, to, corner, n);
 }
 
 // One bucket of more than kSmallFan entries: sorted by third (the three
@@ -212,9 +255,20 @@ Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, std::v
   for (uint32_t v = 0; v < V; ++v) {
     const uint32_t begin = offset[v], n = offset[v + 1] - begin;
     if (n == 0) continue;
-    Status ok = n <= kSmallFan ? match_small(v, to + begin, third + begin, corner + begin, n, opp, across)
-                               : match_large(v, to + begin, third + begin, corner + begin, n, opp, across, s);
-    if (!ok) return ok;
+    if (n <= kSmallFan) {
+      uint32_t bad = 0;
+      const uint32_t *t = to + begin, *h = third + begin, *k = corner + begin;
+      uint32_t code;
+      if (n <= 4) code = match_small<true, 1>(t, h, k, n, opp, across, &bad);
+      else if (n <= 8) code = match_small<true, 2>(t, h, k, n, opp, across, &bad);
+      else if (n <= 12) code = match_small<true, 3>(t, h, k, n, opp, across, &bad);
+      else if (n < 16) code = match_small<true, 4>(t, h, k, n, opp, across, &bad);
+      else code = match_small<false, 0>(t, h, k, n, opp, across, &bad);
+      if (code != kMatched) return small_bucket_error(code, v, to + begin, corner + begin, n, bad);
+    } else {
+      Status ok = match_large(v, to + begin, third + begin, corner + begin, n, opp, across, s);
+      if (!ok) return ok;
+    }
   }
   return {};
 }
