@@ -53,6 +53,19 @@ void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vert
   }
 }
 
+void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vertex_features,
+                                    const std::vector<uint32_t>& list) {
+  for (const uint32_t v : list) {
+    const uint32_t K = valence[v];
+    if (vertex_features[v] == 0 && K >= 3 && K != 6 && (K >= offset_.size() || offset_[K] == kNone)) add(K);
+  }
+}
+
+void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t first,
+                                    uint32_t count) {
+  add_valences(valence + first, vertex_features + first, count);
+}
+
 void ButterflyWeights::add(uint32_t K) {
   if (K < 3) return;
   if (K >= offset_.size()) offset_.resize(K + 1, kNone);

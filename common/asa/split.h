@@ -32,6 +32,7 @@ struct SplitScratch {
   std::vector<uint32_t> slot_a, slot_b;
   std::vector<uint32_t> kept_base;  // per face: first output corner of a kept face, else kNone
   std::vector<uint32_t> naming;     // adaptive: the corner naming each split edge, in id order
+  std::vector<uint32_t> touched;    // adaptive: old vertices whose faces changed (repeats allowed)
   EdgePointScratch points;
 };
 

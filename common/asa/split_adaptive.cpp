@@ -221,6 +221,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     out.fresh.clear();
   }
   e.start(total);
+  s.touched.clear();
   if (topo) {
     out.valence.resize(static_cast<size_t>(V) + E);
     std::memcpy(out.valence.data(), m.valence, sizeof(uint32_t) * V);
@@ -261,10 +262,12 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     const uint32_t v[3] = {cv[3 * f], cv[3 * f + 1], cv[3 * f + 2]};
     if (e.track_source) e.source = in.source[f];
     if (topo) {
-      // A replaced face: its faces-per-vertex share goes (its children add theirs).
+      // A replaced face: its faces-per-vertex share goes (its children add
+      // theirs); its vertices may end with a valence not seen before.
       --e.valence[v[0]];
       --e.valence[v[1]];
       --e.valence[v[2]];
+      s.touched.insert(s.touched.end(), v, v + 3);
     }
     switch (action[f]) {
       case kKeep:
@@ -354,12 +357,19 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t base = kept_base[f];
     if (base != kNone) {
-      // A kept face: one output corner per parent corner; the side across
-      // an unsplit edge is a kept face or one corner of a refined one.
-      for (uint32_t k = 0; k < 3; ++k) {
-        const uint32_t o = opp[3 * f + k];
-        oo[base + k] = o == kNone ? kNone : side_b(o);
+      // A run of kept faces: one output corner per parent corner, shifted by
+      // the same amount across the run, so a neighbour inside the run needs
+      // no lookup; across an unsplit edge to elsewhere lies a kept face or
+      // one corner of a refined one.
+      uint32_t end = f + 1;
+      while (end < F && kept_base[end] != kNone) ++end;
+      const uint32_t first = 3 * f, last = 3 * end;
+      const uint32_t shift = base - first;
+      for (uint32_t c = first; c < last; ++c) {
+        const uint32_t o = opp[c];
+        oo[c + shift] = o == kNone ? kNone : (o - first < last - first ? o + shift : side_b(o));
       }
+      f = end - 1;
       continue;
     }
     for (uint32_t k = 0; k < 3; ++k) {

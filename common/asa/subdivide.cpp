@@ -178,9 +178,11 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     }
     if (!last) {
       if (!options.uniform) {
-        // Bisections change valences (the split counted them): add any new ones.
-        ws.weights.add_valences(out.valence.data(), out.vertex_features.data(),
-                                static_cast<uint32_t>(out.valence.size()));
+        // Bisections change valences (the split counted them): add any new
+        // ones, looking only at new vertices and those of replaced faces.
+        ws.weights.add_valences(out.valence.data(), out.vertex_features.data(), ws.scratch.touched);
+        ws.weights.add_valences(out.valence.data(), out.vertex_features.data(), view.vertex_count,
+                                static_cast<uint32_t>(out.valence.size()) - view.vertex_count);
       }
       view = out.view();
       if (source) source = out.source.data();
