@@ -47,9 +47,20 @@ void ButterflyWeights::configure(float tension) {
 
 void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vertex_features,
                                     uint32_t vertex_count) {
+  // Which valences below 63 occur, as bits (branch-free: most vertices
+  // repeat a handful of valences); 63 stands for "63 or more".
+  uint64_t seen = 0;
   for (uint32_t v = 0; v < vertex_count; ++v) {
-    const uint32_t K = valence[v];
-    if (vertex_features[v] == 0 && K >= 3 && K != 6 && (K >= offset_.size() || offset_[K] == kNone)) add(K);
+    const uint32_t K = valence[v] < 63 ? valence[v] : 63;
+    seen |= static_cast<uint64_t>(vertex_features[v] == 0) << K;
+  }
+  for (uint32_t K = 3; K < 63; ++K)
+    if (K != 6 && (seen >> K & 1)) add(K);
+  if (seen >> 63 & 1) {
+    for (uint32_t v = 0; v < vertex_count; ++v) {
+      const uint32_t K = valence[v];
+      if (vertex_features[v] == 0 && K >= 63 && (K >= offset_.size() || offset_[K] == kNone)) add(K);
+    }
   }
 }
 

@@ -26,6 +26,16 @@ uint32_t tag_feature_edges(const LevelView& m, float crease_degrees, const std::
   feature_edge.resize(corners);
   uint32_t tagged = 0;
   const bool creases = crease_degrees > 0;
+  if (!creases) {
+    // Boundaries only: a branch-free pass the compiler vectorizes.
+    uint8_t* fe = feature_edge.data();
+    for (uint32_t c = 0; c < corners; ++c) {
+      const uint8_t sharp = m.opposite[c] == kNone;
+      fe[c] = sharp;
+      tagged += sharp;
+    }
+    return tagged;
+  }
   const float cos_limit = std::cos(crease_degrees * static_cast<float>(std::numbers::pi) / 180.0f);
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t o = m.opposite[c];
