@@ -49,6 +49,25 @@ struct MeshMeasurements {
   uint32_t ours_vertices_at_ratio20 = 0;  // in the prefix of 1/20 of the stream (HCS's ratio 20)
   uint64_t ours_bytes_at_ratio20 = 0;
 
+  // Embedded stream details (issue 5).
+  uint64_t ours_structure_bytes = 0, ours_plane_bytes = 0, ours_plane_raw_bytes = 0;
+  uint32_t ours_plane_records = 0;
+  uint64_t ours_largest_record = 0;  // beyond the base
+  uint32_t ours_base_shift = 0;
+  // Prefix equals the encoder's model at every record boundary (hashes).
+  bool ours_model_matches = false;
+  // RMS along the measured curve: the largest rise between consecutive
+  // points, relative to the earlier one.
+  double ours_worst_rms_rise = 0;
+
+  // Issue I's ordering (EncodeOptions::embedded = false), same run.
+  std::string plain_error;
+  uint64_t plain_bytes = 0;
+  uint32_t plain_records = 0;
+  uint32_t plain_vertices_at_ratio20 = 0;
+  std::vector<RdPoint> plain_curve;
+  std::vector<ChainComparison> plain_at_chain;
+
   std::vector<RdPoint> ours_curve;
   std::vector<RdPoint> chain_curve;
   std::vector<ChainComparison> at_chain;
