@@ -18,7 +18,7 @@ namespace meshstream::asa {
 namespace {
 
 // Prefetch distance of pass 1, in corners.
-constexpr uint32_t kAhead = 24;
+constexpr uint32_t kAhead = 64;
 
 // Arrival states of a pending edge's new vertex.
 enum : uint8_t { kOneCentre = 1, kTwoCentres = 2, kSecondOfTwo = 3 };
@@ -43,12 +43,37 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
                                      const ButterflyWeights& wt, Vec3f* pos, EdgePointScratch& s) {
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
-  const uint32_t count = static_cast<uint32_t>(s.centres.size());
+  // Fans either come from the cache (a uniform child level: no walking) or
+  // are walked and recorded into it.
+  const bool cached = s.fans_valid;
+  const bool record = !cached && s.record_fans;
+  if (record) {
+    s.fan_vertex.clear();
+    s.fan_corner.clear();
+    s.fan_start.assign(1, 0);
+  }
+  const uint32_t* const centres = cached ? s.fan_vertex.data() : s.centres.data();
+  const uint32_t count = static_cast<uint32_t>(cached ? s.fan_vertex.size() : s.centres.size());
   for (uint32_t k = 0; k < count; ++k) {
-    const uint32_t v = s.centres[k];
-    if (k + 4 < count) {
+    const uint32_t v = centres[k];
+    if (cached) {
+      // Fan corners are independent loads: fetch a later centre's corner
+      // data, then a nearer one's ring positions.
+      if (k + 8 < count) {
+        for (uint32_t i = s.fan_start[k + 8]; i < s.fan_start[k + 9]; ++i) {
+          const uint32_t y = s.fan_corner[i];
+          __builtin_prefetch(cv + next_corner(y));
+          __builtin_prefetch(edge_vertex + prev_corner(y));
+        }
+      }
+      if (k + 4 < count) {
+        __builtin_prefetch(m.positions + centres[k + 4]);
+        for (uint32_t i = s.fan_start[k + 4]; i < s.fan_start[k + 5]; ++i)
+          __builtin_prefetch(m.positions + cv[next_corner(s.fan_corner[i])]);
+      }
+    } else if (k + 4 < count) {
       // The start of a later centre's fan walk (the walk itself is a chain).
-      const uint32_t u = s.centres[k + 4];
+      const uint32_t u = centres[k + 4];
       const uint32_t y = s.vertex_corner[u];
       __builtin_prefetch(m.positions + u);
       __builtin_prefetch(opp + y);
@@ -57,8 +82,14 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     }
     const uint32_t K = m.valence[v];
     const float* weights = wt.extraordinary(K);
-    uint32_t x = s.vertex_corner[v];
-    s.vertex_corner[v] = kNone;
+    uint32_t x = kNone;
+    const uint32_t* fan = nullptr;
+    if (cached) {
+      fan = s.fan_corner.data() + s.fan_start[k];
+    } else {
+      x = s.vertex_corner[v];
+      s.vertex_corner[v] = kNone;
+    }
     const size_t need = 9 * static_cast<size_t>(K) + 24;
     if (s.ring.size() < need) {
       s.ring.assign(need, 0.0f);  // the padding stays zero
@@ -76,13 +107,22 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     float* sz = sy + K + 4;
     uint32_t* ids = s.ring_ids.data();
     for (uint32_t j = 0; j < K; ++j) {
+      if (cached) {
+        x = fan[j];
+      } else if (record) {
+        s.fan_corner.push_back(x);
+      }
       const uint32_t nx = next_corner(x);
       const Vec3f p = m.positions[cv[nx]];
       rx[j] = rx[j + K] = p.x;
       ry[j] = ry[j + K] = p.y;
       rz[j] = rz[j + K] = p.z;
       ids[j] = edge_vertex[prev_corner(x)];
-      x = next_corner(opp[nx]);
+      if (!cached) x = next_corner(opp[nx]);
+    }
+    if (record) {
+      s.fan_vertex.push_back(v);
+      s.fan_start.push_back(static_cast<uint32_t>(s.fan_corner.size()));
     }
     for (uint32_t j = 2 * K; j < stride; ++j) rx[j] = ry[j] = rz[j] = 0.0f;
     const Vec3f centre = m.positions[v] * weights[K];
@@ -169,8 +209,10 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     return;
   }
   s.arrivals[id - first_new] = irregular_a && irregular_b ? kTwoCentres : kOneCentre;
-  if (irregular_a) note_centre(cv[n], n, s);
-  if (irregular_b) note_centre(cv[p], next_corner(o), s);
+  if (!s.fans_valid) {
+    if (irregular_a) note_centre(cv[n], n, s);
+    if (irregular_b) note_centre(cv[p], next_corner(o), s);
+  }
   if (project) s.pending.push_back(c);
 }
 
@@ -192,6 +234,8 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
   const Vec3f* P = m.positions;
 
   if (naming) {
+    s.fans_valid = false;  // the cache is for uniform levels only
+    s.record_fans = false;
     // Few split edges (adaptive levels): visit only them. Without `across`
     // (adaptive levels do not keep it) the stencil looks its wings up.
     for (const uint32_t c : *naming) {
@@ -242,6 +286,11 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
     const uint32_t id = edge_vertex[c];
     pos[id] = rules::project_point(m, c, pos[id]);
   }
+}
+
+void map_fans_to_uniform_children(EdgePointScratch& s) {
+  for (uint32_t& c : s.fan_corner) c = 4 * c - c % 3;
+  s.fans_valid = true;
 }
 
 }  // namespace meshstream::asa

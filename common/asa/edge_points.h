@@ -25,6 +25,13 @@ struct EdgePointScratch {
   std::vector<uint8_t> arrivals;        // per new vertex (minus first_new): stencils still expected
   std::vector<float> ring;              // one centre's one-ring (twice over) and sums, per coordinate
   std::vector<uint32_t> ring_ids;       // new vertex on each ring edge (or kNone)
+  // Fans of the extraordinary centres (corners in walk order), recorded by a
+  // walk; after a uniform split the caller maps them to the child level
+  // (map_fans_to_uniform_children) and the next call reads them instead of
+  // walking (a chain of dependent loads per step).
+  std::vector<uint32_t> fan_vertex, fan_start, fan_corner;
+  bool fans_valid = false;
+  bool record_fans = false;  // walked fans are recorded (set by the uniform split)
 };
 
 // For every corner c with edge_vertex[c] != kNone that names its edge
@@ -35,6 +42,12 @@ struct EdgePointScratch {
 // the same order as the per-edge stencils.
 // With `naming` (the corners naming the split edges, any order), only those
 // corners are visited: O(split edges) instead of O(corners + vertices).
+// After a uniform 1-to-4 split (face 4f + i is the corner child at vertex i
+// of f): every cached fan corner c moves to 12 (c / 3) + 3 (c % 3), the same
+// vertex's corner in its corner child; the fans stay valid (old vertices keep
+// their valence and order). O(cached corners).
+void map_fans_to_uniform_children(EdgePointScratch& scratch);
+
 void compute_edge_points(const LevelView& mesh, const uint32_t* edge_vertex, uint32_t first_new,
                          uint32_t new_count, const ButterflyWeights& weights, EdgePlacement placement,
                          Vec3f* pos, EdgePointScratch& scratch, const std::vector<uint32_t>* naming = nullptr);

@@ -77,7 +77,13 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       }
     }
   }
+  scratch.points.record_fans = in.want_topology;
   compute_edge_points(m, edge_of.data(), V, E, *in.weights, in.placement, pos, scratch.points);
+  if (in.want_topology) {
+    map_fans_to_uniform_children(scratch.points);
+  } else {
+    scratch.points.fans_valid = false;
+  }
 
   out.triangles.resize(4 * static_cast<size_t>(F));
   uint32_t* t = out.triangles.front().data();

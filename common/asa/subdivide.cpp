@@ -71,6 +71,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   }
 
   AsaWorkspace::Buffers& ws = workspace.buffers();
+  ws.scratch.points.fans_valid = false;  // a new input: fans are walked again
   ws.stats.targets.clear();
   ws.stats.split_edges.clear();
   const uint32_t F = mesh.face_count(), V = mesh.vertex_count();
