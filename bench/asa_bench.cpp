@@ -254,11 +254,13 @@ int main(int argc, char** argv) {
                    "speed-up | speed-up incl. OpenMesh's mesh build | ours peak MB | OpenMesh peak MB | write floor ms | ours / floor |\n"
                    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   asa_table << "| mesh | level | t | vertices | faces | vertices / uniform | time ms | uniform ms (same window) | "
-               "time / uniform | time share / output share |\n|---|---|---|---|---|---|---|---|---|---|\n";
+               "time / uniform | time share / output share | same for the input's corner table alone |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<double> speedups, speedups_with_build;
   std::ostringstream corner_table_notes;
   std::vector<double> speedup_by_level[4];
   std::vector<double> asa_share_ratio_by_level[4];  // (time share) / (output share)
+  std::vector<double> table_share_ratio_by_level[4];  // the same for the corner table alone
   std::vector<double> asa_time_ratio;                // ASA time / uniform time
   for (const std::string& name : names) {
     auto imported = import_mesh(testing::test_mesh(name));
@@ -372,11 +374,13 @@ int main(int argc, char** argv) {
         const double vfrac = double(ar.mesh.vertex_count()) / uniform_vertices;
         const double ffrac = double(ar.mesh.face_count()) / out_faces;
         asa_share_ratio_by_level[level].push_back((ms / uniform_ms) / ffrac);
+        table_share_ratio_by_level[level].push_back((table_ms / uniform_ms) / ffrac);
         asa_time_ratio.push_back(ms / uniform_ms);
         asa_table << "| " << name << " | " << level << " | " << fmt("%.1f", t) << " | " << ar.mesh.vertex_count()
                   << " | " << ar.mesh.face_count() << " | " << fmt("%.2f", vfrac) << " | " << fmt("%.2f", ms)
                   << " | " << fmt("%.2f", uniform_ms) << " | " << fmt("%.2f", ms / uniform_ms) << " | "
-                  << fmt("%.2f", (ms / uniform_ms) / ffrac) << " |\n";
+                  << fmt("%.2f", (ms / uniform_ms) / ffrac) << " | " << fmt("%.2f", (table_ms / uniform_ms) / ffrac)
+                  << " |\n";
       }
     }
   }
@@ -629,7 +633,8 @@ int main(int argc, char** argv) {
         << fmt("%.1f", median(speedup_by_level[level])) << "x (min "
         << fmt("%.1f", *std::min_element(speedup_by_level[level].begin(), speedup_by_level[level].end()))
         << "x); ASA (time share)/(output share) median " << fmt("%.1f", median(asa_share_ratio_by_level[level]))
-        << ".\n";
+        << " (the input's corner table alone, which every call builds: "
+        << fmt("%.1f", median(table_share_ratio_by_level[level])) << ").\n";
   }
   if (!asa_time_ratio.empty()) {
     out << "- ASA time / uniform time: at most " << fmt("%.2f", *std::max_element(asa_time_ratio.begin(), asa_time_ratio.end()))
@@ -652,7 +657,12 @@ int main(int argc, char** argv) {
   out << "### ASA against uniform (the thesis's tables 4.1-4.4)\n\n"
          "`time share / output share` = (ASA time / uniform time) / (ASA faces / uniform faces): at most 1 "
          "means ASA costs no more per output triangle than uniform. Uniform is timed again in alternation "
-         "with each ASA configuration (same workspace reuse), and the ratios use that time.\n\n"
+         "with each ASA configuration (same workspace reuse), and the ratios use that time. The last column "
+         "is the ratio the input's corner table alone would score (its build time as the time share): every "
+         "call, ASA or uniform, builds it before any level, and ASA's output is only about 1 to 1.5 times the "
+         "input at any level while uniform's is 4^level times, so where that column exceeds 1 the target "
+         "(ratio at most 1) is out of reach for any method that builds the input's adjacency per call; the "
+         "remaining gap is ASA's per-level passes over the whole (mostly unchanged) mesh.\n\n"
       << asa_table.str() << "\n";
   out << "### Incremental updates (the client's case)\n\n"
          "After each decoder-like record (synthetic rows: a vertex inserted into a random face, one face "

@@ -5,7 +5,10 @@
 // arrival order, float addition being commutative). The stencil sum at a
 // centre adds the same terms in the same order as rules::extraordinary_point
 // (centre first, then the ring from the edge's other endpoint on), so every
-// bit agrees with the per-edge evaluation.
+// bit agrees with the per-edge evaluation (tests/asa/asa_edge_points_test.cpp).
+// The SSE path multiplies and adds separately, like scalar code built for
+// baseline x86-64 (no FMA to contract into); a build with FMA enabled could
+// contract the per-edge reference differently.
 #include "common/asa/edge_points.h"
 
 #include "common/asa/butterfly_rules.h"

@@ -8,11 +8,17 @@
 //                       four-point, boundary-touching interior edges exactly as
 //                       OpenMesh's ModifiedButterFlyT, creases, projection);
 //                       the rules themselves are inline in butterfly_rules.h
+//   edge_points         every new edge point of a level in two passes
+//                       (regular stencils, then each extraordinary centre's
+//                       stencils from one gathered ring), bit-identical to
+//                       the per-edge rules
 //   flatness            face normals, crease tagging, flatness targets
 //   closure             conforming closure with red-green rules (worklist)
 //   split_uniform       1-to-4 split of every face, child corner table by
 //                       index arithmetic
-//   split_adaptive      keep / bisect / 1-to-4 / re-split a green pair's parent
+//   split_adaptive      keep / bisect / 1-to-4 / re-split a green pair's parent;
+//                       writes the next level's normals and which faces
+//                       changed, so flatness is re-tested only there
 //   corner_table        fast opposite-corner builder for the input
 //   subdivide           levels, attributes, buffers (this header)
 //   incremental         redo only the region a change touched (incremental.h)
