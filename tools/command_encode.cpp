@@ -1,4 +1,5 @@
-// `meshstream encode IN -o OUT.hcs [--quant-bits 12] [--base-vertices N]`:
+// `meshstream encode IN -o OUT.hcs [--quant-bits 12] [--base-vertices N]
+//   [--record-bytes N] [--base-shift B] [--issue1-order]`:
 // import and clean a mesh, encode it into one progressive .hcs stream
 // (common/codec/encoder.h), write it, and say what was made.
 #include <cstdio>
@@ -18,6 +19,8 @@ struct EncodeArgs {
   int quant_bits = EncodeOptions{}.quant_bits;
   uint32_t base_vertices = EncodeOptions{}.target_base_vertices;
   uint32_t record_bytes = EncodeOptions{}.record_bytes;
+  int base_shift = EncodeOptions{}.base_shift;
+  bool issue1_order = false;
 };
 
 int run_encode(const EncodeArgs& args) {
@@ -27,6 +30,8 @@ int run_encode(const EncodeArgs& args) {
   options.quant_bits = args.quant_bits;
   options.target_base_vertices = args.base_vertices;
   options.record_bytes = args.record_bytes;
+  options.base_shift = args.base_shift;
+  options.embedded = !args.issue1_order;
   auto bytes = encode_hcs(imported->mesh, options);
   if (!bytes) return report_failure(std::move(bytes.error()).with_context(args.input));
   std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
@@ -57,9 +62,17 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--base-vertices", args->base_vertices, "stop decimating at about this many vertices")
       ->check(CLI::Range(4u, 1u << 30))
       ->capture_default_str();
-  cmd->add_option("--record-bytes", args->record_bytes, "close a refinement record at about this size")
-      ->check(CLI::Range(64u, 1u << 26))
+  cmd->add_option("--record-bytes", args->record_bytes,
+                  "close a refinement record at about this size (0: automatic, at least min(n/50, 200) "
+                  "records, none above 2 % of the stream)")
+      ->check(CLI::Range(0u, 1u << 26))
       ->capture_default_str();
+  cmd->add_option("--base-shift", args->base_shift,
+                  "low bits of the base positions sent later as bit planes (-1: automatic)")
+      ->check(CLI::Range(-1, 12))
+      ->capture_default_str();
+  cmd->add_flag("--issue1-order", args->issue1_order,
+                "no bit planes: every position exact when its vertex arrives (issue I's ordering)");
   cmd->callback([args, &exit_code] { exit_code = run_encode(*args); });
 }
 

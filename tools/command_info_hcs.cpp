@@ -10,6 +10,7 @@
 
 #include "common/codec/base_coder.h"
 #include "common/codec/container.h"
+#include "common/codec/refinement_codec.h"
 #include "tools/commands.h"
 
 namespace meshstream::tools {
@@ -21,6 +22,14 @@ const char* base_coder_name(uint8_t id) {
     case kBaseCoderDraco: return "draco-edgebreaker";
   }
   return "unknown";
+}
+
+// "base", "structure", "plane" (bit planes of positions), or "?" when the
+// file is cut short before the record.
+const char* record_kind(const std::vector<uint8_t>& bytes, const RecordEntry& r, size_t i) {
+  if (i == 0) return "base";
+  if (r.offset >= bytes.size() || r.size == 0) return "?";
+  return bytes[r.offset] == kRecordPlane ? "plane" : "structure";
 }
 
 }  // namespace
@@ -40,7 +49,7 @@ int run_info_hcs(const std::string& path, bool json) {
     for (size_t i = 0; i < index->records.size(); ++i) {
       const RecordEntry& r = index->records[i];
       records.push_back({{"index", i}, {"offset", r.offset}, {"bytes", r.size}, {"vertices", r.vertices},
-                         {"faces", r.faces}});
+                         {"faces", r.faces}, {"kind", record_kind(bytes, r, i)}});
     }
     nlohmann::json out = {
         {"path", path},
@@ -74,12 +83,16 @@ int run_info_hcs(const std::string& path, bool json) {
               base_coder_name(h.base_coder), h.structure_coder, h.geometry_coder);
   std::printf("base mesh: %u vertices, %u faces, %u bytes\n", h.base_vertex_count, h.base_face_count,
               index->records[0].size);
-  std::printf("%8s %12s %10s %10s %10s\n", "record", "offset", "bytes", "vertices", "faces");
+  std::printf("%8s %12s %10s %10s %10s  %s\n", "record", "offset", "bytes", "vertices", "faces", "kind");
+  size_t planes = 0;
   for (size_t i = 0; i < index->records.size(); ++i) {
     const RecordEntry& r = index->records[i];
-    std::printf("%8zu %12llu %10u %10u %10u\n", i, static_cast<unsigned long long>(r.offset), r.size,
-                r.vertices, r.faces);
+    const char* kind = record_kind(bytes, r, i);
+    planes += std::string(kind) == "plane" ? 1 : 0;
+    std::printf("%8zu %12llu %10u %10u %10u  %s\n", i, static_cast<unsigned long long>(r.offset), r.size,
+                r.vertices, r.faces, kind);
   }
+  std::printf("plane records (bit planes of positions): %zu\n", planes);
   std::printf("total: %zu records, %llu bytes\n", index->records.size(), static_cast<unsigned long long>(total));
   return 0;
 }

@@ -90,14 +90,20 @@ std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
   out.insert(out.end(), head.begin(), head.end());
   put_u32(out, crc32(0, head.data(), head.size()));
   // Version 2 index: count, byte length, then per record varint size,
-  // varint vertex and face growth, u32 CRC (about 8 bytes instead of 24:
+  // varint vertices added, zigzag varint (2 x vertices added - faces added),
+  // u32 CRC (about 8 bytes instead of 24:
   // an embedded stream has hundreds of records and the index comes first).
   std::vector<uint8_t> entries;
   uint32_t prev_v = 0, prev_f = 0;
   for (const RecordEntry& r : records) {
+    // Faces added are close to twice the vertices added (2 per interior
+    // vertex, 1 per boundary vertex, 0 for a plane record): code the
+    // difference, zigzag-signed (a base of higher genus has more).
+    const int64_t dv = int64_t(r.vertices) - prev_v, df = int64_t(r.faces) - prev_f;
+    const int64_t gap = 2 * dv - df;
     put_varint(entries, r.size);
-    put_varint(entries, r.vertices - prev_v);
-    put_varint(entries, r.faces - prev_f);
+    put_varint(entries, static_cast<uint32_t>(dv));
+    put_varint(entries, static_cast<uint32_t>(gap >= 0 ? 2 * gap : -2 * gap - 1));
     put_u32(entries, r.crc32);
     prev_v = r.vertices;
     prev_f = r.faces;
@@ -191,7 +197,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   } else {
     if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
     const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
-    if (index_bytes < 7ull * record_count || index_bytes > 19ull * record_count) {
+    if (index_bytes < 7ull * record_count || index_bytes > 19ull * record_count) {  // 3 varints + CRC
       return make_error(ErrorCode::kParse, "implausible record index length " + std::to_string(index_bytes));
     }
     const size_t entries_at = count_at + 8;
@@ -205,13 +211,16 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
     for (uint32_t i = 0; i < record_count; ++i) {
       RecordEntry& r = index.records[i];
-      uint32_t size = 0, dv = 0, df = 0;
+      uint32_t size = 0, dv = 0, zigzag = 0;
       if (!get_varint(in.data(), index_end, pos, size) || !get_varint(in.data(), index_end, pos, dv) ||
-          !get_varint(in.data(), index_end, pos, df) || pos + 4 > index_end) {
+          !get_varint(in.data(), index_end, pos, zigzag) || pos + 4 > index_end) {
         return make_error(ErrorCode::kParse, "record index entry " + std::to_string(i) + " is malformed");
       }
+      const int64_t gap = zigzag & 1 ? -(int64_t(zigzag) + 1) / 2 : int64_t(zigzag) / 2;
+      const int64_t df = 2 * int64_t(dv) - gap;
+      if (df < 0) return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " removes faces");
       vertices += dv;
-      faces += df;
+      faces += uint64_t(df);
       if (vertices > UINT32_MAX || faces > UINT32_MAX) {
         return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " counts overflow");
       }

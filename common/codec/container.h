@@ -8,8 +8,9 @@
 //              container.cpp; fields added later go at the end, so a reader
 //              skips what it does not know), then u32 CRC-32 of those H bytes
 //   12+H+4     record index (version 2): u32 record_count, u32 L, then L
-//              bytes: per record varint size, varint vertices added, varint
-//              faces added, u32 crc32; then a u32 CRC-32 of count, L and
+//              bytes: per record varint size, varint vertices added, zigzag
+//              varint (2 * vertices added - faces added), u32 crc32; then a
+//              u32 CRC-32 of count, L and
 //              entries. (Version 1, still read: record_count entries of 24
 //              bytes, u64 offset, u32 size, u32 vertices, u32 faces, u32
 //              crc32, then the CRC.) Offsets follow from the sizes.

@@ -146,6 +146,7 @@ struct IncrementalDecoder::State {
       delta.added_vertices = std::move(applied.added_vertices);
       delta.touched_faces = std::move(applied.touched_faces);
       delta.moved_vertices = std::move(applied.moved_vertices);
+      delta.full_rebuild = !delta.moved_vertices.empty();  // see RecordDelta
     }
     deltas.push_back(std::move(delta));
     return {};

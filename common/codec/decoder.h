@@ -26,7 +26,11 @@ struct RecordDelta {
   bool full_rebuild = false;            // e.g. the base mesh: everything changed
   // Existing vertices whose position changed (a plane record of an embedded
   // stream sharpened them): refresh their positions and the faces around
-  // them. Empty for records that only insert.
+  // them. Empty for records that only insert. A plane record's delta also
+  // sets full_rebuild, so a consumer that predates this field refreshes
+  // everything (correct, slower); one that knows it can take a delta with
+  // moved vertices and no added vertices as a position update of exactly
+  // those vertices (no face changes its corners).
   std::vector<uint32_t> moved_vertices;
 };
 

@@ -47,6 +47,8 @@ TEST(EmbeddedStream, EveryPrefixEqualsTheEncoderModel) {
           ASSERT_EQ(dec.last_deltas().size(), 1u);
           EXPECT_TRUE(dec.last_deltas()[0].added_vertices.empty());
           EXPECT_TRUE(dec.last_deltas()[0].touched_faces.empty());
+          EXPECT_FALSE(dec.last_deltas()[0].moved_vertices.empty());
+          EXPECT_TRUE(dec.last_deltas()[0].full_rebuild);
         }
       }
       EXPECT_GT(planes, 0u) << "an embedded stream refines positions in plane records";
