@@ -546,6 +546,13 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
     f.plane = true;
     const uint32_t steps = g.pending;
     const int plane = g.top_plane;
+    uint64_t sign_bits = 0;  // for the raw comparison: signs sent on becoming significant
+    for (uint32_t v = g.first; v < g.first + g.count; ++v) {
+      const VertexGeometry& geo = state->geometry[v];
+      if (geo.shift == 0 || geo.normal_axis == kBaseVertexAxis) continue;
+      for (int a = 0; a < 3; ++a)
+        sign_bits += geo.mag[a] == 0 && ((uint32_t(std::abs(truth.residual[v][a])) >> (geo.shift - 1)) & 1u);
+    }
     f.payload = write_plane_record(*state, g.first, g.count, truth.residual);
     f.vertices = state->mesh.vertex_count();
     f.faces = state->mesh.face_slot_count();
@@ -555,7 +562,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
     plane_bits_per_step[plane] = 0.7 * plane_bits_per_step[plane] + 0.3 * coded_bits / std::max(1u, steps);
     g.started = true;
     if (report) {
-      report->plane_bits_raw += 3ull * steps;
+      report->plane_bits_raw += 3ull * steps + sign_bits;
       report->plane_bytes_coded += f.payload.size() - std::min(head, f.payload.size());
       report->records.push_back({true, f.vertices, uint32_t(f.payload.size()), hash_state(*state), f.drop});
     }

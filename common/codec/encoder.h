@@ -58,7 +58,7 @@ struct EncodedRecord {
 };
 struct EncodeReport {
   std::vector<EncodedRecord> records;
-  uint64_t plane_bits_raw = 0;    // plane-record bits sent as they are would take
+  uint64_t plane_bits_raw = 0;    // plane bits and signs, uncoded (one bit each)
   uint64_t plane_bytes_coded = 0; // their context-coded payload (range-coded blocks)
   uint64_t structure_bytes = 0;   // structure records
   uint32_t base_shift = 0;
