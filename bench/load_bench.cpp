@@ -563,6 +563,13 @@ int main(int argc, char** argv) {
   const fs::path work = fs::temp_directory_path() / ("ms_load_" + std::to_string(::getpid()));
   fs::create_directories(work / "models");
   fs::create_directories(work / "cache");
+  struct RemoveWhenDone {  // also on the early error returns
+    fs::path dir;
+    ~RemoveWhenDone() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } remove_work{work};
   // Debug level: each session logs when it read its request and wrote its
   // first chunk (joined with the clients' own times by port).
   std::vector<std::string> args{"--cache", (work / "cache").string(), "--max-connections", "5000",
@@ -744,7 +751,5 @@ int main(int argc, char** argv) {
     fs::create_directories(report_dir);
     std::ofstream(fs::path(report_dir) / "server.md") << md;
   }
-  std::error_code ec;
-  fs::remove_all(work, ec);
   return errors == 0 ? 0 : 1;
 }
