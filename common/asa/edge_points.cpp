@@ -239,13 +239,11 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
   if (naming) {
     s.fans_valid = false;  // the cache is for uniform levels only
     s.record_fans = false;
-    // Few split edges (adaptive levels): visit only them. Without `across`
-    // (adaptive levels do not keep it) the stencil looks its wings up.
-    for (const uint32_t c : *naming) {
-      const bool irregular_a = extraordinary(m, cv[next_corner(c)]);
-      const bool irregular_b = extraordinary(m, cv[prev_corner(c)]);
-      first_pass_edge(m, c, edge_vertex[c], irregular_a, irregular_b, across, w, project, first_new, pos, s);
-    }
+    // Adaptive levels: visit only the split edges, each with its own
+    // stencil (an extraordinary vertex usually has only some of its edges
+    // split, so evaluating all K of its stencils at once would be wasted).
+    for (const uint32_t c : *naming) pos[edge_vertex[c]] = rules::edge_point(m, c, wt, placement);
+    return;
   } else {
     if (!across) {  // a level built by hand (tests): derive it
       fill_across(cv, opp, corners, s.across);

@@ -41,7 +41,8 @@ struct EdgePointScratch {
 // butterfly_point. O(split edges + sum over extraordinary centres of K^2),
 // the same order as the per-edge stencils.
 // With `naming` (the corners naming the split edges, any order), only those
-// corners are visited: O(split edges) instead of O(corners + vertices).
+// corners are visited, each edge with its own stencil (rules::edge_point):
+// O(split edges x valence) instead of O(corners + vertices).
 // After a uniform 1-to-4 split (face 4f + i is the corner child at vertex i
 // of f): every cached fan corner c moves to 12 (c / 3) + 3 (c % 3), the same
 // vertex's corner in its corner child; the fans stay valid (old vertices keep

@@ -33,6 +33,7 @@ struct SplitScratch {
   std::vector<uint32_t> kept_base;  // per face: first output corner of a kept face, else kNone
   std::vector<uint32_t> naming;     // adaptive: the corner naming each split edge, in id order
   std::vector<uint32_t> touched;    // adaptive: old vertices whose faces changed (repeats allowed)
+  uint32_t fresh_count = 0;         // adaptive: output faces that are not copies of a parent face
   EdgePointScratch points;
 };
 

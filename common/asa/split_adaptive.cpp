@@ -199,12 +199,12 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     s.kept_base.resize(F);
   }
   uint32_t* kept_base = topo ? s.kept_base.data() : nullptr;
-  size_t total = 0;
+  size_t total = 0, kept = 0;
   for (uint32_t f = 0; f < F; ++f) {
     const uint8_t a = action[f];
     if (topo) kept_base[f] = a == kKeep ? static_cast<uint32_t>(3 * total) : kNone;
     switch (a) {
-      case kKeep: total += 1; break;
+      case kKeep: total += 1; ++kept; break;
       case kBisect: total += 2; break;
       case kRed: total += 4; break;
       case kOpened:
@@ -212,6 +212,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
         break;
     }
   }
+  s.fresh_count = static_cast<uint32_t>(total - kept);
   Emitter e{out, face_kind, topo};
   e.track_source = in.source != nullptr;
   e.normals = topo && in.normals != nullptr;

@@ -141,10 +141,13 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
       ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) - view.vertex_count);
     } else {
       // Level 0 tests every edge; later levels only the edges of faces the
-      // last split made (their normals came with the split).
+      // last split made (their normals came with the split), unless most
+      // faces are new anyway.
+      const bool mostly_fresh = level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
       const uint32_t targets =
-          level == 0 ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
-                     : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
+          level == 0 || mostly_fresh
+              ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
+              : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
       if (targets == 0) {
         // Nothing bends: this and every later level would copy the mesh
         // unchanged (same normals, same verdicts). Stop here.
