@@ -42,7 +42,7 @@ inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 2;
+inline constexpr uint32_t kEncoderVersion = 3;  // 3: container 2 index, embedded records
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {
