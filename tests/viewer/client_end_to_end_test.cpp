@@ -164,12 +164,12 @@ TEST_F(ClientEndToEnd, ClosingTheWindowEarlyReportsWhatWasShown) {
   std::string display = xvfb.start();
   ASSERT_FALSE(display.empty()) << "Xvfb did not start";
   testing::ChildProcess server;
-  address_ = start_server(server, {"--rate", "3000"});  // several seconds per stream
+  address_ = start_server(server, {"--rate", "4000"});  // ~5 s per stream, base after ~1 s
   ASSERT_FALSE(address_.empty()) << "server did not start";
   const char* old = std::getenv("DISPLAY");
   std::string saved = old ? old : "";
   ::setenv("DISPLAY", display.c_str(), 1);
-  std::vector<std::string> args{client_binary(), address_, "knot", "--view", "--exit-after", "20",
+  std::vector<std::string> args{client_binary(), address_, "knot", "--view", "--exit-after", "150",
                                 "--width", "200", "--height", "150", "--json"};
   testing::ChildProcess client;
   ASSERT_TRUE(client.start(args, path("client.log")));
