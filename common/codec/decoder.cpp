@@ -39,6 +39,12 @@ struct IncrementalDecoder::State {
     return r.offset + r.size;
   }
 
+  // `e` with the record it concerns named first.
+  Error about_record(uint32_t i, const Error& e) const {
+    return Error{e.code, "record " + std::to_string(i) + " of " + std::to_string(index->records.size()) + ": " +
+                             e.message};
+  }
+
   Status check_header() {
     const StreamHeader& h = index->header;
     if (h.quant_bits < kMinQuantBits || h.quant_bits > kMaxQuantBits) {
@@ -89,10 +95,7 @@ struct IncrementalDecoder::State {
   Status apply_record(uint32_t i, std::span<const uint8_t> payload) {
     const RecordEntry& rec = index->records[i];
     const StreamHeader& h = index->header;
-    auto where = [&](const Error& e) {
-      return make_error(e.code, "record " + std::to_string(i) + " of " +
-                                    std::to_string(index->records.size()) + ": " + e.message);
-    };
+    auto where = [&](const Error& e) { return tl::unexpected(about_record(i, e)); };
     // The caller (feed) has checked the record's CRC-32.
     RecordDelta delta;
     delta.record = i;
@@ -203,9 +206,7 @@ Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
     std::span<const uint8_t> payload(s.buffer.data() + at, rec.size);
     if (!record_intact(rec, payload)) {
       // Checked before anything is applied, so the state stays good.
-      s.error = Error{ErrorCode::kCorrupt, "record " + std::to_string(s.records_done) + " of " +
-                                               std::to_string(s.index->records.size()) +
-                                               ": checksum mismatch (corrupt or altered bytes)"};
+      s.error = s.about_record(s.records_done, {ErrorCode::kCorrupt, "checksum mismatch (corrupt or altered bytes)"});
       s.error_recoverable = true;
       return tl::unexpected(*s.error);
     }

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/codec/crc32.h"
+#include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/adjacency.h"
@@ -184,12 +184,16 @@ TEST(Codec, LayersRemoveAFifthOrMore) {
   EXPECT_LT(per_layer, 0.8) << h.layer_count << " layers";
 }
 
-TEST(Codec, ResumeAtRecordBoundary) {
-  Mesh m = icosphere(3, 0.1f);
+// A small stream of many short records (for resume and damage tests).
+Result<std::vector<uint8_t>> small_many_record_stream() {
   EncodeOptions opt;
   opt.target_base_vertices = 20;
   opt.record_bytes = 100;
-  auto bytes = encode_hcs(m, opt);
+  return encode_hcs(icosphere(3, 0.1f), opt);
+}
+
+TEST(Codec, ResumeAtRecordBoundary) {
+  auto bytes = small_many_record_stream();
   ASSERT_TRUE(bytes);
   IncrementalDecoder dec;
   const size_t half = bytes->size() / 2;
@@ -208,11 +212,7 @@ TEST(Codec, ResumeAtRecordBoundary) {
 // is applied: the decoder keeps its last good mesh, says the error is
 // recoverable, and after resume_at the good bytes finish the stream exactly.
 TEST(Codec, ChecksumFailureIsRecoverableByResuming) {
-  Mesh m = icosphere(3, 0.1f);
-  EncodeOptions opt;
-  opt.target_base_vertices = 20;
-  opt.record_bytes = 100;
-  auto bytes = encode_hcs(m, opt);
+  auto bytes = small_many_record_stream();
   ASSERT_TRUE(bytes);
   auto index = read_stream_index(*bytes);
   ASSERT_TRUE(index);
@@ -244,24 +244,16 @@ TEST(Codec, ChecksumFailureIsRecoverableByResuming) {
 // A record whose checksum matches but whose content is invalid is the
 // stream's own fault: not recoverable, resume_at repeats the error.
 TEST(Codec, InvalidRecordWithGoodChecksumStaysFatal) {
-  Mesh m = icosphere(3, 0.1f);
-  EncodeOptions opt;
-  opt.target_base_vertices = 20;
-  opt.record_bytes = 100;
-  auto bytes = encode_hcs(m, opt);
+  auto bytes = small_many_record_stream();
   ASSERT_TRUE(bytes);
   auto index = read_stream_index(*bytes);
   ASSERT_TRUE(index);
   const RecordEntry& victim = index->records[1];
-  // Truncate the record's content to nothing valid but keep the CRC right:
-  // zero its bytes and rewrite the stream with a recomputed index.
+  // Overwrite the record's content with bytes that decode to nothing valid
+  // and make its checksum (and the index's) match them again.
   std::vector<uint8_t> damaged = *bytes;
   std::fill(damaged.begin() + victim.offset, damaged.begin() + victim.offset + victim.size, 0xFF);
-  StreamIndex rewritten = *index;
-  rewritten.records[1].crc32 = crc32(0, damaged.data() + victim.offset, victim.size);
-  const std::vector<uint8_t> prefix = write_container_prefix(rewritten.header, rewritten.records);
-  ASSERT_EQ(prefix.size(), index->payload_offset);
-  std::copy(prefix.begin(), prefix.end(), damaged.begin());
+  reseal_checksums(damaged);
 
   IncrementalDecoder dec;
   auto fed = dec.feed(damaged);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,25 @@ using namespace std::chrono_literals;
 
 std::string server_binary() { return std::string(MESHSTREAM_BINARY_DIR) + "/server/meshstream-server"; }
 std::string client_binary() { return std::string(MESHSTREAM_BINARY_DIR) + "/client/meshstream-client"; }
+
+// Sets an environment variable for a scope (the children started in it
+// inherit it) and restores the old value on every exit, ASSERT included.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) saved_ = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (saved_) ::setenv(name_, saved_->c_str(), 1); else ::unsetenv(name_);
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> saved_;
+};
 
 class ClientEndToEnd : public ::testing::Test {
  protected:
@@ -146,11 +166,8 @@ TEST_F(ClientEndToEnd, WindowFollowsAThrottledStreamUnderXvfb) {
   testing::ChildProcess server;
   address_ = start_server(server, {"--rate", "200000"});
   ASSERT_FALSE(address_.empty()) << "server did not start";
-  const char* old = std::getenv("DISPLAY");
-  std::string saved = old ? old : "";
-  ::setenv("DISPLAY", display.c_str(), 1);
+  ScopedEnv on_xvfb("DISPLAY", display);
   int code = run_client({"--view", "--exit-after", "45", "--width", "400", "--height", "300"});
-  if (old) ::setenv("DISPLAY", saved.c_str(), 1); else ::unsetenv("DISPLAY");
   EXPECT_EQ(code, 0) << client_log();
 }
 
@@ -166,9 +183,7 @@ TEST_F(ClientEndToEnd, ClosingTheWindowEarlyReportsWhatWasShown) {
   testing::ChildProcess server;
   address_ = start_server(server, {"--rate", "4000"});  // ~5 s per stream, base after ~1 s
   ASSERT_FALSE(address_.empty()) << "server did not start";
-  const char* old = std::getenv("DISPLAY");
-  std::string saved = old ? old : "";
-  ::setenv("DISPLAY", display.c_str(), 1);
+  ScopedEnv on_xvfb("DISPLAY", display);
   std::vector<std::string> args{client_binary(), address_, "knot", "--view", "--exit-after", "150",
                                 "--width", "200", "--height", "150", "--json"};
   testing::ChildProcess client;
@@ -178,18 +193,16 @@ TEST_F(ClientEndToEnd, ClosingTheWindowEarlyReportsWhatWasShown) {
     if (line->find("\"event\":\"done\"") != std::string::npos) done_line = *line;
   }
   const int code = client.wait(30s).value_or(-1);
-  if (old) ::setenv("DISPLAY", saved.c_str(), 1); else ::unsetenv("DISPLAY");
   ASSERT_EQ(code, 0) << client_log();
   ASSERT_FALSE(done_line.empty()) << "no done event; stderr: " << client_log();
   auto j = nlohmann::json::parse(done_line, nullptr, false);
   ASSERT_FALSE(j.is_discarded()) << done_line;
-  const std::string& log = done_line;
-  EXPECT_EQ(j["reason"], "cancelled") << log;
-  EXPECT_GE(j["records"].get<int>(), 1) << log;
-  EXPECT_LT(j["records"].get<int>(), j["records_total"].get<int>()) << log;
-  EXPECT_GT(j["bytes"].get<int64_t>(), 0) << log;
-  EXPECT_GT(j["faces"].get<int64_t>(), 0) << log;
-  EXPECT_GT(j["display_faces"].get<int64_t>(), 0) << log;
+  EXPECT_EQ(j["reason"], "cancelled") << done_line;
+  EXPECT_GE(j["records"].get<int>(), 1) << done_line;
+  EXPECT_LT(j["records"].get<int>(), j["records_total"].get<int>()) << done_line;
+  EXPECT_GT(j["bytes"].get<int64_t>(), 0) << done_line;
+  EXPECT_GT(j["faces"].get<int64_t>(), 0) << done_line;
+  EXPECT_GT(j["display_faces"].get<int64_t>(), 0) << done_line;
 }
 
 }  // namespace
