@@ -12,27 +12,14 @@
 #include "common/mesh/import.h"
 #include "common/mesh/topology.h"
 #include "tests/test_meshes.h"
+#include "tests/mesh/temp_file.h"
 
 namespace meshstream {
 namespace {
 
 using ::testing::HasSubstr;
 
-// A file in the test's temporary folder, removed at the end of the test.
-class TempFile {
- public:
-  TempFile(const std::string& name, const std::string& content) {
-    path_ = (std::filesystem::temp_directory_path() /
-             ("meshstream_import_" + std::to_string(::getpid()) + "_" + name))
-                .string();
-    std::ofstream(path_, std::ios::binary) << content;
-  }
-  ~TempFile() { std::filesystem::remove(path_); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+using testing::TempFile;
 
 TEST(ImportErrors, NanAndInfAreRefusedNamingFileAndVertex) {
   MESHSTREAM_REQUIRE_TEST_MESHES();

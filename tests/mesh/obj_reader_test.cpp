@@ -17,26 +17,14 @@
 #include "common/mesh/mesh_readers.h"
 #include "common/mesh/procedural.h"
 #include "tests/test_meshes.h"
+#include "tests/mesh/temp_file.h"
 
 namespace meshstream {
 namespace {
 
 using ::testing::HasSubstr;
 
-class TempFile {
- public:
-  TempFile(const std::string& name, const std::string& content) {
-    path_ = (std::filesystem::temp_directory_path() /
-             ("meshstream_obj_" + std::to_string(::getpid()) + "_" + name))
-                .string();
-    std::ofstream(path_, std::ios::binary) << content;
-  }
-  ~TempFile() { std::filesystem::remove(path_); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+using testing::TempFile;
 
 template <class T>
 bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {

@@ -11,26 +11,14 @@
 
 #include "common/mesh/import.h"
 #include "common/mesh/mesh_readers.h"
+#include "tests/mesh/temp_file.h"
 
 namespace meshstream {
 namespace {
 
 using ::testing::HasSubstr;
 
-class TempFile {
- public:
-  TempFile(const std::string& name, const std::string& content) {
-    path_ = (std::filesystem::temp_directory_path() /
-             ("meshstream_reader_" + std::to_string(::getpid()) + "_" + name))
-                .string();
-    std::ofstream(path_, std::ios::binary) << content;
-  }
-  ~TempFile() { std::filesystem::remove(path_); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+using testing::TempFile;
 
 const char* kTetraOff =
     "OFF\n"
