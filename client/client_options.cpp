@@ -13,7 +13,7 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   std::string address, rule = "zorin", path = "auto";
   std::optional<uint64_t> bytes;
   std::optional<uint32_t> vertices;
-  std::optional<double> percent;
+  std::optional<double> percent, percent_bytes;
   int reconnect_attempts = o.reconnect.max_attempts;
   app.add_option("address", address, "server address HOST:PORT")->required();
   app.add_option("model", o.model, "model name to stream (see --list)");
@@ -38,10 +38,16 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->capture_default_str();
   auto* b = app.add_option("--bytes", bytes, "stop at the last record boundary within N stream bytes");
   auto* v = app.add_option("--vertices", vertices, "stop after the last record with at most N vertices");
-  auto* p = app.add_option("--percent", percent, "stop at P percent of the stream's bytes (0 < P <= 100)")
+  auto* p = app.add_option("--percent", percent,
+                           "stop after the last record with at most P percent of the full mesh's vertices "
+                           "(0 < P <= 100; as `meshstream decode --percent`)")
                 ->check(CLI::Range(0.0, 100.0));
-  b->excludes(v)->excludes(p);
-  v->excludes(p);
+  auto* pb = app.add_option("--percent-bytes", percent_bytes,
+                            "stop at the last record boundary within P percent of the stream's bytes (0 < P <= 100)")
+                 ->check(CLI::Range(0.0, 100.0));
+  b->excludes(v)->excludes(p)->excludes(pb);
+  v->excludes(p)->excludes(pb);
+  p->excludes(pb);
   app.add_flag("--json", o.json, "print one JSON event per line on stdout");
   app.add_flag("--view", o.view, "open a window that shows the model as it refines");
   app.add_option("--snapshot", o.snapshot_png, "render the final (or --snapshot-at) display mesh to a PNG");
@@ -74,14 +80,17 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   o.port = hp->port;
   if (!o.list && o.model.empty()) return usage("name a MODEL to stream, or use --list");
   if (o.list && !o.model.empty()) return usage("--list takes no MODEL");
-  if (percent && (*percent <= 0)) return usage("--percent must be in (0, 100]");
+  // !(x > 0) also refuses NaN, which CLI11's range check lets through.
+  if (percent && !(*percent > 0)) return usage("--percent must be in (0, 100]");
+  if (percent_bytes && !(*percent_bytes > 0)) return usage("--percent-bytes must be in (0, 100]");
   if (o.snapshot_at && o.snapshot_png.empty()) return usage("--snapshot-at needs --snapshot FILE.png");
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
   o.asa_enabled = !no_asa;
   o.asa_path = path == "full" ? AsaPath::kFull : path == "incremental" ? AsaPath::kIncremental : AsaPath::kAuto;
   if (bytes) o.budget = {Budget::Kind::kBytes, static_cast<double>(*bytes)};
   if (vertices) o.budget = {Budget::Kind::kVertices, static_cast<double>(*vertices)};
-  if (percent) o.budget = {Budget::Kind::kPercent, *percent};
+  if (percent) o.budget = {Budget::Kind::kPercentVertices, *percent};
+  if (percent_bytes) o.budget = {Budget::Kind::kPercentBytes, *percent_bytes};
   o.reconnect.max_attempts = reconnect_attempts;
   return o;
 }

@@ -1,7 +1,7 @@
 // The `meshstream-client` command line (contract in ../shared/DESIGN.md):
 //   meshstream-client HOST:PORT [MODEL] [--list] [--out DIR] [--asa-levels L]
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
-//     [--bytes N | --vertices N | --percent P] [--json] [--view]
+//     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
 //     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
 //     [--exit-after N]
 #pragma once

@@ -50,7 +50,8 @@ v1::Budget to_proto(const Budget& b) {
     case Budget::Kind::kAll: break;
     case Budget::Kind::kBytes: out.set_bytes(static_cast<uint64_t>(b.value)); break;
     case Budget::Kind::kVertices: out.set_vertices(static_cast<uint32_t>(b.value)); break;
-    case Budget::Kind::kPercent: out.set_percent(b.value); break;
+    case Budget::Kind::kPercentVertices: out.set_percent_vertices(b.value); break;
+    case Budget::Kind::kPercentBytes: out.set_percent(b.value); break;
   }
   return out;
 }

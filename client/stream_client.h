@@ -22,8 +22,12 @@
 
 namespace meshstream::client {
 
+// Where the stream stops (proto/meshstream.proto, Budget). kPercentVertices
+// is HCS's "percentage of points" (wire percent_vertices, the rule of
+// `meshstream decode --percent`); kPercentBytes is a percent of the stream's
+// bytes (wire percent).
 struct Budget {
-  enum class Kind { kAll, kBytes, kVertices, kPercent };
+  enum class Kind { kAll, kBytes, kVertices, kPercentVertices, kPercentBytes };
   Kind kind = Kind::kAll;
   double value = 0;
 };

@@ -256,6 +256,7 @@ void Session::handle_stream(const v1::StreamRequest& request) {
       case v1::Budget::kBytes: budget = ByteBudget{b.bytes()}; break;
       case v1::Budget::kVertices: budget = VertexBudget{b.vertices()}; break;
       case v1::Budget::kPercent: budget = PercentBudget{b.percent()}; break;
+      case v1::Budget::kPercentVertices: budget = PercentVerticesBudget{b.percent_vertices()}; break;
       default: break;
     }
   }

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <charconv>
+#include <string>
+
+#include "common/codec/decoder.h"
 
 namespace meshstream::server {
 namespace {
@@ -18,6 +22,16 @@ uint32_t first_ending_after(const StreamIndex& index, uint64_t offset) {
 // Number of whole records within a byte prefix, at least 1 (the base mesh).
 uint32_t records_within_bytes(const StreamIndex& index, uint64_t bytes) {
   return std::max<uint32_t>(1, first_ending_after(index, bytes));
+}
+
+bool valid_percent(double p) { return std::isfinite(p) && p > 0 && p <= 100; }
+
+tl::unexpected<Error> bad_percent(const std::string& what, double value) {
+  // Shortest round-trip form: "nan", "-0", "101", "100.0000001" as sent.
+  char shown[64];
+  const auto end = std::to_chars(shown, shown + sizeof shown, value).ptr;
+  return make_error(ErrorCode::kInvalidArgument,
+                    what + " " + std::string(shown, end) + " is not in (0, 100]");
 }
 
 }  // namespace
@@ -39,12 +53,16 @@ Result<StreamPlan> plan_stream(const StreamIndex& index, uint64_t resume_offset,
                                [](uint32_t n, const RecordEntry& r) { return n < r.vertices; });
     end_record = std::max<uint32_t>(1, static_cast<uint32_t>(it - index.records.begin()));
   } else if (const auto* p = std::get_if<PercentBudget>(&budget)) {
-    if (!std::isfinite(p->percent) || p->percent <= 0 || p->percent > 100) {
-      return make_error(ErrorCode::kInvalidArgument,
-                        "budget percent " + std::to_string(p->percent) + " is not in (0, 100]");
-    }
+    if (!valid_percent(p->percent)) return bad_percent("budget percent (of bytes)", p->percent);
     const auto bytes = static_cast<uint64_t>(std::floor(double(total) * p->percent / 100.0));
     end_record = records_within_bytes(index, bytes);
+  } else if (const auto* pv = std::get_if<PercentVerticesBudget>(&budget)) {
+    if (!valid_percent(pv->percent)) return bad_percent("budget percent_vertices", pv->percent);
+    // The decoder's own rule, so the server ends exactly where
+    // `meshstream decode --percent` does. It returns a record boundary.
+    const uint64_t prefix =
+        prefix_for_budget(index, DecodeBudget{DecodeBudget::Kind::kPercentVertices, pv->percent});
+    end_record = records_within_bytes(index, prefix);
   }
 
   StreamPlan plan;

@@ -18,9 +18,14 @@ namespace meshstream::server {
 
 struct ByteBudget { uint64_t bytes; };
 struct VertexBudget { uint32_t vertices; };
+// Percent of the stream's bytes (wire Budget.percent).
 struct PercentBudget { double percent; };
+// Percent of the full mesh's vertices (wire Budget.percent_vertices): the
+// rule of `meshstream decode --percent`, i.e. prefix_for_budget's
+// kPercentVertices (common/codec/decoder.h).
+struct PercentVerticesBudget { double percent; };
 // monostate = whole stream.
-using Budget = std::variant<std::monostate, ByteBudget, VertexBudget, PercentBudget>;
+using Budget = std::variant<std::monostate, ByteBudget, VertexBudget, PercentBudget, PercentVerticesBudget>;
 
 struct StreamPlan {
   uint64_t start = 0;         // first byte sent (0 or a record's offset)
@@ -30,9 +35,11 @@ struct StreamPlan {
   bool complete = false;      // end is the end of the whole stream
 };
 
-// Resolves a request against `index`. kInvalidArgument for a percent outside
-// (0, 100] or not finite. Never fails for offsets or budgets past the end
-// (they are clamped). O(log records).
+// Resolves a request against `index`. kInvalidArgument for a percent (of
+// bytes or of vertices) outside (0, 100] or not finite; the message names
+// the value. Never fails for offsets or budgets past the end (they are
+// clamped). O(log records), O(records) for a vertex percent (it reuses the
+// decoder's prefix_for_budget so both sides choose the same record).
 Result<StreamPlan> plan_stream(const StreamIndex& index, uint64_t resume_offset,
                                const Budget& budget);
 

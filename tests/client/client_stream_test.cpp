@@ -244,7 +244,9 @@ TEST_F(ClientStreamTest, BudgetsStopOnTheLastRecordBoundaryWithinThem) {
     EXPECT_EQ(done["reason"], "budget");
   }
   {
-    const ClientRun r = client(server_->address(), {"demo", "--json", "--percent", "50", "--no-asa"});
+    // --percent counts vertices (client_percent_test.cpp); --percent-bytes
+    // is the wire's percent of the stream's bytes.
+    const ClientRun r = client(server_->address(), {"demo", "--json", "--percent-bytes", "50", "--no-asa"});
     ASSERT_EQ(r.status, 0) << r.err;
     const auto& done = r.events.back();
     EXPECT_LE(done["bytes"].get<uint64_t>(), total / 2);
@@ -255,6 +257,44 @@ TEST_F(ClientStreamTest, BudgetsStopOnTheLastRecordBoundaryWithinThem) {
     const ClientRun r = client(server_->address(), {"demo", "--json", "--bytes", "1", "--no-asa"});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.events.back()["records"], 1);
+  }
+}
+
+// --percent P is HCS's percentage of points, as `meshstream decode --percent
+// P`: the client (over the wire's Budget.percent_vertices) ends on the same
+// record with the same vertex count and the same decoded mesh, byte for byte.
+TEST_F(ClientStreamTest, PercentMeansTheSameVerticesAsTheDecodeTool) {
+  const Mesh full = load_ply([&] {
+    tool_decode(0, "pfull.ply");
+    return *dir_ / "pfull.ply";
+  }());
+  ASSERT_GT(full.vertex_count(), 0u);
+  for (const char* p : {"12.5", "50", "80", "100"}) {
+    TempDir out;
+    const ClientRun r =
+        client(server_->address(), {"demo", "--json", "--percent", p, "--no-asa", "--out", out.path()});
+    ASSERT_EQ(r.status, 0) << p << ": " << r.err;
+    const auto& done = r.events.back();
+    ASSERT_EQ(done["event"], "done") << p;
+
+    const std::string name = std::string("pdec") + p + ".ply";
+    ASSERT_EQ(run({tool_bin(), "decode", hcs(), "-o", *dir_ / name, "--percent", p}, *dir_ / "pdec.out",
+                  *dir_ / "pdec.err"),
+              0)
+        << read_text(*dir_ / "pdec.err");
+    // "IN: decoded R of N records (...)"
+    const std::string said = read_text(*dir_ / "pdec.out");
+    const auto at = said.find("decoded ");
+    ASSERT_NE(at, std::string::npos) << said;
+    const int tool_records = std::stoi(said.substr(at + 8));
+    const Mesh tool_mesh = load_ply(*dir_ / name);
+
+    EXPECT_EQ(done["records"].get<int>(), tool_records) << p;
+    EXPECT_EQ(done["vertices"].get<uint32_t>(), tool_mesh.vertex_count()) << p;
+    EXPECT_EQ(done["faces"].get<uint32_t>(), tool_mesh.face_count()) << p;
+    EXPECT_EQ(read_text(out / "final.decoded.ply"), read_text(*dir_ / name)) << p;
+    EXPECT_LE(double(tool_mesh.vertex_count()), std::stod(p) / 100.0 * double(full.vertex_count()) + 1e-9) << p;
+    EXPECT_EQ(done["reason"], tool_records == done["records_total"].get<int>() ? "complete" : "budget") << p;
   }
 }
 
@@ -368,6 +408,10 @@ TEST_F(ClientStreamTest, UsageErrorsExitTwo) {
   EXPECT_EQ(client(server_->address(), {"demo", "--bytes", "10", "--vertices", "5"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--rule", "loop"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--percent", "0"}).status, 2);
+  EXPECT_EQ(client(server_->address(), {"demo", "--percent", "nan"}).status, 2);
+  EXPECT_EQ(client(server_->address(), {"demo", "--percent", "101"}).status, 2);
+  EXPECT_EQ(client(server_->address(), {"demo", "--percent-bytes", "0"}).status, 2);
+  EXPECT_EQ(client(server_->address(), {"demo", "--percent", "5", "--percent-bytes", "5"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--frobnicate"}).status, 2);
 }
 
