@@ -67,6 +67,7 @@ Result<RefinementState> RefinementState::from_coarse_base(const std::vector<Vec3
   auto s = from_base(std::move(positions), std::move(faces), quant_bits);
   if (!s) return s;
   s->geometry = std::move(geometry);
+  for (auto& e : s->vertices) e.shift = static_cast<uint8_t>(base_shift);
   return s;
 }
 
@@ -181,7 +182,7 @@ bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const R
 
 int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift) {
   int shift = min_shift;
-  for (uint32_t u : ring) shift = std::max<int>(shift, s.geometry[u].shift);
+  for (uint32_t u : ring) shift = std::max<int>(shift, s.vertices[u].shift);
   return shift;
 }
 
@@ -204,8 +205,31 @@ uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>&
   return free_faces;
 }
 
-void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out) {
+namespace {
+
+// Scratch of the start scoring: on the stack for ordinary stars, on the
+// heap for huge ones.
+struct StartScratch {
+  static constexpr uint32_t kSmall = 64;
+  int64_t edge_small[kSmall], score_small[kSmall];
+  std::vector<int64_t> edge_big, score_big;
+  int64_t* edge = edge_small;
+  int64_t* score = score_small;
+  explicit StartScratch(uint32_t faces) {
+    if (faces > kSmall) {
+      edge_big.resize(faces);
+      score_big.resize(faces);
+      edge = edge_big.data();
+      score = score_big.data();
+    }
+  }
+};
+
+// The candidate starts of rank_patch_starts in increasing r, with their
+// scores in `score` (score[i] belongs to out[i]), unsorted.
+void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                        const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
+                        StartScratch& scratch) {
   out.clear();
   const uint32_t faces = static_cast<uint32_t>(used.size());
   const uint32_t fan = k - 2;
@@ -216,18 +240,8 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
     const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y, dz = int64_t(p[a].z) - p[b].z;
     return dx * dx + dy * dy + dz * dz;
   };
-  // Scratch on the stack for ordinary stars, on the heap for huge ones.
-  constexpr uint32_t kSmall = 64;
-  int64_t edge_small[kSmall], score_small[kSmall];
-  std::vector<int64_t> edge_big, score_big;
-  int64_t* edge = edge_small;
-  int64_t* score = score_small;
-  if (faces > kSmall) {
-    edge_big.resize(faces);
-    score_big.resize(faces);
-    edge = edge_big.data();
-    score = score_big.data();
-  }
+  int64_t* edge = scratch.edge;
+  int64_t* score = scratch.score;
   const uint32_t last_start = boundary ? faces - fan : faces - 1;
   const size_t ring_n = star_ring.size();
   if (k == 3) {
@@ -257,7 +271,10 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
       used_in_run -= used[r];
     }
   }
-  // Larger score first, ties by r (stable insertion sort: runs are few).
+}
+
+// Larger score first, ties by r (stable insertion sort: runs are few).
+void sort_patch_starts(std::vector<uint32_t>& out, int64_t* score) {
   for (size_t i = 1; i < out.size(); ++i) {
     const int64_t sc = score[i];
     const uint32_t r = out[i];
@@ -270,6 +287,34 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
     score[j] = sc;
     out[j] = r;
   }
+}
+
+}  // namespace
+
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out) {
+  StartScratch scratch(static_cast<uint32_t>(used.size()));
+  score_patch_starts(mesh, apex, star_ring, used, k, out, scratch);
+  sort_patch_starts(out, scratch.score);
+}
+
+uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                            const std::vector<uint8_t>& used, uint32_t k, uint32_t rank,
+                            std::vector<uint32_t>& scratch_starts) {
+  StartScratch scratch(static_cast<uint32_t>(used.size()));
+  std::vector<uint32_t>& starts = scratch_starts;
+  score_patch_starts(mesh, apex, star_ring, used, k, starts, scratch);
+  if (rank >= starts.size()) return kNone;
+  if (rank == 0) {
+    // The first of the best: strictly larger wins, so ties keep the smaller r
+    // (starts are in increasing r), as the stable sort orders them.
+    size_t best = 0;
+    for (size_t i = 1; i < starts.size(); ++i)
+      if (scratch.score[i] > scratch.score[best]) best = i;
+    return starts[best];
+  }
+  sort_patch_starts(starts, scratch.score);
+  return starts[rank];
 }
 
 void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
@@ -330,7 +375,9 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
                      const VertexGeometry& geometry, std::vector<uint32_t>* touched) {
   state.geometry.push_back(geometry);
-  return apply_patch(state, patch, open, reconstruct(geometry, state.max_coordinate), touched);
+  const uint32_t v = apply_patch(state, patch, open, reconstruct(geometry, state.max_coordinate), touched);
+  state.vertices[v].shift = geometry.shift;
+  return v;
 }
 
 void write_varint(uint32_t v, std::vector<uint8_t>& out) {
@@ -373,6 +420,7 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
     if (!plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate)) {
       return bad("plane record gives vertex " + std::to_string(v) + " a residual beyond the grid");
     }
+    state.vertices[v].shift = g.shift;
     if (g.shift == 0 && g.normal_axis != kBaseVertexAxis) {
       for (int a = 0; a < 3; ++a) {
         const int64_t value = int64_t(g.anchor[a]) + ((g.negative >> a) & 1 ? -int64_t(g.mag[a]) : int64_t(g.mag[a]));
@@ -405,6 +453,7 @@ std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, 
     if (g.shift == 0) continue;
     PlaneBitWriter io{enc, residuals[v]};
     plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate);
+    state.vertices[v].shift = g.shift;
     state.mesh.set_position(v, reconstruct(g, state.max_coordinate));
   }
   const std::vector<uint8_t> coded = enc.finish();
@@ -500,14 +549,16 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     opens.resize(count);
     for (uint32_t i = 0; i < count; ++i) {
       const uint32_t k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
-      rank_patch_starts(mesh, u, star_ring, used_faces, k, candidates);
+      // The rank depends only on k, so it is read first: the decoder then
+      // needs only the start of that rank, most often the best one (a
+      // linear scan), not the whole ordered list the encoder searches.
       const uint32_t rank = decode_start_rank(m, dec, k);
-      if (rank >= candidates.size()) {
+      const uint32_t r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
+      if (r == kNone) {
         return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
                     std::to_string(k) + ", start rank " + std::to_string(rank) + ") does not fit its star of " +
                     std::to_string(faces) + " faces");
       }
-      const uint32_t r = candidates[rank];
       if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
         return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " does not fit");
       }

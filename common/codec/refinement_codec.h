@@ -60,6 +60,13 @@ struct RefinementState {
     uint32_t valence = 0;
     uint32_t taken = 0;        // faces holding a vertex of layer `taken_layer`
     uint32_t taken_layer = 0;
+    // Copy of geometry[v].shift, kept in step by every function here that
+    // changes it (from_coarse_base, apply_patch, the plane records):
+    // insertion_shift reads it for every ring vertex, and this entry is
+    // already in cache from mark_taken_faces, while geometry[v] (28 bytes
+    // a vertex, scattered ids) cost a cache miss per ring vertex (~9 % of
+    // a decode).
+    uint8_t shift = 0;
   };
   std::vector<VertexEntry> vertices;
   uint32_t order_head = kNone;
@@ -140,6 +147,14 @@ void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
 // O(faces * k).
 void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
                        const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out);
+
+// The decoder's shortcut: the same as rank_patch_starts(...)[rank], or
+// kNone when there are not more than `rank` candidates. Rank 0 (the common
+// case) is one pass over the candidates instead of a sort. `scratch_starts`
+// is working space kept by the caller (no allocation per call).
+uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                            const std::vector<uint8_t>& used, uint32_t k, uint32_t rank,
+                            std::vector<uint32_t>& scratch_starts);
 
 // The decoder's prediction of a vertex inserted into `ring`: the rounded
 // average of the ring's positions. Exact integers.
