@@ -16,21 +16,25 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
   if (!applied) return applied;
   if (*applied == 0) return applied;
   for (const RecordDelta& d : decoder_.last_deltas()) {
-    if (d.full_rebuild) {
+    // A plane record's delta sets full_rebuild for consumers that predate
+    // moved_vertices; with no vertex added and no face touched it is a
+    // position update of exactly the moved vertices (decoder.h).
+    const bool moves_only = !d.moved_vertices.empty() && d.added_vertices.empty() && d.touched_faces.empty();
+    if (d.full_rebuild && !moves_only) {
+      pending_.clear();
       pending_.full = true;
-      pending_.vertices.clear();
-      pending_.faces.clear();
     } else if (!pending_.full) {
       pending_.vertices.insert(pending_.vertices.end(), d.added_vertices.begin(), d.added_vertices.end());
       pending_.faces.insert(pending_.faces.end(), d.touched_faces.begin(), d.touched_faces.end());
+      pending_.moved.insert(pending_.moved.end(), d.moved_vertices.begin(), d.moved_vertices.end());
     }
   }
   // Past one entry per face, copying the whole mesh is cheaper than the
   // list (and the list would grow without bound behind a slow pipeline).
-  if (!pending_.full && pending_.faces.size() + pending_.vertices.size() > decoder_.mesh().triangles.size()) {
+  if (!pending_.full && pending_.faces.size() + pending_.vertices.size() + pending_.moved.size() >
+                            decoder_.mesh().triangles.size()) {
+    pending_.clear();
     pending_.full = true;
-    pending_.vertices.clear();
-    pending_.faces.clear();
   }
   pending_updates_ += *applied;
   pending_decode_ms_ += ms;
@@ -123,15 +127,16 @@ TakenUpdate DecodedStream::take(Mesh& mirror, MeshChanges& changes) {
       mirror.positions.resize(m.positions.size());
       mirror.triangles.resize(m.triangles.size());
       for (uint32_t v : pending_.vertices) mirror.positions[v] = m.positions[v];
+      for (uint32_t v : pending_.moved) mirror.positions[v] = m.positions[v];
       for (uint32_t f : pending_.faces) mirror.triangles[f] = m.triangles[f];
     }
     if (pending_.full) {
+      changes.clear();
       changes.full = true;
-      changes.vertices.clear();
-      changes.faces.clear();
     } else if (!changes.full) {
       changes.vertices.insert(changes.vertices.end(), pending_.vertices.begin(), pending_.vertices.end());
       changes.faces.insert(changes.faces.end(), pending_.faces.begin(), pending_.faces.end());
+      changes.moved.insert(changes.moved.end(), pending_.moved.begin(), pending_.moved.end());
     }
     pending_.clear();
     u.records_decoded = decoder_.records_decoded();

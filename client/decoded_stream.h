@@ -26,10 +26,15 @@ struct MeshChanges {
   bool full = false;                  // everything (the base mesh arrived)
   std::vector<uint32_t> vertices;     // added vertices (may repeat)
   std::vector<uint32_t> faces;        // faces created or rewritten (may repeat)
+  // Existing vertices that only moved (plane records, RecordDelta::
+  // moved_vertices; may repeat): their positions changed, no face changed
+  // its corners, so the faces around them changed shape only.
+  std::vector<uint32_t> moved;
   void clear() {
     full = false;
     vertices.clear();
     faces.clear();
+    moved.clear();
   }
 };
 

@@ -28,6 +28,7 @@ struct DisplayBuilder::State {
   float dirty_fraction = 0.25f;
   double full_ms_per_face = 0;  // measured on the last full run
   std::vector<uint8_t> seen;    // scratch: changed faces counted once
+  std::vector<uint8_t> moved;   // scratch: per vertex, moved by this update
 };
 
 DisplayBuilder::DisplayBuilder() : state_(std::make_unique<State>()) {}
@@ -39,7 +40,8 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
                                           const MeshChanges& changes, bool asa_enabled,
                                           const AsaOptions& options, bool options_changed,
                                           BuildReport& report) {
-  (void)changes;  // the incremental subdivider finds the changes itself, by index
+  // The incremental subdivider finds the changes itself, by index; `changes`
+  // only steers the auto path's choice below.
   report = {};
   State& s = *state_;
   if (!asa_enabled || options.levels == 0) {
@@ -62,6 +64,23 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
       if (f < F && !s.seen[f]) {
         s.seen[f] = 1;
         ++unique;
+      }
+    }
+    if (!changes.moved.empty()) {
+      // Moved vertices (plane records) change the shape of every face
+      // around them. Plane records cover vertex index ranges, which are
+      // spread over the whole surface, so this is often most of the mesh.
+      const uint32_t V = mesh.vertex_count();
+      s.moved.assign(V, 0);
+      for (uint32_t v : changes.moved) {
+        if (v < V) s.moved[v] = 1;
+      }
+      for (uint32_t f = 0; f < F; ++f) {
+        const Triangle& t = mesh.triangles[f];
+        if (!s.seen[f] && (s.moved[t[0]] | s.moved[t[1]] | s.moved[t[2]])) {
+          s.seen[f] = 1;
+          ++unique;
+        }
       }
     }
     // The dirty region is the changed faces widened by a few rings: several
