@@ -193,6 +193,20 @@ TEST(PlaneRecordUpdate, DISABLED_MeasurePlaneRecordTime) {
                  {"ASA incremental", true, AsaPath::kIncremental}};
   std::printf("demo %u faces, %zu bytes, %d runs: median ms per record (pipeline side)\n", faces,
               stream.size(), runs);
+  {
+    // For scale: what the viewer does per uploaded mesh on its render thread
+    // (area-weighted normals of the whole mesh, MeshRenderer::upload).
+    auto whole = decode_hcs(stream);
+    ASSERT_TRUE(whole);
+    std::vector<double> ms;
+    for (int run = 0; run < std::max(runs, 3); ++run) {
+      const auto start = Clock::now();
+      const auto normals = compute_vertex_normals(*whole);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+      ASSERT_EQ(normals.size(), whole->positions.size());
+    }
+    std::printf("  normals of the whole decoded mesh (%u vertices): %.4f ms\n", whole->vertex_count(), median(ms));
+  }
   for (const Config& c : configs) {
     std::vector<double> plane, insert, decode;
     ReplayTimes t;
