@@ -117,6 +117,7 @@ struct IncrementalDecoder::State {
       const uint32_t nf = static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
       refine->mesh.reserve(nv, nf);
       refine->vertices.reserve(nv);
+      refine->vertex_layer.reserve(nv);
       mesh = Mesh{};
       mesh.positions.reserve(nv);
       mesh.triangles.reserve(nf);

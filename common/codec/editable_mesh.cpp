@@ -169,20 +169,22 @@ uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
   opposite_.resize(3 * (first_new + appended), kNone);
   if (!dead_.empty()) dead_.resize(first_new + appended, 0);
 
+  // Ring indices wrap with compares, not `% k`: a division by a variable
+  // costs tens of cycles, and this loop runs for every inserted vertex.
   for (uint32_t i = 0; i < k; ++i) {
     if (i == open) continue;
     const uint32_t f = slot[i];
-    set_face(f, {v, ring[i], ring[(i + 1) % k]});
+    const uint32_t after = i + 1 == k ? 0 : i + 1, before = i == 0 ? k - 1 : i - 1;
+    set_face(f, {v, ring[i], ring[after]});
     const uint32_t b = 3 * f;
     set_opposite(b, o[i]);
     if (o[i] != kNone) set_opposite(o[i], b);
-    const uint32_t after = (i + 1) % k, before = (i + k - 1) % k;
     set_opposite(b + 1, after == open ? kNone : 3 * slot[after] + 2);
     set_opposite(b + 2, before == open ? kNone : 3 * slot[before] + 1);
     if (touched) touched->push_back(f);
   }
   // The new vertex starts at the face after its open edge (any face if interior).
-  vertex_corner_[v] = open == kNone ? 3 * slot[0] : 3 * slot[(open + 1) % k];
+  vertex_corner_[v] = open == kNone ? 3 * slot[0] : 3 * slot[open + 1 == k ? 0 : open + 1];
   uint32_t fan_face[kMaxPatchValence];
   for (uint32_t j = 0; j + 2 < k; ++j) fan_face[j] = face_of(fan_corners[j]);
   auto in_fan = [&](uint32_t c) {
@@ -196,7 +198,7 @@ uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
     const uint32_t u = ring[i];
     if (i == open) {
       // Its outgoing boundary edge is now (R_i, v), in S_i-1 at corner 2.
-      set_vertex_corner(u, 3 * slot[(i + k - 1) % k] + 2);
+      set_vertex_corner(u, 3 * slot[i == 0 ? k - 1 : i - 1] + 2);
     } else if (o[i] == kNone || in_fan(vertex_corner_[u])) {
       set_vertex_corner(u, 3 * slot[i] + 1);
     }

@@ -35,6 +35,7 @@ Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
   RefinementState s;
   s.mesh = std::move(*mesh);
   s.vertices.resize(n);
+  s.vertex_layer.assign(n, 0);
   for (uint32_t v = 0; v < n; ++v) s.vertices[v].next = v + 1 < n ? v + 1 : kNone;
   s.order_head = n > 0 ? 0 : kNone;
   std::vector<uint32_t> ring, corners;
@@ -85,12 +86,15 @@ bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<ui
   out.ring.resize(k);
   out.fan_corners.resize(fan);
   out.ring[0] = apex;
+  // r < faces and fan <= faces, so one subtraction wraps (no division).
+  uint32_t i = r;
   for (uint32_t j = 0; j < fan; ++j) {
-    const uint32_t i = (r + j) % faces;
     out.fan_corners[j] = star_corners[i];
     out.ring[j + 1] = star_ring[i];
+    if (++i == faces) i = 0;
   }
-  out.ring[k - 1] = star_ring[(r + fan) % star_ring.size()];
+  const size_t last = r + fan;
+  out.ring[k - 1] = star_ring[last < star_ring.size() ? last : last - star_ring.size()];
   return true;
 }
 
@@ -192,11 +196,12 @@ uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>&
   if (faces == 0) return 0;
   const size_t n = star_ring.size();
   // Face i joins ring entries i and i+1 (the last wraps to 0 when interior).
-  const bool first_new = s.vertices[star_ring[0]].layer == s.layer;
+  const uint32_t* layer = s.vertex_layer.data();
+  const bool first_new = layer[star_ring[0]] == s.layer;
   bool prev_new = first_new;
   uint32_t free_faces = 0;
   for (uint32_t i = 0; i < faces; ++i) {
-    const bool next_new = i + 1 < n ? s.vertices[star_ring[i + 1]].layer == s.layer : first_new;
+    const bool next_new = i + 1 < n ? layer[star_ring[i + 1]] == s.layer : first_new;
     const bool taken = prev_new || next_new;
     used[i] = taken ? 1 : 0;
     free_faces += taken ? 0 : 1;
@@ -349,6 +354,7 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
   const uint32_t apex = patch.ring[0];
   const uint32_t k = static_cast<uint32_t>(patch.ring.size());
   state.vertices.push_back({state.vertices[apex].next, state.layer, k});
+  state.vertex_layer.push_back(state.layer);
   state.vertices[apex].next = v;
   // Valences: the apex trades its k-3 diagonals for v, R_1 and R_k-1 gain v,
   // and the ends of a re-opened boundary edge lose each other.
@@ -360,14 +366,15 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
       e.taken_layer = state.layer;
       e.taken = 0;
     }
-    e.taken += (i != open ? 1u : 0u) + ((i + k - 1) % k != open ? 1u : 0u);
+    const uint32_t before = i == 0 ? k - 1 : i - 1;  // no division: this runs per ring vertex
+    e.taken += (i != open ? 1u : 0u) + (before != open ? 1u : 0u);
   }
   state.vertices[apex].valence = state.vertices[apex].valence + 4 - k;
   state.vertices[patch.ring[1]].valence += 1;
   state.vertices[patch.ring[k - 1]].valence += 1;
   if (open != kNone) {
     state.vertices[patch.ring[open]].valence -= 1;
-    state.vertices[patch.ring[(open + 1) % k]].valence -= 1;
+    state.vertices[patch.ring[open + 1 == k ? 0 : open + 1]].valence -= 1;
   }
   return v;
 }
@@ -526,6 +533,18 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
     const uint32_t u = state.cursor;
     state.cursor = state.vertices[u].next;
+    // The order list jumps around memory: start loading what the next two
+    // walk vertices need while this one is decoded (the entry and start
+    // corner of the one after next, the first star face of the next, whose
+    // entry and corner were asked for one step ago).
+    if (state.cursor != kNone) {
+      const uint32_t after = state.vertices[state.cursor].next;
+      if (after != kNone) {
+        __builtin_prefetch(&state.vertices[after]);
+        mesh.prefetch_vertex(after);
+      }
+      mesh.prefetch_first_face(state.cursor);
+    }
     const uint32_t free_faces = free_face_count(state, u);
     uint32_t count = 0;
     if (free_faces > 0) {
@@ -535,6 +554,13 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     state.last_count = count;
     if (count == 0) continue;
     mesh.star(u, star_ring, star_corners);
+    // Positions (patch scores), start corners (insert_vertex) and entries
+    // (apply_patch) of the ring are read after some bits are decoded: ask
+    // for them now.
+    for (uint32_t r : star_ring) {
+      mesh.prefetch_vertex(r);
+      __builtin_prefetch(&state.vertices[r]);
+    }
     const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
     const uint32_t faces = static_cast<uint32_t>(star_corners.size());
     if (mark_taken_faces(state, star_ring, faces, used_faces) != free_faces) {
@@ -562,7 +588,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
         return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " does not fit");
       }
-      for (uint32_t j = 0; j + 2 < k; ++j) used_faces[(r + j) % faces] = 1;
+      for (uint32_t j = 0, f = r; j + 2 < k; ++j, f = f + 1 == faces ? 0 : f + 1) used_faces[f] = 1;
       opens[i] = kNone;
       patch_boundary_edges(mesh, patches[i], open_edges);
       if (!open_edges.empty()) {
