@@ -30,7 +30,20 @@ struct EncodeOptions {
   // automatic (quant_bits - 10: a 10-bit base measured best between 0 and
   // 6 on the bunny, fandisk, casting and skull). Embedded only.
   int base_shift = -1;
+  // How much the record ordering's distortion proxy values plane records
+  // against structure records (encoder.cpp). 0 = automatic: the streams of
+  // kPlaneCalibrations are decoded at log-spaced budgets and the one with
+  // the smallest measured surface distance to the original wins
+  // (rd_measure.h; about 3 extra encodes and 30 distance measurements).
+  // Embedded only.
+  double plane_calibration = 0;
+  // Low residual bits of inserted vertices left to plane records (at least;
+  // a vertex is never sharper than its ring). Embedded only.
+  int insertion_shift = 0;
 };
+
+// The balances the automatic choice tries (see EncodeOptions).
+inline constexpr double kPlaneCalibrations[] = {1.0, 3.0, 10.0};
 
 // Ids written in the stream header (`structure_coder`, `geometry_coder`).
 inline constexpr uint8_t kStructureCoderRange = 1;  // adaptive binary range coder
@@ -42,7 +55,7 @@ inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 3;  // 3: container 2 index, embedded records
+inline constexpr uint32_t kEncoderVersion = 4;  // 3: container 2 index, embedded records; 4: measured plane calibration
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {

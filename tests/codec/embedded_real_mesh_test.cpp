@@ -1,7 +1,7 @@
 // Issue II on real meshes (skipped when ../shared/meshes is absent): the
 // distance to the original along the record boundaries, the granularity
 // bounds, the encoder's model at every prefix and the decoder controls.
-// A sensible subset (small meshes for the distances) keeps the suite fast.
+// The distances run on every real model; the other checks on a subset (time).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +9,9 @@
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/import.h"
-#include "common/metrics/distance.h"
+#include "common/metrics/bvh.h"
+#include "common/metrics/surface_quadrature.h"
+#include "common/metrics/surface_sampling.h"
 #include "tests/test_meshes.h"
 
 namespace meshstream {
@@ -43,24 +45,42 @@ uint64_t end_of(const StreamIndex& index, size_t i) { return index.records[i].of
 class EmbeddedRealMesh : public ::testing::TestWithParam<const char*> {};
 class EmbeddedRealMeshDistance : public ::testing::TestWithParam<const char*> {};
 
-// Distance to the original (symmetric RMS, 8000 area samples a side) after
-// every record. A plane record only sharpens positions: it may not raise the
-// RMS by more than 3 % (sampling noise: a vertex moving closer can still
-// move a sampled point's nearest surface away). A structure record may raise
-// it a little more: the layered decimation's intermediate triangulations are
-// not nested, and on CAD creases a re-inserted vertex's new triangles can sit
-// farther from some original points than the fan they replace; issue I's
-// ordering (all positions exact) shows the same rises, up to 24 % on
-// fandisk, so the bound is 25 % over the best RMS seen so far.
+// Distance to the original after every record, on every real model: the
+// symmetric RMS, with fixed area samples on the original and fixed
+// per-triangle quadrature points on the decoded prefix
+// (surface_quadrature.h). Plain area sampling of the prefix moves every
+// sample when one triangle changes; on CAD parts its RMS then jumps by
+// 10-20 % between records that barely differ (crank.off, 8000 samples),
+// which would hide or fake rises. With the quadrature a record's effect is
+// measured, not the sampler's.
+//
+// A plane record only sharpens positions: at most 2 % above the previous
+// RMS (a plane step can move a vertex whose true position was near the old
+// interval's middle a little away; mask.off: +1.15 % once). A structure record may raise it more:
+// the layered decimation's intermediate meshes are not nested, and on CAD
+// creases a restored vertex's star can leave part of the original farther
+// away than the fan it replaces (fandisk.off: +7.7 % over the best so far;
+// every other model <= 0.2 %). Bound: 10 % over the best RMS seen so far.
+// The worst rises are printed.
 TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
   MESHSTREAM_REQUIRE_TEST_MESHES();
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  if (std::string(GetParam()) != "fandisk.off" && std::string(GetParam()) != "casting.off") {
+    GTEST_SKIP() << "sanitizer build: distances after every record on the two small CAD parts only (time)";
+  }
+#endif
   const Encoded e = encode_real(GetParam());
   ASSERT_FALSE(e.bytes.empty());
-  DistanceOptions options;
-  options.samples = 8000;
-  options.threads = 1;
-  auto original = PreparedSurface::prepare(e.mesh, options);
-  ASSERT_TRUE(original);
+  auto reference = quantized_reference(e.mesh, 12);
+  ASSERT_TRUE(reference);
+  const uint32_t kSamples = 8000;
+  const SurfaceSamples area = sample_surface(*reference, kSamples, 1);
+  WeightedSamples original;
+  original.points.assign(area.points.begin(), area.points.begin() + area.area_count);
+  original.weights.assign(area.area_count, 1.0);
+  const double cell_area = area.area / kSamples;
+  const TriangleBvh original_bvh = TriangleBvh::build(*reference);
+  const double diagonal = bounding_box(*reference).diagonal();
   IncrementalDecoder dec;
   uint64_t fed = 0;
   double previous = 0, best = 0, worst_plane = 0, worst_structure = 0;
@@ -68,24 +88,26 @@ TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
     const uint64_t end = end_of(e.index, i);
     ASSERT_TRUE(dec.feed(std::span<const uint8_t>(e.bytes.data() + fed, end - fed)));
     fed = end;
-    auto shown = PreparedSurface::prepare(dec.mesh(), options);
-    ASSERT_TRUE(shown);
-    const double rms = surface_distance(*original, *shown).relative_rms();
+    const TriangleBvh shown = TriangleBvh::build(dec.mesh());
+    const double rms = std::max(weighted_rms_distance(original, shown),
+                                weighted_rms_distance(quadrature_samples(dec.mesh(), cell_area), original_bvh)) /
+                       diagonal;
     if (i > 0) {
       const bool plane = e.report.records[i].plane;
-      const double rise = rms / previous - 1;
-      (plane ? worst_plane : worst_structure) = std::max(plane ? worst_plane : worst_structure, rise);
       if (plane) {
-        EXPECT_LE(rms, previous * 1.03 + 1e-7) << "plane record " << i << " of " << e.index.records.size();
+        worst_plane = std::max(worst_plane, rms / previous - 1);
+        EXPECT_LE(rms, previous * 1.02 + 1e-9) << "plane record " << i << " of " << e.index.records.size();
+      } else {
+        worst_structure = std::max(worst_structure, rms / best - 1);
       }
-      EXPECT_LE(rms, best * 1.25 + 1e-7) << "record " << i << " of " << e.index.records.size();
+      EXPECT_LE(rms, best * 1.10 + 1e-9) << "record " << i << " of " << e.index.records.size();
     }
     previous = rms;
     best = i == 0 ? rms : std::min(best, rms);
   }
-  EXPECT_LT(previous, 1e-4);
-  std::printf("%s: %zu records, worst RMS rise: plane records %.1f %%, structure records %.1f %%\n", GetParam(),
-              e.index.records.size(), 100 * worst_plane, 100 * worst_structure);
+  EXPECT_LT(previous, 1e-5);  // the full stream: the quantized original itself
+  std::printf("%s: %zu records, worst RMS rise: plane records %.2f %% over the previous, structure records %.2f %% over the best so far\n",
+              GetParam(), e.index.records.size(), 100 * worst_plane, 100 * worst_structure);
 }
 
 // At least min(n / 50, 200) record boundaries and no refinement record above
@@ -166,9 +188,12 @@ std::string test_name(const ::testing::TestParamInfo<const char*>& info) {
 
 INSTANTIATE_TEST_SUITE_P(Shared, EmbeddedRealMesh,
                          ::testing::Values("fandisk.off", "casting.off", "hemisphere.off", "bunny.off"), test_name);
-// Distances after every record: the small meshes only (time).
+// Distances after every record: every real model of the manifest.
 INSTANTIATE_TEST_SUITE_P(Shared, EmbeddedRealMeshDistance,
-                         ::testing::Values("fandisk.off", "casting.off", "hemisphere.off"), test_name);
+                         ::testing::Values("bun_zipper.ply", "bunny.off", "bunny.stl", "armadillo.obj", "fandisk.off",
+                                           "crank.off", "casting.off", "mask.off", "hemisphere.off", "skull.obj",
+                                           "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"),
+                         test_name);
 
 }  // namespace
 }  // namespace meshstream

@@ -1,0 +1,64 @@
+#include "common/codec/rd_measure.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/codec/container.h"
+#include "common/codec/decoder.h"
+
+namespace meshstream {
+
+Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOptions& options) {
+  if (original.triangles.empty()) return make_error(ErrorCode::kInvalidArgument, "rate-distortion measure: mesh has no triangles");
+  RdMeasure m;
+  m.options_ = options;
+  const SurfaceSamples area = sample_surface(original, std::max<uint32_t>(options.samples, 1), 1);
+  m.cell_area_ = area.area / std::max<uint32_t>(options.samples, 1);
+  // The original never changes, so fixed area samples serve (and cost less
+  // than a point per triangle of a large original).
+  m.original_samples_.points.assign(area.points.begin(), area.points.begin() + area.area_count);
+  m.original_samples_.weights.assign(area.area_count, area.area / std::max<uint32_t>(area.area_count, 1));
+  m.original_samples_.area = area.area;
+  m.original_bvh_ = TriangleBvh::build(original);
+  m.diagonal_ = bounding_box(original).diagonal();
+  return m;
+}
+
+Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream, uint64_t reference_bytes) const {
+  auto index = read_stream_index(stream);
+  if (!index) return tl::unexpected(index.error());
+  std::vector<RdPoint> points;
+  const uint32_t n = std::max<uint32_t>(options_.budgets, 1);
+  const double lo = std::log(options_.first_fraction * double(reference_bytes));
+  const double hi = std::log(options_.last_fraction * double(reference_bytes));
+  IncrementalDecoder decoder;
+  uint64_t fed = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    RdPoint p;
+    p.budget = static_cast<uint64_t>(std::exp(n == 1 ? hi : lo + (hi - lo) * i / (n - 1)));
+    p.bytes = prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, double(p.budget)});
+    if (p.bytes > fed) {
+      auto applied = decoder.feed(stream.subspan(fed, p.bytes - fed));
+      if (!applied) return tl::unexpected(applied.error());
+      fed = p.bytes;
+    }
+    const Mesh& shown = decoder.mesh();
+    p.vertices = shown.vertex_count();
+    if (shown.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "rate-distortion measure: decoded prefix has no triangles");
+    const TriangleBvh shown_bvh = TriangleBvh::build(shown);
+    const double to_shown = weighted_rms_distance(original_samples_, shown_bvh);
+    const double to_original = weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_);
+    p.relative_rms = diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;
+    points.push_back(p);
+  }
+  return points;
+}
+
+double RdMeasure::score(const std::vector<RdPoint>& points) {
+  if (points.empty()) return 0;
+  double sum = 0;
+  for (const RdPoint& p : points) sum += std::log(std::max(p.relative_rms, 1e-9));
+  return sum / double(points.size());
+}
+
+}  // namespace meshstream

@@ -1,0 +1,76 @@
+// The encoder's measured rate-distortion choice (rd_measure.h): the
+// automatic stream is the best of the candidate balances by the measure, and
+// the measure itself ranks streams the way their distances do.
+#include "common/codec/rd_measure.h"
+
+#include <gtest/gtest.h>
+
+#include "common/codec/encoder.h"
+#include "common/mesh/procedural.h"
+
+namespace meshstream {
+namespace {
+
+TEST(RdMeasure, AutomaticBalanceIsTheBestMeasuredCandidate) {
+  const Mesh mesh = make_demo_mesh(12000);
+  auto reference = quantized_reference(mesh, 12);
+  ASSERT_TRUE(reference);
+  auto measure = RdMeasure::prepare(*reference);
+  ASSERT_TRUE(measure);
+  EncodeOptions automatic;
+  auto chosen = encode_hcs(mesh, automatic);
+  ASSERT_TRUE(chosen);
+  // Budgets relative to the default balance's stream, as the encoder does.
+  EncodeOptions first;
+  first.plane_calibration = kPlaneCalibrations[1];
+  auto default_stream = encode_hcs(mesh, first);
+  ASSERT_TRUE(default_stream);
+  const uint64_t reference_bytes = default_stream->size();
+  auto chosen_curve = measure->curve(*chosen, reference_bytes);
+  ASSERT_TRUE(chosen_curve);
+  const double chosen_score = RdMeasure::score(*chosen_curve);
+  bool equals_a_candidate = false;
+  for (double calibration : kPlaneCalibrations) {
+    EncodeOptions fixed;
+    fixed.plane_calibration = calibration;
+    auto stream = encode_hcs(mesh, fixed);
+    ASSERT_TRUE(stream);
+    auto curve = measure->curve(*stream, reference_bytes);
+    ASSERT_TRUE(curve);
+    EXPECT_LE(chosen_score, RdMeasure::score(*curve) + 1e-12) << "calibration " << calibration;
+    equals_a_candidate = equals_a_candidate || *stream == *chosen;
+  }
+  EXPECT_TRUE(equals_a_candidate);
+}
+
+// More of the stream is closer: the measured RMS falls along the budgets,
+// and the prefixes grow.
+TEST(RdMeasure, CurveFallsAsTheBudgetGrows) {
+  const Mesh mesh = make_demo_mesh(12000);
+  auto reference = quantized_reference(mesh, 12);
+  ASSERT_TRUE(reference);
+  auto measure = RdMeasure::prepare(*reference);
+  ASSERT_TRUE(measure);
+  auto stream = encode_hcs(mesh, EncodeOptions{});
+  ASSERT_TRUE(stream);
+  auto curve = measure->curve(*stream, stream->size());
+  ASSERT_TRUE(curve);
+  ASSERT_EQ(curve->size(), RdMeasureOptions{}.budgets);
+  for (size_t i = 1; i < curve->size(); ++i) {
+    EXPECT_GE((*curve)[i].bytes, (*curve)[i - 1].bytes);
+    EXPECT_GE((*curve)[i].vertices, (*curve)[i - 1].vertices);
+    EXPECT_LE((*curve)[i].relative_rms, (*curve)[i - 1].relative_rms * 1.02) << "budget " << i;
+  }
+  EXPECT_LT(curve->back().relative_rms, curve->front().relative_rms);
+}
+
+TEST(RdMeasure, GarbageStreamIsAnError) {
+  auto measure = RdMeasure::prepare(make_icosphere(2));
+  ASSERT_TRUE(measure);
+  const std::vector<uint8_t> garbage(100, 0x5A);
+  EXPECT_FALSE(measure->curve(garbage, garbage.size()));
+  EXPECT_FALSE(RdMeasure::prepare(Mesh{}));
+}
+
+}  // namespace
+}  // namespace meshstream
