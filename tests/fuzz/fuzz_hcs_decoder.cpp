@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "common/codec/container.h"
-#include "common/codec/crc32.h"
+#include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
 #include "common/mesh/mesh.h"
 
@@ -33,35 +33,6 @@ void check(bool ok) {
   if (!ok) __builtin_trap();  // a broken invariant is a finding, like a crash
 }
 
-uint32_t get_u32(const std::vector<uint8_t>& s, size_t at) {
-  return uint32_t(s[at]) | uint32_t(s[at + 1]) << 8 | uint32_t(s[at + 2]) << 16 | uint32_t(s[at + 3]) << 24;
-}
-void put_u32(std::vector<uint8_t>& s, size_t at, uint32_t v) {
-  for (int i = 0; i < 4; ++i) s[at + i] = static_cast<uint8_t>(v >> (8 * i));
-}
-
-// Makes every checksum of the layout in container.h match the bytes, as far
-// as the bytes hold them.
-void fix_checksums(std::vector<uint8_t>& s) {
-  using meshstream::crc32;
-  if (s.size() < 12) return;
-  const size_t header_size = get_u32(s, 8);
-  if (header_size > meshstream::kMaxHeaderBytes || 12 + header_size + 8 > s.size()) return;
-  put_u32(s, 12 + header_size, crc32(0, s.data() + 12, header_size));
-  const size_t count_at = 12 + header_size + 4;
-  const size_t count = get_u32(s, count_at);
-  const size_t index_end = count_at + 4 + count * 24;
-  if (count == 0 || count > (1u << 16) || index_end + 4 > s.size()) return;
-  for (size_t i = 0; i < count; ++i) {
-    const size_t e = count_at + 4 + i * 24;
-    const uint64_t offset = uint64_t(get_u32(s, e)) | uint64_t(get_u32(s, e + 4)) << 32;
-    const uint64_t size = get_u32(s, e + 8);
-    if (offset <= s.size() && size <= s.size() - offset) {
-      put_u32(s, e + 20, crc32(0, s.data() + offset, size));
-    }
-  }
-  put_u32(s, index_end, crc32(0, s.data() + count_at, index_end - count_at));
-}
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -69,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<uint8_t> fixed;
   if (size > 0 && (data[size - 1] & 1)) {  // the flag: checksums made valid
     fixed.assign(data, data + size - 1);
-    fix_checksums(fixed);
+    reseal_checksums(fixed);  // both container versions
     data = fixed.data();
     size = fixed.size();
   }
