@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     v.height = o.height;
     v.title = "meshstream - " + o.model;
     v.exit_after_frames = o.exit_after_frames;
+    v.exit_after_records = o.exit_after_records;
     return run_viewer(v, frames, controls);
   };
   hooks.snapshot = [](const meshstream::Mesh& mesh, const std::vector<meshstream::FaceKind>* kinds,

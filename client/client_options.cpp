@@ -55,6 +55,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("--height", o.height, "snapshot/window height")->check(CLI::Range(16, 16384))->capture_default_str();
   app.add_option("--snapshot-at", o.snapshot_at, "snapshot the display mesh after record N (0 = base mesh)");
   app.add_option("--exit-after", o.exit_after_frames, "close the window after N frames (tests)");
+  app.add_option("--exit-after-records", o.exit_after_records,
+                 "close the window once a frame with N decoded records is drawn (tests)");
   app.add_option("--max-chunk-bytes", o.max_chunk_bytes, "largest chunk to ask the server for");
   app.add_option("--reconnect-attempts", reconnect_attempts, "consecutive reconnects before giving up")
       ->check(CLI::Range(0, 1000))

@@ -3,7 +3,7 @@
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
 //     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
-//     [--exit-after N]
+//     [--exit-after N] [--exit-after-records N]
 #pragma once
 
 #include <cstdint>
@@ -34,6 +34,7 @@ struct ClientOptions {
   int height = 768;
   std::optional<uint32_t> snapshot_at;  // record index (0 = base mesh)
   uint64_t exit_after_frames = 0;
+  uint32_t exit_after_records = 0;
   uint32_t max_chunk_bytes = 0;
   ReconnectPolicy reconnect;
   bool quiet = false;         // no progress line

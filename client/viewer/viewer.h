@@ -19,6 +19,10 @@ struct ViewerOptions {
   // Close the window after this many frames (0: run until the user closes
   // it); for tests under Xvfb.
   uint64_t exit_after_frames = 0;
+  // Close the window once a frame with at least this many decoded records
+  // has been drawn (0: off); for tests that must close mid-stream whatever
+  // the display's frame rate.
+  uint32_t exit_after_records = 0;
   // When not empty: the last drawn frame (model only, no panel) is written
   // to this PNG as the window closes; for tests and scripted captures.
   std::string exit_screenshot;

@@ -326,8 +326,10 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
                                    std::max(panel.reference_diagonal, 1e-12f);
     gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
     renderer->draw(camera, fb_w, fb_h, style);
-    bool last_frame = options.exit_after_frames != 0 &&
-                      report.frames_drawn + 1 >= options.exit_after_frames;
+    bool last_frame = (options.exit_after_frames != 0 &&
+                       report.frames_drawn + 1 >= options.exit_after_frames) ||
+                      (options.exit_after_records != 0 && has_shown &&
+                       shown.records_decoded >= options.exit_after_records);
     if (panel.screenshot_requested && fb_w > 0 && fb_h > 0) {
       panel.screenshot_requested = false;
       std::string path = options.screenshot_dir + "/meshstream-screenshot-" +
