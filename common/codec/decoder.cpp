@@ -118,6 +118,7 @@ struct IncrementalDecoder::State {
       refine->mesh.reserve(nv, nf);
       refine->vertices.reserve(nv);
       refine->vertex_layer.reserve(nv);
+      refine->vertex_shift.reserve(nv);
       mesh = Mesh{};
       mesh.positions.reserve(nv);
       mesh.triangles.reserve(nf);
@@ -140,11 +141,19 @@ struct IncrementalDecoder::State {
         return where({ErrorCode::kCorrupt, "more layers than the header's " + std::to_string(h.layer_count)});
       }
       const auto& positions = refine->mesh.positions();
+      // QuantGrid::dequantize's arithmetic with its step computed once per
+      // record instead of per vertex (same doubles, same floats).
+      const double step = grid.step();
+      const Vec3f& lo = grid.bounds.min;
+      auto dequantize = [&](Vec3i q) {
+        return Vec3f{static_cast<float>(double(lo.x) + q.x * step), static_cast<float>(double(lo.y) + q.y * step),
+                     static_cast<float>(double(lo.z) + q.z * step)};
+      };
       for (uint32_t v : applied.added_vertices) {
         if (v >= mesh.positions.size()) mesh.positions.resize(v + 1);
-        mesh.positions[v] = grid.dequantize(positions[v]);
+        mesh.positions[v] = dequantize(positions[v]);
       }
-      for (uint32_t v : applied.moved_vertices) mesh.positions[v] = grid.dequantize(positions[v]);
+      for (uint32_t v : applied.moved_vertices) mesh.positions[v] = dequantize(positions[v]);
       mesh.triangles.resize(refine->mesh.face_slot_count());
       for (uint32_t f : applied.touched_faces) mesh.triangles[f] = refine->mesh.faces()[f];
       delta.added_vertices = std::move(applied.added_vertices);

@@ -103,6 +103,14 @@ class EditableMesh {
     __builtin_prefetch(&faces_[c / 3]);
   }
 
+  // The same for the face of corner c (its vertex and opposite entries).
+  void prefetch_corner(uint32_t c) const {
+    if (c < opposite_.size()) {
+      __builtin_prefetch(&opposite_[c]);
+      __builtin_prefetch(&faces_[c / 3]);
+    }
+  }
+
   // Moves vertex v (successive approximation: a plane record sharpened it).
   void set_position(uint32_t v, Vec3i p) { positions_[v] = p; }
 

@@ -36,6 +36,7 @@ Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
   s.mesh = std::move(*mesh);
   s.vertices.resize(n);
   s.vertex_layer.assign(n, 0);
+  s.vertex_shift.assign(n, 0);
   for (uint32_t v = 0; v < n; ++v) s.vertices[v].next = v + 1 < n ? v + 1 : kNone;
   s.order_head = n > 0 ? 0 : kNone;
   std::vector<uint32_t> ring, corners;
@@ -68,7 +69,7 @@ Result<RefinementState> RefinementState::from_coarse_base(const std::vector<Vec3
   auto s = from_base(std::move(positions), std::move(faces), quant_bits);
   if (!s) return s;
   s->geometry = std::move(geometry);
-  for (auto& e : s->vertices) e.shift = static_cast<uint8_t>(base_shift);
+  s->vertex_shift.assign(s->vertices.size(), static_cast<uint8_t>(base_shift));
   return s;
 }
 
@@ -186,7 +187,7 @@ bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const R
 
 int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift) {
   int shift = min_shift;
-  for (uint32_t u : ring) shift = std::max<int>(shift, s.vertices[u].shift);
+  for (uint32_t u : ring) shift = std::max<int>(shift, s.vertex_shift[u]);
   return shift;
 }
 
@@ -216,13 +217,13 @@ namespace {
 // heap for huge ones.
 struct StartScratch {
   static constexpr uint32_t kSmall = 64;
-  int64_t edge_small[kSmall], score_small[kSmall];
+  int64_t edge_small[2 * kSmall], score_small[kSmall];  // edge: wrapped copy after the end
   std::vector<int64_t> edge_big, score_big;
   int64_t* edge = edge_small;
   int64_t* score = score_small;
   explicit StartScratch(uint32_t faces) {
     if (faces > kSmall) {
-      edge_big.resize(faces);
+      edge_big.resize(2 * size_t(faces));
       score_big.resize(faces);
       edge = edge_big.data();
       score = score_big.data();
@@ -258,22 +259,27 @@ void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vect
     }
   } else {
     // Squared apex edge lengths, then a sliding sum over the k-3 diagonals
-    // of each run (ring entries r+1 .. r+k-3).
+    // of each run (ring entries r+1 .. r+k-3). Indices past the last face
+    // wrap to the start: `edge` holds the first `fan` lengths again after
+    // the last (room for 2 * faces), and `used` is read through a wrapped
+    // index only at the run's far end.
     for (uint32_t i = 0; i < faces; ++i) edge[i] = l2(apex, star_ring[i]);
-    auto wrap = [faces](uint32_t i) { return i >= faces ? i - faces : i; };
+    for (uint32_t i = 0; i < fan; ++i) edge[faces + i] = edge[i];
     int64_t window = 0;
-    for (uint32_t j = 1; j < fan; ++j) window += edge[wrap(j)];
+    for (uint32_t j = 1; j < fan; ++j) window += edge[j];
     uint32_t used_in_run = 0;
-    for (uint32_t j = 0; j < fan; ++j) used_in_run += used[wrap(j)];
+    for (uint32_t j = 0; j < fan; ++j) used_in_run += used[j];
+    uint32_t far = fan < faces ? fan : 0;  // (r + fan) wrapped, maintained without division
     for (uint32_t r = 0; r <= last_start; ++r) {
       if (used_in_run == 0) {
         score[out.size()] = window;
         out.push_back(r);
       }
       // Slide the run one face on: drop face r and diagonal r+1, add the next.
-      window += edge[wrap(r + fan)] - edge[wrap(r + 1)];
-      used_in_run += used[wrap(r + fan)];
+      window += edge[r + fan] - edge[r + 1];
+      used_in_run += used[far];
       used_in_run -= used[r];
+      if (++far == faces) far = 0;
     }
   }
 }
@@ -355,6 +361,7 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
   const uint32_t k = static_cast<uint32_t>(patch.ring.size());
   state.vertices.push_back({state.vertices[apex].next, state.layer, k});
   state.vertex_layer.push_back(state.layer);
+  state.vertex_shift.push_back(0);  // the geometry overload sets it
   state.vertices[apex].next = v;
   // Valences: the apex trades its k-3 diagonals for v, R_1 and R_k-1 gain v,
   // and the ends of a re-opened boundary edge lose each other.
@@ -383,7 +390,7 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
                      const VertexGeometry& geometry, std::vector<uint32_t>* touched) {
   state.geometry.push_back(geometry);
   const uint32_t v = apply_patch(state, patch, open, reconstruct(geometry, state.max_coordinate), touched);
-  state.vertices[v].shift = geometry.shift;
+  state.vertex_shift[v] = geometry.shift;
   return v;
 }
 
@@ -427,7 +434,7 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
     if (!plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate)) {
       return bad("plane record gives vertex " + std::to_string(v) + " a residual beyond the grid");
     }
-    state.vertices[v].shift = g.shift;
+    state.vertex_shift[v] = g.shift;
     if (g.shift == 0 && g.normal_axis != kBaseVertexAxis) {
       for (int a = 0; a < 3; ++a) {
         const int64_t value = int64_t(g.anchor[a]) + ((g.negative >> a) & 1 ? -int64_t(g.mag[a]) : int64_t(g.mag[a]));
@@ -460,7 +467,7 @@ std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, 
     if (g.shift == 0) continue;
     PlaneBitWriter io{enc, residuals[v]};
     plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate);
-    state.vertices[v].shift = g.shift;
+    state.vertex_shift[v] = g.shift;
     state.mesh.set_position(v, reconstruct(g, state.max_coordinate));
   }
   const std::vector<uint8_t> coded = enc.finish();
@@ -560,6 +567,14 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     for (uint32_t r : star_ring) {
       mesh.prefetch_vertex(r);
       __builtin_prefetch(&state.vertices[r]);
+    }
+    // So are the faces beyond the star's outer edges (insert_vertex links
+    // the new faces to them), which are also in the stars of the ring
+    // vertices the walk visits next. Their corners sit next to what star()
+    // just read, so asking costs no wait.
+    for (uint32_t c : star_corners) {
+      const uint32_t o = mesh.opposite(c);
+      if (o != kNone) mesh.prefetch_corner(o);
     }
     const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
     const uint32_t faces = static_cast<uint32_t>(star_corners.size());

@@ -60,20 +60,18 @@ struct RefinementState {
     uint32_t valence = 0;
     uint32_t taken = 0;        // faces holding a vertex of layer `taken_layer`
     uint32_t taken_layer = 0;
-    // Copy of geometry[v].shift, kept in step by every function here that
-    // changes it (from_coarse_base, apply_patch, the plane records):
-    // insertion_shift reads it for every ring vertex, and this entry is
-    // already in cache from mark_taken_faces, while geometry[v] (28 bytes
-    // a vertex, scattered ids) cost a cache miss per ring vertex (~9 % of
-    // a decode).
-    uint8_t shift = 0;
   };
   std::vector<VertexEntry> vertices;
-  // vertices[v].layer again, densely (4 bytes a vertex, small enough to
-  // stay in cache on meshes of 100k vertices, where `vertices` is not):
-  // mark_taken_faces reads it for every ring vertex of every apex.
-  // Appended by apply_patch, never changed.
+  // Dense copies of what the decoder reads for every ring vertex of every
+  // apex, small enough to stay in cache on meshes of 100k vertices where
+  // `vertices` (20 bytes a vertex) and `geometry` (28) are not: reading
+  // geometry[v].shift there cost ~9 % of a decode in cache misses.
+  // vertex_layer[v] == vertices[v].layer (appended by apply_patch, never
+  // changed; mark_taken_faces); vertex_shift[v] == geometry[v].shift, kept
+  // in step by every function here that changes it (from_coarse_base,
+  // apply_patch, the plane records; insertion_shift).
   std::vector<uint32_t> vertex_layer;
+  std::vector<uint8_t> vertex_shift;
   uint32_t order_head = kNone;
   uint32_t layer = 0;                   // layers started so far
   uint32_t cursor = kNone;              // next vertex of the walk
