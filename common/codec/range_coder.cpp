@@ -77,28 +77,6 @@ std::vector<uint8_t> RangeEncoder::finish() {
   return std::move(out_);
 }
 
-RangeDecoder::RangeDecoder(std::span<const uint8_t> in) : in_(in) {
-  for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
-}
-
-uint32_t RangeDecoder::decode_direct(int count) {
-  uint32_t value = 0;
-  for (int i = 0; i < count; ++i) {
-    range_ >>= 1;
-    uint32_t bit = 0;
-    if (code_ >= range_) {
-      code_ -= range_;
-      bit = 1;
-    }
-    value = (value << 1) | bit;
-    while (range_ < kTop) {
-      range_ <<= 8;
-      code_ = (code_ << 8) | next_byte();
-    }
-  }
-  return value;
-}
-
 void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
   const uint64_t v = uint64_t(value) + 1;  // >= 1, so it has a leading one
   int len = 0;
@@ -122,35 +100,12 @@ void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
   if (rest > 0) enc.encode_direct(static_cast<uint32_t>(v & ((uint64_t(1) << rest) - 1)), rest);
 }
 
-uint32_t AdaptiveUIntModel::decode(RangeDecoder& dec) {
-  uint32_t len = length.decode(dec);
-  if (len == 31) len += dec.decode_direct(1);
-  uint64_t v = 1;
-  int rest = static_cast<int>(len);
-  uint32_t ctx = 1;
-  for (int i = 0; i < 2 && rest > 0; ++i) {
-    --rest;
-    uint32_t bit = dec.decode_bit(high[len][ctx]);
-    v = (v << 1) | bit;
-    ctx = (ctx << 1 | bit) & 3u;
-  }
-  if (rest > 0) v = (v << rest) | dec.decode_direct(rest);
-  return static_cast<uint32_t>(v - 1);  // v <= 2^33 - 1 only if corrupt; wraps harmlessly
-}
-
 void AdaptiveIntModel::encode(RangeEncoder& enc, int32_t value) {
   enc.encode_bit(zero, value == 0 ? 0 : 1);
   if (value == 0) return;
   enc.encode_bit(sign, value < 0 ? 1 : 0);
   const uint32_t mag = value < 0 ? static_cast<uint32_t>(-int64_t(value)) : static_cast<uint32_t>(value);
   magnitude.encode(enc, mag - 1);
-}
-
-int64_t AdaptiveIntModel::decode(RangeDecoder& dec) {
-  if (dec.decode_bit(zero) == 0) return 0;
-  const bool negative = dec.decode_bit(sign) != 0;
-  const int64_t mag = int64_t(magnitude.decode(dec)) + 1;
-  return negative ? -mag : mag;
 }
 
 }  // namespace meshstream

@@ -43,11 +43,19 @@ class RangeEncoder {
   std::vector<uint8_t> out_;
 };
 
+// The decoder side is defined here, inline: a record's decoding loop can
+// then keep the coder's state in registers (range, code and input position
+// stored to memory and reloaded for every bit were a fifth of the cost of a
+// bit), which needs every use of the decoder inlined into it.
+#define MESHSTREAM_DECODE_INLINE [[gnu::always_inline]] inline
+
 class RangeDecoder {
  public:
-  explicit RangeDecoder(std::span<const uint8_t> in);
+  MESHSTREAM_DECODE_INLINE explicit RangeDecoder(std::span<const uint8_t> in) : in_(in) {
+    for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
+  }
   // Inline: it runs for every coded bit.
-  uint32_t decode_bit(BitModel& model) {
+  MESHSTREAM_DECODE_INLINE uint32_t decode_bit(BitModel& model) {
     const uint32_t bound = (range_ >> 11) * model.p;
     uint32_t bit;
     if (code_ < bound) {
@@ -66,7 +74,23 @@ class RangeDecoder {
     }
     return bit;
   }
-  uint32_t decode_direct(int count);
+  MESHSTREAM_DECODE_INLINE uint32_t decode_direct(int count) {
+    uint32_t value = 0;
+    for (int i = 0; i < count; ++i) {
+      range_ >>= 1;
+      uint32_t bit = 0;
+      if (code_ >= range_) {
+        code_ -= range_;
+        bit = 1;
+      }
+      value = (value << 1) | bit;
+      while (range_ < (1u << 24)) {
+        range_ <<= 8;
+        code_ = (code_ << 8) | next_byte();
+      }
+    }
+    return value;
+  }
   // Bytes requested past the end of the input. A correct stream needs at
   // most 8 of them: the decoder looks 4 bytes ahead and the encoder drops up
   // to 4 trailing zero bytes of its flush.
@@ -99,7 +123,7 @@ struct BitTreeModel {
       m = (m << 1) | bit;
     }
   }
-  uint32_t decode(RangeDecoder& dec) {
+  MESHSTREAM_DECODE_INLINE uint32_t decode(RangeDecoder& dec) {
     uint32_t m = 1;
     for (int i = 0; i < Bits; ++i) m = (m << 1) | dec.decode_bit(nodes[m]);
     return m - (1u << Bits);
@@ -113,7 +137,21 @@ struct AdaptiveUIntModel {
   BitTreeModel<5> length;
   BitModel high[33][4];
   void encode(RangeEncoder& enc, uint32_t value);
-  uint32_t decode(RangeDecoder& dec);
+  MESHSTREAM_DECODE_INLINE uint32_t decode(RangeDecoder& dec) {
+    uint32_t len = length.decode(dec);
+    if (len == 31) len += dec.decode_direct(1);
+    uint64_t v = 1;
+    int rest = static_cast<int>(len);
+    uint32_t ctx = 1;
+    for (int i = 0; i < 2 && rest > 0; ++i) {
+      --rest;
+      uint32_t bit = dec.decode_bit(high[len][ctx]);
+      v = (v << 1) | bit;
+      ctx = (ctx << 1 | bit) & 3u;
+    }
+    if (rest > 0) v = (v << rest) | dec.decode_direct(rest);
+    return static_cast<uint32_t>(v - 1);  // v <= 2^33 - 1 only if corrupt; wraps harmlessly
+  }
 };
 
 // Signed integers: zero flag, sign, then magnitude - 1 as above.
@@ -123,7 +161,12 @@ struct AdaptiveIntModel {
   AdaptiveUIntModel magnitude;
   void encode(RangeEncoder& enc, int32_t value);
   // Decodes a value; the caller range-checks it.
-  int64_t decode(RangeDecoder& dec);
+  MESHSTREAM_DECODE_INLINE int64_t decode(RangeDecoder& dec) {
+    if (dec.decode_bit(zero) == 0) return 0;
+    const bool negative = dec.decode_bit(sign) != 0;
+    const int64_t mag = int64_t(magnitude.decode(dec)) + 1;
+    return negative ? -mag : mag;
+  }
 };
 
 }  // namespace meshstream

@@ -162,8 +162,14 @@ void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const R
   }
 }
 
-bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
-                            Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out) {
+namespace {
+
+// The bodies of decode_coarse_residual and decode_start_rank, forced inline
+// into apply_refinement_record so its range decoder stays in registers
+// (see MESHSTREAM_DECODE_INLINE in range_coder.h).
+MESHSTREAM_DECODE_INLINE bool decode_residual_inline(RefinementModels& models, RangeDecoder& dec,
+                                                     const ResidualContext& ctx, Vec3i predicted, int shift,
+                                                     int32_t max_coordinate, VertexGeometry& out) {
   const int bucket = std::max(ctx.scale - shift, 0);
   out = VertexGeometry{};
   out.anchor = predicted;
@@ -183,6 +189,18 @@ bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const R
     if (q < 0) out.negative |= uint8_t(1u << a);
   }
   return true;
+}
+
+MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, RangeDecoder& dec, uint32_t k) {
+  const uint32_t rank = m.start_rank[std::min(k - 3, 5u)].decode(dec);
+  return rank < 15 ? rank : 15 + m.start_rank_big.decode(dec);
+}
+
+}  // namespace
+
+bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
+                            Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out) {
+  return decode_residual_inline(models, dec, ctx, predicted, shift, max_coordinate, out);
 }
 
 int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift) {
@@ -350,8 +368,7 @@ void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint3
 }
 
 uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k) {
-  const uint32_t rank = m.start_rank[std::min(k - 3, 5u)].decode(dec);
-  return rank < 15 ? rank : 15 + m.start_rank_big.decode(dec);
+  return decode_start_rank_inline(m, dec, k);
 }
 
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
@@ -593,7 +610,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       // The rank depends only on k, so it is read first: the decoder then
       // needs only the start of that rank, most often the best one (a
       // linear scan), not the whole ordered list the encoder searches.
-      const uint32_t rank = decode_start_rank(m, dec, k);
+      const uint32_t rank = decode_start_rank_inline(m, dec, k);
       const uint32_t r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
       if (r == kNone) {
         return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
@@ -617,7 +634,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       const Vec3i pred = predict_position(mesh, patches[i].ring);
       const ResidualContext ctx = residual_context(mesh, patches[i].ring);
       const int shift = insertion_shift(state, patches[i].ring, static_cast<int>(h.min_shift));
-      if (!decode_coarse_residual(m, dec, ctx, pred, shift, state.max_coordinate, positions[i])) {
+      if (!decode_residual_inline(m, dec, ctx, pred, shift, state.max_coordinate, positions[i])) {
         return fail("vertex position outside the quantization grid at vertex " +
                                std::to_string(u));
       }
