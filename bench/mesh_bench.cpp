@@ -211,7 +211,7 @@ int main(int argc, char** argv) {
       << " interleaved rounds per figure (each round times every step once, so load bursts on "
          "the shared 2-core machine hit ours and the peers alike). *Import* = parse + "
          "clean (weld, degenerate/duplicate/unreferenced removal, non-manifold repair); *parse* = our "
-         "reader alone (OFF and PLY our own, OBJ/STL through Draco's io); *Draco* = "
+         "reader alone (OFF, PLY, OBJ and ASCII STL our own, binary STL through Draco's io); *Draco* = "
          "`draco::ReadMeshFromFile` on the same file (no cleaning; no OFF support). *Adjacency* = "
          "`Adjacency::build` (corner table) on the imported mesh; *OpenMesh* = building OpenMesh's "
          "half-edge `TriMesh` from the same arrays. Ratios > 1 mean ours is faster.\n\n";
