@@ -283,10 +283,12 @@ TEST(HostileStream, ResealMakesEveryChecksumMatch) {
       EXPECT_TRUE(record_intact(r, std::span<const uint8_t>(damaged.data() + r.offset, r.size)));
   }
   // A version-1 stream from issue I's encoder.
-  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/fuzz/corpus/hcs_decoder/grid8_own.hcs",
+  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/issue1_components3_own.hcs",
                    std::ios::binary);
   ASSERT_TRUE(in);
   std::vector<uint8_t> v1{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  ASSERT_GT(v1.size(), 6u);
+  ASSERT_EQ(v1[4] | v1[5] << 8, 1) << "container version 1";
   auto index = read_stream_index(v1);
   ASSERT_TRUE(index);
   v1[index->records.back().offset] ^= 0x01;
