@@ -77,7 +77,7 @@ inline void write_markdown(const std::filesystem::path& path,
      << "imports, cleaned by `import_mesh` (so Draco and ours code the very same mesh), "
      << "positions quantized to " << s.quant_bits << " bits by both. *Ours* is the default "
      << "`encode_hcs` stream (issue 5: successive-approximation bit planes, records ordered by "
-        "estimated distortion drop per byte, the estimate's plane weight chosen among 1, 3 and 10 "
+        "estimated distortion drop per byte, the estimate's plane weight chosen between 3 and 1 "
         "by the measured surface distance of decoded prefixes, `rd_measure.h`; the encode times "
         "include that measurement); *issue I order* is the same encoder with "
         "`EncodeOptions::embedded = false` (every position exact at insertion, no plane records, "

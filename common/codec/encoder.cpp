@@ -655,7 +655,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   const uint32_t n = mesh.vertex_count();
   const bool automatic = options.record_bytes == 0;
   const bool measured = options.embedded && options.plane_calibration <= 0;
-  const double first_calibration = measured ? kPlaneCalibrations[1] : options.plane_calibration;
+  const double first_calibration = measured ? kPlaneCalibrations[0] : options.plane_calibration;
   const double estimate = 20.0 * n / 8.0;
   // Plane records add to the count; the index costs about 9 bytes a record.
   const double wanted = std::max(50.0, 1.1 * std::min<double>(n / 50, 200));

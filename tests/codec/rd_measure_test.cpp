@@ -22,7 +22,7 @@ TEST(RdMeasure, AutomaticBalanceIsTheBestMeasuredCandidate) {
   ASSERT_TRUE(chosen);
   // Budgets relative to the default balance's stream, as the encoder does.
   EncodeOptions first;
-  first.plane_calibration = kPlaneCalibrations[1];
+  first.plane_calibration = kPlaneCalibrations[0];
   auto default_stream = encode_hcs(mesh, first);
   ASSERT_TRUE(default_stream);
   const uint64_t reference_bytes = default_stream->size();
