@@ -83,7 +83,9 @@ TEST(NetCatalog, DemoServesProceduralModelsWithoutAFolder) {
   if (!server::demo_models_available()) GTEST_SKIP() << "this build has no demo meshes";
   const std::string cache = fresh_dir("demo_cache");
   ServerProcess server;
-  ASSERT_TRUE(server.start({"--demo", "--cache", cache, "--threads", "2"}, cache + "/../demo.txt"))
+  // The server encodes its three demo models before it listens: a few
+  // seconds in a release build, up to a minute under the sanitizers.
+  ASSERT_TRUE(server.start({"--demo", "--cache", cache, "--threads", "2"}, cache + "/../demo.txt", 120s))
       << server.log();
   const v1::ModelList list = list_models(server.port());
   ASSERT_GE(list.models_size(), 1) << server.log();
