@@ -5,18 +5,30 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include "common/codec/encoder.h"
 #include "common/mesh/procedural.h"
 
 namespace meshstream {
 namespace {
 
-TEST(RdMeasure, AutomaticBalanceIsTheBestMeasuredCandidate) {
+// The demo model and the measure of its quantized original, as the encoder
+// prepares it.
+class RdMeasureOnDemo : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto reference = quantized_reference(mesh, 12);
+    ASSERT_TRUE(reference);
+    auto prepared = RdMeasure::prepare(*reference);
+    ASSERT_TRUE(prepared);
+    measure = std::move(*prepared);
+  }
   const Mesh mesh = make_demo_mesh(12000);
-  auto reference = quantized_reference(mesh, 12);
-  ASSERT_TRUE(reference);
-  auto measure = RdMeasure::prepare(*reference);
-  ASSERT_TRUE(measure);
+  std::optional<RdMeasure> measure;
+};
+
+TEST_F(RdMeasureOnDemo, AutomaticBalanceIsTheBestMeasuredCandidate) {
   EncodeOptions automatic;
   auto chosen = encode_hcs(mesh, automatic);
   ASSERT_TRUE(chosen);
@@ -45,12 +57,7 @@ TEST(RdMeasure, AutomaticBalanceIsTheBestMeasuredCandidate) {
 
 // More of the stream is closer: the measured RMS falls along the budgets,
 // and the prefixes grow.
-TEST(RdMeasure, CurveFallsAsTheBudgetGrows) {
-  const Mesh mesh = make_demo_mesh(12000);
-  auto reference = quantized_reference(mesh, 12);
-  ASSERT_TRUE(reference);
-  auto measure = RdMeasure::prepare(*reference);
-  ASSERT_TRUE(measure);
+TEST_F(RdMeasureOnDemo, CurveFallsAsTheBudgetGrows) {
   auto stream = encode_hcs(mesh, EncodeOptions{});
   ASSERT_TRUE(stream);
   auto curve = measure->curve(*stream, stream->size());
