@@ -20,11 +20,8 @@ std::string fresh_dir(const std::string& name) {
 }
 
 v1::ModelList list_models(uint16_t port) {
-  TestClient c;
-  EXPECT_TRUE(c.connect(port));
-  EXPECT_TRUE(c.hello());
+  TestClient c = greeted_client(port);
   v1::ServerMessage m;
-  EXPECT_EQ(c.read(m), ReadEnd::kMessage);
   EXPECT_TRUE(c.list());
   EXPECT_EQ(c.read(m), ReadEnd::kMessage);
   return m.model_list();

@@ -126,19 +126,9 @@ bool start_holding_server(ServerProcess& server, const std::string& log_name) {
                       gate_models().dir + "/" + log_name + ".log");
 }
 
-TestClient greeted(uint16_t port) {
-  TestClient c;
-  EXPECT_TRUE(c.connect(port));
-  EXPECT_TRUE(c.hello());
-  v1::ServerMessage m;
-  EXPECT_EQ(c.read(m), ReadEnd::kMessage);
-  EXPECT_TRUE(m.has_hello()) << m.DebugString();
-  return c;
-}
-
 // Streams `big` to the end; the seconds it took (byte-exact or a failure).
 double timed_full_stream(uint16_t port) {
-  TestClient c = greeted(port);
+  TestClient c = greeted_client(port);
   const auto start = Clock::now();
   c.stream("big");
   const StreamResult r = read_stream(c, 30000ms);
@@ -153,12 +143,12 @@ TEST(FirstChunkHold, EveryWayAStartingStreamEndsReleasesTheHold) {
   const uint16_t port = server.port();
   {
     // Requests, then leaves before reading anything.
-    TestClient c = greeted(port);
+    TestClient c = greeted_client(port);
     c.stream("big");
   }
   {
     // Two requests back to back: the first is replaced before its first chunk.
-    TestClient c = greeted(port);
+    TestClient c = greeted_client(port);
     c.stream("big");
     c.stream("big");
     const StreamResult first = read_stream(c, 30000ms);
@@ -170,7 +160,7 @@ TEST(FirstChunkHold, EveryWayAStartingStreamEndsReleasesTheHold) {
   }
   {
     // Cancelled right after the request.
-    TestClient c = greeted(port);
+    TestClient c = greeted_client(port);
     c.stream("big");
     c.cancel();
     const StreamResult r = read_stream(c, 30000ms);
@@ -178,7 +168,7 @@ TEST(FirstChunkHold, EveryWayAStartingStreamEndsReleasesTheHold) {
   }
   {
     // Resumed past the end: a header and an end, no chunk at all.
-    TestClient c = greeted(port);
+    TestClient c = greeted_client(port);
     v1::StreamRequest request;
     request.set_model("big");
     request.set_resume_offset(uint64_t(1) << 40);
@@ -189,7 +179,7 @@ TEST(FirstChunkHold, EveryWayAStartingStreamEndsReleasesTheHold) {
   }
   {
     // Unknown model: an error, never a starting stream.
-    TestClient c = greeted(port);
+    TestClient c = greeted_client(port);
     c.stream("nope");
     v1::ServerMessage m;
     ASSERT_EQ(c.read(m), ReadEnd::kMessage);
@@ -216,7 +206,7 @@ TEST(FirstChunkHold, AStreamStuckBehindAStalledWriteHoldsBulkOnlyUntilItsSession
   std::this_thread::sleep_for(100ms);
   // Meanwhile another client streams: its first chunk is never held, its
   // bulk only until the stuck session is closed, far below the 10 s hold.
-  TestClient c = greeted(port);
+  TestClient c = greeted_client(port);
   const auto start = Clock::now();
   c.stream("big");
   v1::ServerMessage m;

@@ -128,15 +128,7 @@ class PercentVerticesServerTest : public ::testing::Test {
     dir_ = nullptr;
   }
 
-  static TestClient connected() {
-    TestClient c;
-    EXPECT_TRUE(c.connect(server_->port()));
-    EXPECT_TRUE(c.hello());
-    v1::ServerMessage m;
-    EXPECT_EQ(c.read(m), ReadEnd::kMessage);
-    EXPECT_TRUE(m.has_hello());
-    return c;
-  }
+  static TestClient connected() { return greeted_client(server_->port()); }
 
   static v1::StreamRequest percent_request(double p) {
     v1::StreamRequest request;

@@ -84,15 +84,7 @@ class NetTest : public ::testing::Test {
   void SetUp() override { ASSERT_NE(server_, nullptr); }
 
   // A connected client past the handshake.
-  static TestClient connected() {
-    TestClient c;
-    EXPECT_TRUE(c.connect(server_->port()));
-    EXPECT_TRUE(c.hello());
-    v1::ServerMessage m;
-    EXPECT_EQ(c.read(m), ReadEnd::kMessage);
-    EXPECT_TRUE(m.has_hello()) << m.DebugString();
-    return c;
-  }
+  static TestClient connected() { return greeted_client(server_->port()); }
 
   static ServerProcess* server_;
 };
