@@ -136,12 +136,11 @@ std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std
 }
 
 // What only the encoder knows about each decoder vertex: its true position
-// (and residual against its anchor), a unit normal of the original surface
-// there, and the weight of its error in the distortion estimate.
+// (and residual against its anchor) and the weight of its error in the
+// distortion estimate; and, by input id, unit normals of the original.
 struct EncoderTruth {
   std::vector<Vec3i> position;
   std::vector<Vec3i> residual;
-  std::vector<Vec3f> normal;
   // Star area when the vertex got its geometry x sqrt(vertex count then):
   // the area its error spreads over shrinks as the mesh refines around it;
   // area(now) ~ weight / sqrt(vertices now) measured better than 1 / n
@@ -154,8 +153,7 @@ struct EncoderTruth {
 // whole vector counts: weighting tangential slip down (it mostly slides the
 // surface within itself) measured worse on CAD meshes, where a vertex on a
 // crease slides across the other face.
-double surface_error2(Vec3i recon, Vec3i truth, Vec3f n) {
-  (void)n;
+double surface_error2(Vec3i recon, Vec3i truth) {
   const double e[3] = {double(recon.x) - truth.x, double(recon.y) - truth.y, double(recon.z) - truth.z};
   return e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
 }
@@ -296,12 +294,11 @@ class StructureWriter {
                              double(r.position.z) - pred.z};
         const double dn = d[0] * nrm.x + d[1] * nrm.y + d[2] * nrm.z;
         const Vec3i recon = reconstruct(g, s_.max_coordinate);
-        drop += area * (dn * dn - surface_error2(recon, r.position, nrm)) / 6.0;
+        drop += area * (dn * dn - surface_error2(recon, r.position)) / 6.0;
         const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
         inserted.push_back({r.vertex, v});
         t_.position.push_back(r.position);
         t_.residual.push_back({r.position.x - pred.x, r.position.y - pred.y, r.position.z - pred.z});
-        t_.normal.push_back(nrm);
         t_.weight.push_back(area * std::sqrt(double(vertices_before + count)));
       }
       insertions += count;
@@ -366,8 +363,7 @@ void evaluate_group(const RefinementState& s, const EncoderTruth& t, PlaneGroup&
     plane_step(scratch, io, geo, prev_new, s.max_coordinate);
     const Vec3i after = reconstruct(geo, s.max_coordinate);
     g.scaled_drop += t.weight[v] *
-                     (surface_error2(before, t.position[v], t.normal[v]) -
-                      surface_error2(after, t.position[v], t.normal[v])) / 6.0;
+                     (surface_error2(before, t.position[v]) - surface_error2(after, t.position[v])) / 6.0;
   }
 }
 
@@ -422,7 +418,6 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   // Encoder-side truth, in decoder ids.
   EncoderTruth truth;
   truth.input_normal = vertex_normals(q, mesh.triangles);
-  const std::vector<Vec3f>& normals = truth.input_normal;
   {
     std::vector<double> star_area(base_n, 0.0);
     for (const Triangle& f : base.decoded.faces) {
@@ -434,7 +429,6 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
       truth.position.push_back(q[in]);
       const Vec3i anchor = state->geometry[d].anchor;
       truth.residual.push_back({q[in].x - anchor.x, q[in].y - anchor.y, q[in].z - anchor.z});
-      truth.normal.push_back(normals[in]);
       truth.weight.push_back(star_area[d] * std::sqrt(double(base_n)));
     }
   }
