@@ -45,13 +45,16 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream, u
     const Mesh& shown = decoder.mesh();
     p.vertices = shown.vertex_count();
     if (shown.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "rate-distortion measure: decoded prefix has no triangles");
-    const TriangleBvh shown_bvh = TriangleBvh::build(shown);
-    const double to_shown = weighted_rms_distance(original_samples_, shown_bvh);
-    const double to_original = weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_);
-    p.relative_rms = diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;
+    p.relative_rms = relative_rms(shown);
     points.push_back(p);
   }
   return points;
+}
+
+double RdMeasure::relative_rms(const Mesh& shown) const {
+  const double to_shown = weighted_rms_distance(original_samples_, TriangleBvh::build(shown));
+  const double to_original = weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_);
+  return diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;
 }
 
 double RdMeasure::score(const std::vector<RdPoint>& points) {

@@ -58,6 +58,12 @@ class RdMeasure {
   // prefix and 2 x samples closest-point queries.
   Result<std::vector<RdPoint>> curve(std::span<const uint8_t> stream, uint64_t reference_bytes) const;
 
+  // The symmetric RMS distance of `shown` (e.g. one decoded prefix) to the
+  // original, over the original's bounding-box diagonal. Precondition:
+  // shown has triangles, indices in range. Cost: a hierarchy over `shown`
+  // and samples + max(faces, samples) closest-point queries.
+  double relative_rms(const Mesh& shown) const;
+
   // Mean natural log of the points' RMS (lower is better). A zero RMS
   // counts as 1e-9 of the diagonal.
   static double score(const std::vector<RdPoint>& points);

@@ -8,10 +8,8 @@
 
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
+#include "common/codec/rd_measure.h"
 #include "common/mesh/import.h"
-#include "common/metrics/bvh.h"
-#include "common/metrics/surface_quadrature.h"
-#include "common/metrics/surface_sampling.h"
 #include "tests/test_meshes.h"
 
 namespace meshstream {
@@ -46,9 +44,9 @@ class EmbeddedRealMesh : public ::testing::TestWithParam<const char*> {};
 class EmbeddedRealMeshDistance : public ::testing::TestWithParam<const char*> {};
 
 // Distance to the original after every record, on every real model: the
-// symmetric RMS, with fixed area samples on the original and fixed
-// per-triangle quadrature points on the decoded prefix
-// (surface_quadrature.h). Plain area sampling of the prefix moves every
+// symmetric RMS as the encoder measures it (RdMeasure::relative_rms, 8000
+// samples): fixed area samples on the original and fixed per-triangle
+// quadrature points on the decoded prefix (surface_quadrature.h). Plain area sampling of the prefix moves every
 // sample when one triangle changes; on CAD parts its RMS then jumps by
 // 10-20 % between records that barely differ (crank.off, 8000 samples),
 // which would hide or fake rises. With the quadrature a record's effect is
@@ -56,8 +54,9 @@ class EmbeddedRealMeshDistance : public ::testing::TestWithParam<const char*> {}
 //
 // A plane record only sharpens positions: at most 2 % above the previous
 // RMS (a plane step can move a vertex whose true position was near the old
-// interval's middle a little away; mask.off: +1.15 % once). A structure record may raise it more:
-// the layered decimation's intermediate meshes are not nested, and on CAD
+// interval's middle a little away; mask.off: +1.15 % once). A structure
+// record may raise it more: the layered decimation's intermediate meshes
+// are not nested, and on CAD
 // creases a restored vertex's star can leave part of the original farther
 // away than the fan it replaces (fandisk.off: +7.7 % over the best so far;
 // every other model <= 0.2 %). Bound: 10 % over the best RMS seen so far.
@@ -73,14 +72,10 @@ TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
   ASSERT_FALSE(e.bytes.empty());
   auto reference = quantized_reference(e.mesh, 12);
   ASSERT_TRUE(reference);
-  const uint32_t kSamples = 8000;
-  const SurfaceSamples area = sample_surface(*reference, kSamples, 1);
-  WeightedSamples original;
-  original.points.assign(area.points.begin(), area.points.begin() + area.area_count);
-  original.weights.assign(area.area_count, 1.0);
-  const double cell_area = area.area / kSamples;
-  const TriangleBvh original_bvh = TriangleBvh::build(*reference);
-  const double diagonal = bounding_box(*reference).diagonal();
+  RdMeasureOptions options;
+  options.samples = 8000;
+  auto measure = RdMeasure::prepare(*reference, options);
+  ASSERT_TRUE(measure);
   IncrementalDecoder dec;
   uint64_t fed = 0;
   double previous = 0, best = 0, worst_plane = 0, worst_structure = 0;
@@ -88,10 +83,7 @@ TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
     const uint64_t end = end_of(e.index, i);
     ASSERT_TRUE(dec.feed(std::span<const uint8_t>(e.bytes.data() + fed, end - fed)));
     fed = end;
-    const TriangleBvh shown = TriangleBvh::build(dec.mesh());
-    const double rms = std::max(weighted_rms_distance(original, shown),
-                                weighted_rms_distance(quadrature_samples(dec.mesh(), cell_area), original_bvh)) /
-                       diagonal;
+    const double rms = measure->relative_rms(dec.mesh());
     if (i > 0) {
       const bool plane = e.report.records[i].plane;
       if (plane) {
