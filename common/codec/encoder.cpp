@@ -672,9 +672,11 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   // Rate-distortion by measurement (rd_measure.h): the other balances at
   // the same record size, judged at the same byte budgets by the surface
   // distance of their decoded prefixes to the original.
-  auto reference = quantized_reference(mesh, options.quant_bits);
-  if (!reference) return tl::unexpected(reference.error());
-  auto measure = RdMeasure::prepare(*reference);
+  Mesh reference;  // the quantized original, from the positions already quantized
+  reference.triangles = mesh.triangles;
+  reference.positions.reserve(q.size());
+  for (const Vec3i& p : q) reference.positions.push_back(grid->dequantize(p));
+  auto measure = RdMeasure::prepare(reference);
   if (!measure) return tl::unexpected(measure.error());
   const uint64_t reference_bytes = chosen.bytes.size();
   auto chosen_curve = measure->curve(chosen.bytes, reference_bytes);
