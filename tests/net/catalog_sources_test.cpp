@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "server/catalog.h"
+#include "tests/net/greeted_client.h"
 #include "tests/net/net_harness.h"
 #include "tests/test_meshes.h"
 

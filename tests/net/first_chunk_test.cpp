@@ -8,6 +8,7 @@
 
 #include "server/first_chunk_gate.h"
 #include "server/synthetic_stream.h"
+#include "tests/net/greeted_client.h"
 #include "tests/net/net_harness.h"
 
 namespace meshstream::nettest {

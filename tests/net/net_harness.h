@@ -264,17 +264,6 @@ class TestClient {
   proto::ServerFrameReader reader_;
 };
 
-// A client connected to `port` and past the handshake (Hello sent, the
-// server's Hello read).
-inline TestClient greeted_client(uint16_t port) {
-  TestClient c;
-  EXPECT_TRUE(c.connect(port));
-  EXPECT_TRUE(c.hello());
-  v1::ServerMessage m;
-  EXPECT_EQ(c.read(m), ReadEnd::kMessage);
-  EXPECT_TRUE(m.has_hello()) << m.DebugString();
-  return c;
-}
 
 // Everything one stream request produced.
 struct StreamResult {

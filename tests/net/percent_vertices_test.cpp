@@ -15,6 +15,7 @@
 #include "common/mesh/procedural.h"
 #include "server/stream_plan.h"
 #include "server/synthetic_stream.h"
+#include "tests/net/greeted_client.h"
 #include "tests/net/net_harness.h"
 
 namespace meshstream::nettest {

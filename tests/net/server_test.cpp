@@ -9,6 +9,7 @@
 
 #include "common/codec/container.h"
 #include "server/synthetic_stream.h"
+#include "tests/net/greeted_client.h"
 #include "tests/net/net_harness.h"
 
 namespace meshstream::nettest {
