@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "common/codec/crc32.h"
+#include "common/codec/record_index_coder.h"
 
 namespace meshstream {
 namespace {
@@ -17,9 +18,6 @@ void put_u16(std::vector<uint8_t>& out, uint16_t v) {
 }
 void put_u32(std::vector<uint8_t>& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
-}
-void put_u64(std::vector<uint8_t>& out, uint64_t v) {
-  for (int i = 0; i < 8; ++i) out.push_back(uint8_t(v >> (8 * i)));
 }
 void put_f32(std::vector<uint8_t>& out, float f) {
   uint32_t v;
@@ -78,17 +76,23 @@ std::vector<uint8_t> encode_header(const StreamHeader& h) {
   return out;
 }
 
-}  // namespace
-
-std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
-                                            std::vector<RecordEntry>& records) {
+// Magic, version, flags, header and its CRC: the same in every version.
+std::vector<uint8_t> write_magic_and_header(uint16_t version, const StreamHeader& header) {
   std::vector<uint8_t> head = encode_header(header);
   std::vector<uint8_t> out(kContainerMagic, kContainerMagic + 4);
-  put_u16(out, kContainerVersion);
+  put_u16(out, version);
   put_u16(out, 0);
   put_u32(out, static_cast<uint32_t>(head.size()));
   out.insert(out.end(), head.begin(), head.end());
   put_u32(out, crc32(0, head.data(), head.size()));
+  return out;
+}
+
+}  // namespace
+
+std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
+                                            std::vector<RecordEntry>& records) {
+  std::vector<uint8_t> out = write_magic_and_header(2, header);
   // Version 2 index: count, byte length, then per record varint size,
   // varint vertices added, zigzag varint (2 x vertices added - faces added),
   // u32 CRC (about 8 bytes instead of 24:
@@ -121,6 +125,57 @@ std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
   return out;
 }
 
+Result<WrittenContainer> write_container(const StreamHeader& header,
+                                         std::span<const std::vector<uint8_t>> payloads,
+                                         std::span<const RecordCounts> counts) {
+  if (payloads.size() != counts.size()) {
+    return make_error(ErrorCode::kInvalidArgument, "write_container: " + std::to_string(payloads.size()) +
+                                                       " payloads but " + std::to_string(counts.size()) +
+                                                       " record counts");
+  }
+  if (encode_header(header).size() > kMaxHeaderBytes) {
+    return make_error(ErrorCode::kInvalidArgument, "write_container: header too large");
+  }
+  WrittenContainer out;
+  out.records.resize(payloads.size());
+  for (size_t i = 0; i < payloads.size(); ++i) {
+    if (payloads[i].size() > kMaxRecordBytes - kRecordTrailerBytes) {
+      return make_error(ErrorCode::kInvalidArgument,
+                        "write_container: record " + std::to_string(i) + " is over 1 GiB");
+    }
+    RecordEntry& r = out.records[i];
+    r.size = static_cast<uint32_t>(payloads[i].size() + kRecordTrailerBytes);
+    r.vertices = counts[i].vertices;
+    r.faces = counts[i].faces;
+    r.crc32 = crc32(0, payloads[i].data(), payloads[i].size());
+    r.crc_trailer = true;
+  }
+  if (!out.records.empty() &&
+      (out.records.back().vertices != header.vertex_count || out.records.back().faces != header.face_count)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "write_container: the last record's counts differ from the header's");
+  }
+  auto coded = encode_record_index(out.records);  // refuses empty lists and decreasing counts
+  if (!coded) return tl::unexpected(Error{coded.error().code, "write_container: " + coded.error().message});
+
+  out.bytes = write_magic_and_header(3, header);
+  const size_t index_start = out.bytes.size();  // the index checksum covers count and length too
+  put_u32(out.bytes, static_cast<uint32_t>(out.records.size()));
+  put_u32(out.bytes, static_cast<uint32_t>(coded->size()));
+  out.bytes.insert(out.bytes.end(), coded->begin(), coded->end());
+  put_u32(out.bytes, crc32(0, out.bytes.data() + index_start, out.bytes.size() - index_start));
+  out.payload_offset = out.bytes.size();
+  uint64_t total = out.payload_offset;
+  for (const RecordEntry& r : out.records) total += r.size;
+  out.bytes.reserve(total);
+  for (size_t i = 0; i < payloads.size(); ++i) {
+    out.records[i].offset = out.bytes.size();
+    out.bytes.insert(out.bytes.end(), payloads[i].begin(), payloads[i].end());
+    put_u32(out.bytes, out.records[i].crc32);
+  }
+  return out;
+}
+
 Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   auto need = [&](size_t bytes) -> Status {
     if (in.size() < bytes) {
@@ -135,7 +190,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     return make_error(ErrorCode::kParse, "not an .hcs stream (bad magic bytes)");
   }
   const uint16_t version = get_u16(in.data() + 4);
-  if (version != kContainerVersion && version != 1) {
+  if (version < 1 || version > kContainerVersion) {
     return make_error(ErrorCode::kUnsupported,
                       "unsupported .hcs version " + std::to_string(version) + " (this build reads " +
                           std::to_string(kContainerVersion) + ")");
@@ -156,6 +211,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   }
 
   StreamIndex index;
+  index.version = version;
   StreamHeader& hd = index.header;
   hd.vertex_count = get_u32(h);
   hd.face_count = get_u32(h + 4);
@@ -177,10 +233,12 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
                       "implausible record count " + std::to_string(record_count));
   }
   const size_t index_start = count_at;  // the index CRC covers the count too
-  index.records.resize(record_count);
+  // Every version allocates the entries only once the index bytes are there
+  // and checked: a hostile count costs no memory before.
   if (version == 1) {
     const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
     if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
+    index.records.resize(record_count);
     if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
       return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
     }
@@ -193,6 +251,30 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
       r.vertices = get_u32(e + 12);
       r.faces = get_u32(e + 16);
       r.crc32 = get_u32(e + 20);
+    }
+  } else if (version == 3) {
+    if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
+    // Bounds before waiting for the bytes: a hostile length is an error
+    // now, not a wait for gigabytes.
+    const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
+    if (index_bytes == 0 || index_bytes > uint64_t(kMaxIndexBytesPerRecord) * record_count ||
+        record_count > uint64_t(kMaxRecordsPerIndexByte) * index_bytes) {
+      return make_error(ErrorCode::kParse, "implausible record index length " + std::to_string(index_bytes) +
+                                               " for " + std::to_string(record_count) + " records");
+    }
+    const size_t entries_at = count_at + 8;
+    const size_t index_end = entries_at + index_bytes;
+    if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
+    if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
+      return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
+    }
+    index.payload_offset = index_end + 4;
+    auto records = decode_record_index(in.subspan(entries_at, index_bytes), record_count, index.payload_offset);
+    if (!records) return tl::unexpected(records.error());
+    index.records = std::move(*records);
+    for (RecordEntry& r : index.records) {
+      if (r.offset + r.size > in.size()) break;  // contiguous: the rest lie beyond too
+      r.crc32 = get_u32(in.data() + r.offset + r.size - kRecordTrailerBytes);
     }
   } else {
     if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
@@ -207,6 +289,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
       return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
     }
     index.payload_offset = index_end + 4;
+    index.records.resize(record_count);
     size_t pos = entries_at;
     uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
     for (uint32_t i = 0; i < record_count; ++i) {
@@ -255,8 +338,17 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   return index;
 }
 
-bool record_intact(const RecordEntry& record, std::span<const uint8_t> payload) {
-  return payload.size() == record.size && crc32(0, payload.data(), payload.size()) == record.crc32;
+bool record_intact(const RecordEntry& record, std::span<const uint8_t> bytes) {
+  if (bytes.size() != record.size) return false;
+  if (!record.crc_trailer) return crc32(0, bytes.data(), bytes.size()) == record.crc32;
+  if (bytes.size() < kRecordTrailerBytes) return false;
+  const size_t payload = bytes.size() - kRecordTrailerBytes;
+  return crc32(0, bytes.data(), payload) == get_u32(bytes.data() + payload);
+}
+
+std::span<const uint8_t> record_payload(const RecordEntry& record, std::span<const uint8_t> bytes) {
+  if (!record.crc_trailer) return bytes;
+  return bytes.first(bytes.size() >= kRecordTrailerBytes ? bytes.size() - kRecordTrailerBytes : 0);
 }
 
 }  // namespace meshstream

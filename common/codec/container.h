@@ -7,14 +7,18 @@
 //          8   u32 header_size H, then H header bytes (StreamHeader, see
 //              container.cpp; fields added later go at the end, so a reader
 //              skips what it does not know), then u32 CRC-32 of those H bytes
-//   12+H+4     record index (version 2): u32 record_count, u32 L, then L
-//              bytes: per record varint size, varint vertices added, zigzag
-//              varint (2 * vertices added - faces added), u32 crc32; then a
-//              u32 CRC-32 of count, L and
-//              entries. (Version 1, still read: record_count entries of 24
-//              bytes, u64 offset, u32 size, u32 vertices, u32 faces, u32
-//              crc32, then the CRC.) Offsets follow from the sizes.
-//   ...        record payloads, in index order, contiguous, record 0 first
+//   12+H+4     record index (version 3): u32 record_count, u32 L, then L
+//              range-coded bytes holding per record its size, vertices
+//              added and (2 * vertices added - faces added), each predicted
+//              from the records before it (record_index_coder.h, about 1.5
+//              bytes a record); then a u32 CRC-32 of count, L and the bytes.
+//              Offsets follow from the sizes.
+//   ...        records, in index order, contiguous, record 0 first; each is
+//              its payload followed by a u32 CRC-32 of that payload (the
+//              trailer; a record's size counts it).
+// Still read: version 2 (index entries varint size, varint vertices added,
+// zigzag varint gap, u32 payload CRC-32; records are bare payloads) and
+// version 1 (24-byte entries: u64 offset, u32 size, vertices, faces, CRC).
 // Record 0 is the base mesh. `vertices`/`faces` of a record are the counts of
 // the mesh after applying it and all before it. Any prefix that ends on a
 // record boundary decodes to a valid mesh.
@@ -32,7 +36,9 @@
 namespace meshstream {
 
 inline constexpr char kContainerMagic[4] = {'M', 'H', 'C', 'S'};
-inline constexpr uint16_t kContainerVersion = 2;  // 1 (24-byte index entries) is still read
+inline constexpr uint16_t kContainerVersion = 3;  // 1 and 2 (index CRCs, bare payloads) are still read
+// Version 3 records end in a CRC-32 of their payload.
+inline constexpr uint32_t kRecordTrailerBytes = 4;
 // Refuse absurd counts before allocating anything for them.
 inline constexpr uint32_t kMaxRecords = 1u << 22;
 inline constexpr uint32_t kMaxHeaderBytes = 1u << 16;
@@ -53,33 +59,72 @@ struct StreamHeader {
 
 struct RecordEntry {
   uint64_t offset = 0;  // from the start of the stream
-  uint32_t size = 0;
+  uint32_t size = 0;      // bytes in the stream (payload and trailer, if any)
   uint32_t vertices = 0;  // cumulative, after this record
   uint32_t faces = 0;
-  uint32_t crc32 = 0;     // of the record's payload bytes
+  // CRC-32 of the record's payload. Versions 1-2: from the index. Version 3:
+  // the record's trailer as read_stream_index found it (0 when the record's
+  // bytes were not in the span it read).
+  uint32_t crc32 = 0;
+  bool crc_trailer = false;  // version 3: the last 4 bytes are the CRC-32
 };
 
 struct StreamIndex {
   StreamHeader header;
   std::vector<RecordEntry> records;
   uint64_t payload_offset = 0;  // where record 0 starts == bytes of magic+header+index
+  uint16_t version = 0;         // container version of the stream (1..kContainerVersion)
   uint64_t total_bytes() const {
     return records.empty() ? payload_offset : records.back().offset + records.back().size;
   }
 };
 
-// Serializes magic, header and index for records of the given payload sizes
-// (offsets are filled in). Returns the bytes to put before the payloads.
+// Serializes magic, header and a VERSION 2 index for records of the given
+// payload sizes and CRCs (offsets are filled in). Returns the bytes to put
+// before the payloads. Kept for tests and synthetic streams: version 2 stays
+// readable. New streams use write_container.
 std::vector<uint8_t> write_container_prefix(const StreamHeader& header,
                                             std::vector<RecordEntry>& records);
+
+// Mesh counts after a record (cumulative), for write_container.
+struct RecordCounts {
+  uint32_t vertices = 0;
+  uint32_t faces = 0;
+};
+
+struct WrittenContainer {
+  std::vector<uint8_t> bytes;        // the whole stream
+  std::vector<RecordEntry> records;  // as read_stream_index(bytes) returns them
+  uint64_t payload_offset = 0;
+};
+
+// Writes a whole version-3 stream: magic, header, the compact index, and
+// every payload followed by its CRC-32 trailer. `payloads` and `counts` have
+// one entry per record, record 0 (the base) first. kInvalidArgument when the
+// lengths differ, there are no records or more than kMaxRecords, a payload
+// is over 1 GiB, counts decrease, or the last counts differ from the
+// header's (anything read_stream_index would refuse). O(stream bytes).
+Result<WrittenContainer> write_container(const StreamHeader& header,
+                                         std::span<const std::vector<uint8_t>> payloads,
+                                         std::span<const RecordCounts> counts);
 
 // Parses magic, header and index from the first bytes of a stream.
 // Returns kTruncated when `prefix` is too short to hold them (feed more and
 // call again), kParse/kCorrupt/kUnsupported/kLimit for a bad stream. Checks
-// that records are contiguous and counts never decrease. O(records).
+// that records are contiguous and counts never decrease. Version 3: fills
+// each record's crc32 from its trailer when the record lies inside `prefix`
+// (0 otherwise; not checked here: record_intact does). O(records).
 Result<StreamIndex> read_stream_index(std::span<const uint8_t> prefix);
 
-// True when `payload` matches the record's checksum and size.
-bool record_intact(const RecordEntry& record, std::span<const uint8_t> payload);
+// True when `bytes` (the record's bytes in the stream, offset..offset+size)
+// have the record's size and pass its checksum: version 3, the trailer
+// matches the CRC-32 of the payload before it; versions 1-2, the index's CRC
+// matches the bytes. O(size).
+bool record_intact(const RecordEntry& record, std::span<const uint8_t> bytes);
+
+// The payload of a record's bytes: without the trailer (version 3), else all
+// of them. This is what the record decoders read. Precondition:
+// bytes.size() == record.size (true once record_intact holds).
+std::span<const uint8_t> record_payload(const RecordEntry& record, std::span<const uint8_t> bytes);
 
 }  // namespace meshstream

@@ -3,6 +3,7 @@
 
 #include "common/codec/container.h"
 #include "common/codec/crc32.h"
+#include "common/codec/record_index_coder.h"
 
 namespace meshstream {
 namespace {
@@ -45,6 +46,26 @@ void reseal_checksums(std::vector<uint8_t>& s) {
       if (offset <= s.size() && size <= s.size() - offset) put_u32(s, e + 20, crc32(0, s.data() + offset, size));
     }
     put_u32(s, index_end, crc32(0, s.data() + count_at, index_end - count_at));
+    return;
+  }
+  if (version == 3) {
+    // The index CRC first (it does not cover the records), then every
+    // trailer of a record the index locates; a mutated index that no longer
+    // decodes leaves the records alone and fails in the reader.
+    if (count_at + 8 > s.size()) return;
+    const size_t length = get_u32(s, count_at + 4);
+    const size_t entries_at = count_at + 8;
+    if (length > s.size() || entries_at + length + 4 > s.size()) return;
+    const size_t index_end = entries_at + length;
+    put_u32(s, index_end, crc32(0, s.data() + count_at, index_end - count_at));
+    auto records = decode_record_index(std::span<const uint8_t>(s.data() + entries_at, length),
+                                       static_cast<uint32_t>(count), index_end + 4);
+    if (!records) return;
+    for (const RecordEntry& r : *records) {
+      if (r.offset > s.size() || r.size > s.size() - r.offset) break;  // contiguous: the rest too
+      const size_t payload = r.size - kRecordTrailerBytes;  // sizes are >= 4
+      put_u32(s, r.offset + payload, crc32(0, s.data() + r.offset, payload));
+    }
     return;
   }
   if (count_at + 8 > s.size()) return;

@@ -1,6 +1,7 @@
 // Incremental decoder: see decoder.h. Bytes are buffered only until the
 // record they belong to is complete; each complete record is checked against
-// its CRC, decoded, applied, and its bytes dropped.
+// its CRC (version 3: its trailer), decoded without the trailer, applied,
+// and its bytes dropped.
 #include "common/codec/decoder.h"
 
 #include <algorithm>
@@ -213,14 +214,15 @@ Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
       return tl::unexpected(*s.error);
     }
     const size_t at = static_cast<size_t>(rec.offset - s.buffer_start);
-    std::span<const uint8_t> payload(s.buffer.data() + at, rec.size);
-    if (!record_intact(rec, payload)) {
+    const std::span<const uint8_t> record_bytes(s.buffer.data() + at, rec.size);
+    if (!record_intact(rec, record_bytes)) {
       // Checked before anything is applied, so the state stays good.
       s.error = s.about_record(s.records_done, {ErrorCode::kCorrupt, "checksum mismatch (corrupt or altered bytes)"});
       s.error_recoverable = true;
       return tl::unexpected(*s.error);
     }
-    if (auto st = s.apply_record(s.records_done, payload); !st) {
+    // Version 3 records end in their CRC: the decoders see the payload only.
+    if (auto st = s.apply_record(s.records_done, record_payload(rec, record_bytes)); !st) {
       s.error = st.error();
       return tl::unexpected(*s.error);
     }

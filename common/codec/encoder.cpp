@@ -573,24 +573,28 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   header.layer_count = static_cast<uint32_t>(dec.layers.size());
   header.extra = {format, static_cast<uint8_t>(base_shift)};
 
+  // Container version 3: compact index, each record's CRC-32 in a trailer.
   EncodedStream out;
-  std::vector<RecordEntry> entries;
-  for (size_t i = 0; i < records.size(); ++i) {
-    const Finished& r = records[i];
-    RecordEntry e;
-    e.size = static_cast<uint32_t>(r.payload.size());
-    e.vertices = r.vertices;
-    e.faces = r.faces;
-    e.crc32 = crc32(0, r.payload.data(), r.payload.size());
-    entries.push_back(e);
-    if (i > 0) out.largest_refinement = std::max(out.largest_refinement, r.payload.size());
+  std::vector<std::vector<uint8_t>> payloads;
+  std::vector<RecordCounts> counts;
+  payloads.reserve(records.size());
+  counts.reserve(records.size());
+  for (Finished& r : records) {
+    counts.push_back({r.vertices, r.faces});
+    payloads.push_back(std::move(r.payload));
   }
-  if (entries.back().vertices != header.vertex_count || entries.back().faces != header.face_count) {
+  if (counts.back().vertices != header.vertex_count || counts.back().faces != header.face_count) {
     return make_error(ErrorCode::kInvalidMesh, "internal: the records do not rebuild the whole mesh");
   }
-  out.records = records.size();
-  out.bytes = write_container_prefix(header, entries);
-  for (const Finished& r : records) out.bytes.insert(out.bytes.end(), r.payload.begin(), r.payload.end());
+  auto written = write_container(header, payloads, counts);
+  if (!written) return tl::unexpected(written.error());
+  // Record sizes as the index has them (with the trailer): the granularity
+  // bound is about what a client receives.
+  for (size_t i = 1; i < written->records.size(); ++i) {
+    out.largest_refinement = std::max<size_t>(out.largest_refinement, written->records[i].size);
+  }
+  out.records = written->records.size();
+  out.bytes = std::move(written->bytes);
   return out;
 }
 

@@ -60,7 +60,7 @@ inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 4;  // 3: container 2 index, embedded records; 4: measured plane calibration
+inline constexpr uint32_t kEncoderVersion = 5;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3 (compact index, CRC trailers)
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {

@@ -96,6 +96,11 @@ class RangeDecoder {
   // to 4 trailing zero bytes of its flush.
   size_t overrun() const { return overrun_; }
   bool exhausted_badly() const { return overrun_ > 8; }
+  // Input bytes read so far (not counting the zeros past the end). After the
+  // last symbol of a block this equals the block's length exactly (the
+  // decoder reads as many bytes as the encoder wrote, the dropped trailing
+  // zeros being the overrun): a reader can refuse trailing bytes.
+  size_t consumed() const { return pos_; }
 
  private:
   uint8_t next_byte() {
