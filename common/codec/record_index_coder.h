@@ -9,14 +9,16 @@
 // proportion to their bytes, plane records (no vertices) have similar sizes,
 // faces added are nearly always twice the vertices added — so each field is
 // coded as the difference from its prediction with adaptive Exp-Golomb
-// models (range_coder.h), about 1.3–2 bytes an entry.
+// models (range_coder.h): 1.3–2.0 bytes an entry on the real meshes.
 //
 // Coding, per record i (models persist across records):
 //   i > 0: one bit "plane record" (vertices added == 0), context: whether
 //          record i - 1 was one;
 //   size:  record 0: size - 4, unsigned; else the signed difference from the
-//          previous record of the same kind (base, structure, plane; the
-//          first of a kind from 0);
+//          previous record of the same kind (structure, plane; the first of
+//          a kind from 0), where a structure record under half the size of
+//          its reference (a layer's short last record) leaves the reference
+//          as it was;
 //   dv:    record 0: vertices added, unsigned; structure record: signed
 //          difference from size x (recent vertices / recent bytes) of
 //          structure records (integer moving sums, decay 1/8);
