@@ -40,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<uint8_t> fixed;
   if (size > 0 && (data[size - 1] & 1)) {  // the flag: checksums made valid
     fixed.assign(data, data + size - 1);
-    reseal_checksums(fixed);  // both container versions
+    reseal_checksums(fixed);  // every container version (v3: index CRC and record trailers)
     data = fixed.data();
     size = fixed.size();
   }
