@@ -110,10 +110,14 @@ struct IncrementalDecoder::State {
       if (!state) return where(state.error());
       refine = std::move(*state);
       refine->format = format;
-      // Reserve for the final size, but never more than the stream's bytes
-      // could describe (every inserted vertex costs well over a bit), so a
-      // hostile header cannot make us allocate gigabytes.
-      const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * index->total_bytes();
+      // Reserve for the final size, but never more than the bytes received
+      // so far could describe (every inserted vertex costs well over a bit):
+      // neither a hostile header nor a hostile index (records claiming a
+      // gigabyte each that never come) can make us allocate gigabytes. A
+      // whole stream fed at once still reserves its final size; a streamed
+      // one grows as records arrive.
+      const uint64_t received = std::min<uint64_t>(index->total_bytes(), stream_pos);
+      const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * received;
       const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
       const uint32_t nf = static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
       refine->mesh.reserve(nv, nf);

@@ -379,6 +379,49 @@ TEST(ContainerV3, TrailingOrMissingIndexBytesAreRefused) {
   }
 }
 
+// An index whose second record claims a gigabyte and two billion vertices
+// (bytes that never come): the base still decodes, and the decoder reserves
+// for the bytes it has, not for the index's claim (it threw bad_alloc).
+TEST(ContainerV3, HugeClaimedRecordReservesNothingForIt) {
+  const auto& clean = encoded_stream();
+  auto index = read_stream_index(clean);
+  ASSERT_TRUE(index);
+  const RecordEntry& r0 = index->records[0];
+  std::vector<RecordEntry> entries = {r0, r0};
+  entries[1].size = kMaxRecordBytes;
+  entries[1].vertices = r0.vertices + (1u << 31);
+  entries[1].faces = r0.faces + (1u << 31) + 5;
+  auto coded = encode_record_index(entries);
+  ASSERT_TRUE(coded) << coded.error().message;
+  // Header as the clean stream's, with the claimed totals.
+  StreamHeader h = index->header;
+  h.vertex_count = entries[1].vertices;
+  h.face_count = entries[1].faces;
+  std::vector<std::vector<uint8_t>> payloads(2);
+  const auto base = record_payload(r0, bytes_of(clean, r0));
+  payloads[0].assign(base.begin(), base.end());
+  payloads[1] = {1};
+  std::vector<RecordCounts> counts = {{r0.vertices, r0.faces}, {entries[1].vertices, entries[1].faces}};
+  auto shell = write_container(h, payloads, counts);
+  ASSERT_TRUE(shell);
+  const IndexAt a = index_at(shell->bytes);
+  std::vector<uint8_t> s(shell->bytes.begin(), shell->bytes.begin() + a.coded_at);
+  put_u32(s, a.count_at + 4, uint32_t(coded->size()));
+  s.insert(s.end(), coded->begin(), coded->end());
+  s.resize(s.size() + 4);
+  put_u32(s, s.size() - 4, crc32(0, s.data() + a.count_at, s.size() - 4 - a.count_at));
+  s.insert(s.end(), shell->bytes.begin() + shell->records[0].offset,
+           shell->bytes.begin() + shell->records[0].offset + shell->records[0].size);
+  auto claimed = read_stream_index(s);
+  ASSERT_TRUE(claimed) << claimed.error().message;
+  EXPECT_GT(claimed->total_bytes(), uint64_t(1) << 30);
+  IncrementalDecoder dec;
+  auto fed = dec.feed(s);
+  ASSERT_TRUE(fed) << fed.error().message;
+  EXPECT_EQ(dec.records_decoded(), 1u);
+  EXPECT_EQ(dec.mesh().vertex_count(), r0.vertices);
+}
+
 // reseal_checksums makes damaged version-3 records pass: index CRC and
 // every trailer.
 TEST(ContainerV3, ResealFixesTrailers) {
