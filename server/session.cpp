@@ -334,7 +334,7 @@ std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& p
   bounds->set_max_x(h.bounds.max.x);
   bounds->set_max_y(h.bounds.max.y);
   bounds->set_max_z(h.bounds.max.z);
-  header->set_container_version(kContainerVersion);
+  header->set_container_version(index.version);  // a catalog may hold older streams
   header->set_max_chunk_bytes(static_cast<uint32_t>(chunk_bytes));
   v1::RecordIndex* records = header->mutable_records();
   const int n = static_cast<int>(index.records.size());

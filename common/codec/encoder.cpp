@@ -655,7 +655,8 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   const bool measured = options.embedded && options.plane_calibration <= 0;
   const double first_calibration = measured ? kPlaneCalibrations[0] : options.plane_calibration;
   const double estimate = 20.0 * n / 8.0;
-  // Plane records add to the count; the index costs about 9 bytes a record.
+  // Plane records add to the count; each record costs an index entry (about
+  // 1.5 bytes, container 3) and a 4-byte CRC trailer.
   const double wanted = std::max(50.0, 1.1 * std::min<double>(n / 50, 200));
   const size_t wanted_records = std::min<size_t>(n / 50, 200) + 1;  // + the base
   auto granular = [&](const EncodedStream& e) {

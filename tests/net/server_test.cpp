@@ -136,6 +136,7 @@ TEST_F(NetTest, FullStreamIsByteIdenticalToTheFile) {
   const StreamIndex index = index_of(models().small);
   EXPECT_EQ(r.header.total_bytes(), models().small.size());
   EXPECT_EQ(r.header.payload_offset(), index.payload_offset);
+  EXPECT_EQ(r.header.container_version(), index.version);
   EXPECT_EQ(r.header.end_record(), index.records.size());
   ASSERT_EQ(r.header.records().sizes_size(), int(index.records.size()));
   for (size_t i = 0; i < index.records.size(); ++i) {
