@@ -1,0 +1,176 @@
+// Layered decimation (common/codec/decimate.h): the base target rule and the
+// cost's preference for removals that do not change the surface.
+#include "common/codec/decimate.h"
+
+#include <array>
+#include <cmath>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "common/codec/quantize.h"
+
+namespace meshstream {
+namespace {
+
+// A unit cube whose faces are s x s grids (6 s^2 + 2 vertices): flat faces
+// and sharp creases, like a CAD part. Outward oriented.
+Mesh subdivided_cube(int s) {
+  Mesh m;
+  std::map<std::array<int, 3>, uint32_t> id;
+  auto vertex = [&](std::array<int, 3> c) {
+    auto [it, fresh] = id.try_emplace(c, m.vertex_count());
+    if (fresh) m.positions.push_back({float(c[0]) / s, float(c[1]) / s, float(c[2]) / s});
+    return it->second;
+  };
+  for (int a = 0; a < 3; ++a) {
+    const int u = (a + 1) % 3, w = (a + 2) % 3;  // e_u x e_w = e_a
+    for (int side : {0, s}) {
+      for (int i = 0; i < s; ++i) {
+        for (int j = 0; j < s; ++j) {
+          auto corner = [&](int di, int dj) {
+            std::array<int, 3> c{};
+            c[a] = side;
+            c[u] = i + di;
+            c[w] = j + dj;
+            return vertex(c);
+          };
+          const uint32_t p00 = corner(0, 0), p10 = corner(1, 0), p11 = corner(1, 1), p01 = corner(0, 1);
+          if (side == s) {
+            m.triangles.push_back({p00, p10, p11});
+            m.triangles.push_back({p00, p11, p01});
+          } else {
+            m.triangles.push_back({p00, p11, p10});
+            m.triangles.push_back({p00, p01, p11});
+          }
+        }
+      }
+    }
+  }
+  return m;
+}
+
+struct Measures {
+  double volume = 0, area = 0;
+};
+// Enclosed volume (divergence theorem) and area, on grid coordinates.
+Measures measures(const std::vector<Vec3i>& p, const std::vector<Triangle>& faces) {
+  Measures out;
+  for (const Triangle& t : faces) {
+    const Vec3d a{double(p[t[0]].x), double(p[t[0]].y), double(p[t[0]].z)};
+    const Vec3d b{double(p[t[1]].x), double(p[t[1]].y), double(p[t[1]].z)};
+    const Vec3d c{double(p[t[2]].x), double(p[t[2]].y), double(p[t[2]].z)};
+    out.volume += dot(a, cross(b, c)) / 6;
+    out.area += length(cross(b - a, c - a)) / 2;
+  }
+  return out;
+}
+
+TEST(Decimate, BaseTargetShrinksForSmallMeshesOnly) {
+  DecimateOptions share;
+  share.max_base_share = 1.0 / 16;
+  EXPECT_EQ(base_target(100000, share), 300u);  // large: the fixed target
+  EXPECT_EQ(base_target(4800, share), 300u);    // 1/16 of it is exactly 300
+  EXPECT_EQ(base_target(1861, share), 116u);    // hemisphere.off: 1/16
+  EXPECT_EQ(base_target(300, share), kMinBaseTarget);  // never below the floor
+  const DecimateOptions off;  // the default (see DecimateOptions)
+  EXPECT_EQ(base_target(1861, off), 300u);
+  share.target_vertices = 50;
+  EXPECT_EQ(base_target(1861, share), 50u);
+}
+
+// The share rule inside decimate_layers: a small mesh stops at 1/16 of its
+// vertices instead of the fixed target.
+TEST(Decimate, SmallMeshBaseHoldsItsShare) {
+  const Mesh cube = subdivided_cube(10);  // 602 vertices: 1/16 = 37
+  auto grid = make_grid(cube, 12);
+  ASSERT_TRUE(grid);
+  auto editable = EditableMesh::build(quantize_positions(cube, *grid), cube.triangles);
+  ASSERT_TRUE(editable);
+  DecimateOptions options;
+  options.max_base_share = 1.0 / 16;
+  const DecimationResult dec = decimate_layers(std::move(*editable), options);
+  EXPECT_EQ(dec.base_vertices.size(), 37u);
+  EXPECT_FALSE(dec.layers.empty());
+}
+
+// A CAD-like cube: every vertex but the 8 corners can go with zero error
+// (inside a flat face, or along a straight crease into a crease
+// neighbour). The decimation reaches a small target and the base is still
+// exactly the cube: volume and area unchanged on the grid.
+TEST(Decimate, FlatFacesAndCreasesDecimateWithoutError) {
+  const Mesh cube = subdivided_cube(16);
+  ASSERT_EQ(cube.vertex_count(), 6u * 16 * 16 + 2);
+  auto grid = make_grid(cube, 12);
+  ASSERT_TRUE(grid);
+  const std::vector<Vec3i> q = quantize_positions(cube, *grid);
+  auto editable = EditableMesh::build(q, cube.triangles);
+  ASSERT_TRUE(editable) << editable.error().message;
+  DecimateOptions options;
+  options.target_vertices = 96;  // 1 538 vertices: many layers, all exact
+  const DecimationResult dec = decimate_layers(std::move(*editable), options);
+  EXPECT_EQ(dec.base_vertices.size(), 96u);
+  const Measures before = measures(q, cube.triangles);
+  const Measures after = measures(q, dec.base_faces);
+  EXPECT_NEAR(after.volume, before.volume, 1e-9 * before.volume);
+  EXPECT_NEAR(after.area, before.area, 1e-9 * before.area);
+  // The corners, the only vertices whose every removal cuts the cube, stay.
+  int corners = 0;
+  for (uint32_t v : dec.base_vertices) {
+    const Vec3i p = q[v];
+    const int m = grid->max_coordinate();
+    corners += (p.x == 0 || p.x == m) && (p.y == 0 || p.y == m) && (p.z == 0 || p.z == m);
+  }
+  EXPECT_EQ(corners, 8);
+}
+
+// A flat square with one bump: the flat part is removable at no cost, so
+// the coarse mesh spends its vertices on the bump (area-weighted quadric
+// error: a large flat star costs nothing, a small curved one does).
+TEST(Decimate, CoarseVerticesGoWhereTheSurfaceBends) {
+  const int n = 41;
+  Mesh m;
+  const double cx = 30, cy = 30, r = 6;
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double d2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+      const float z = d2 < r * r ? float(4.0 * std::pow(1 - d2 / (r * r), 2)) : 0.0f;
+      m.positions.push_back({float(x), float(y), z});
+    }
+  }
+  for (int y = 0; y + 1 < n; ++y) {
+    for (int x = 0; x + 1 < n; ++x) {
+      const uint32_t a = y * n + x, b = a + 1, c = a + n + 1, d = a + n;
+      m.triangles.push_back({a, b, c});
+      m.triangles.push_back({a, c, d});
+    }
+  }
+  auto grid = make_grid(m, 12);
+  ASSERT_TRUE(grid);
+  const std::vector<Vec3i> q = quantize_positions(m, *grid);
+  auto editable = EditableMesh::build(q, m.triangles);
+  ASSERT_TRUE(editable) << editable.error().message;
+  DecimateOptions options;
+  options.target_vertices = 100;
+  const DecimationResult dec = decimate_layers(std::move(*editable), options);
+  ASSERT_EQ(dec.base_vertices.size(), 100u);
+  int on_bump = 0;
+  for (uint32_t v : dec.base_vertices) {
+    const double x = m.positions[v].x, y = m.positions[v].y;
+    on_bump += (x - cx) * (x - cx) + (y - cy) * (y - cy) <= (r + 1) * (r + 1);
+  }
+  // The bump's disk (with a cell of margin) is under 10 % of the square's
+  // area; the flat part needs only its 4 corners.
+  EXPECT_GE(on_bump, 50) << "base vertices on the bump: " << on_bump << " of 100";
+  // The square's outline is kept (boundary planes in the quadrics): its
+  // four corners stay.
+  int square_corners = 0;
+  for (uint32_t v : dec.base_vertices) {
+    const Vec3i p = q[v];
+    square_corners += (p.x == 0 || p.x == q[n - 1].x) && (p.y == 0 || p.y == q[n * (n - 1)].y);
+  }
+  EXPECT_EQ(square_corners, 4);
+}
+
+}  // namespace
+}  // namespace meshstream
