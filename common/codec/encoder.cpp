@@ -183,8 +183,9 @@ struct Finished {
 // the file comment). Each record is a run of the layer's walk.
 class StructureWriter {
  public:
-  StructureWriter(RefinementState& state, EncoderTruth& truth, uint8_t format)
-      : s_(state), t_(truth), format_(format) {}
+  // `bits` (optional) receives the cost of each symbol class.
+  StructureWriter(RefinementState& state, EncoderTruth& truth, uint8_t format, StructureBits* bits)
+      : s_(state), t_(truth), format_(format), bits_(bits) {}
 
   bool layer_open() const { return remaining_ > 0; }
 
@@ -221,6 +222,7 @@ class StructureWriter {
       const uint32_t u = s_.cursor;
       s_.cursor = s_.vertices[u].next;
       ++walk_steps;
+      if (bits_) ++bits_->walk_steps;
       s_.mesh.star(u, star_ring_, star_corners_);
       const uint32_t ring_size = static_cast<uint32_t>(star_ring_.size());
       const uint32_t faces = static_cast<uint32_t>(star_corners_.size());
@@ -242,6 +244,10 @@ class StructureWriter {
         return make_error(ErrorCode::kInvalidMesh, "internal: free face counts disagree");
       }
       if (free_faces > 0) {
+        if (bits_) {
+          ++bits_->count_steps;
+          enc.set_cost_sink(&bits_->count);
+        }
         m.patch_count[count_context(s_, u, free_faces)].encode(enc, std::min(count, 3u));
         if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
       } else if (count > 0) {
@@ -253,10 +259,15 @@ class StructureWriter {
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals_[order_[j].second];
         const uint32_t k = static_cast<uint32_t>(r.ring.size());
+        if (bits_) {
+          ++bits_->insertions;
+          enc.set_cost_sink(&bits_->valence);
+        }
         m.valence[std::min(ring_size, 12u)].encode(enc, k - 3);
         rank_patch_starts(s_.mesh, u, star_ring_, used_, k, candidates_);
         const auto it = std::find(candidates_.begin(), candidates_.end(), order_[j].first);
         if (it == candidates_.end()) return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
+        if (bits_) enc.set_cost_sink(&bits_->rank);
         encode_start_rank(m, enc, k, static_cast<uint32_t>(it - candidates_.begin()));
         for (uint32_t f = 0; f + 2 < k; ++f) used_[(order_[j].first + f) % faces] = 1;
         if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k, patches_[j]) ||
@@ -270,15 +281,21 @@ class StructureWriter {
             if (open_edges_[e] == r.open) choice = e + 1;
           if (r.open != kNone && choice == 0)
             return make_error(ErrorCode::kInvalidMesh, "internal: open edge of a boundary patch not on the boundary");
+          if (bits_) {
+            ++bits_->open_choices;
+            enc.set_cost_sink(&bits_->open_edge);
+          }
           m.open_edge.encode(enc, choice);
         } else if (r.open != kNone) {
           return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
         }
         const Vec3i pred = predict_position(s_.mesh, patches_[j].ring);
         const int shift = format_ >= 2 ? insertion_shift(s_, patches_[j].ring, min_shift) : 0;
+        if (bits_) enc.set_cost_sink(&bits_->residual);
         encode_coarse_residual(m, enc, residual_context(s_.mesh, patches_[j].ring), r.position, pred, shift,
                                geometry_[j]);
       }
+      enc.set_cost_sink(nullptr);
       const uint32_t vertices_before = s_.mesh.vertex_count();
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals_[order_[j].second];
@@ -320,6 +337,7 @@ class StructureWriter {
   RefinementState& s_;
   EncoderTruth& t_;
   uint8_t format_;
+  StructureBits* bits_;
   std::vector<Removal> removals_;
   size_t remaining_ = 0;
   bool starts_layer_ = false;
@@ -452,6 +470,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
     report->records.clear();
     report->base_shift = static_cast<uint32_t>(base_shift);
     report->plane_bits_raw = report->plane_bytes_coded = report->structure_bytes = 0;
+    report->structure_bits = StructureBits{};
     report->records.push_back({false, base_n, uint32_t(base.bytes.size()), hash_state(*state), 0});
   }
 
@@ -480,7 +499,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   };
   add_range(0, base_n);
 
-  StructureWriter writer(*state, truth, format);
+  StructureWriter writer(*state, truth, format, report ? &report->structure_bits : nullptr);
   size_t next_layer = dec.layers.size();  // layers restore from the last one
   double structure_slope = std::numeric_limits<double>::infinity();
   double plane_bits_per_step[kMaxShift + 1];

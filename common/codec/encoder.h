@@ -74,8 +74,24 @@ struct EncodedRecord {
   // record (grid units^2 x area), used to order records.
   double distortion_drop = 0;
 };
+// Ideal coded bits (-log2 p of each range-coded bit, RangeEncoder's cost
+// sink) of the structure records' symbol classes, summed over the stream,
+// and the events they describe: where the structure bytes go.
+struct StructureBits {
+  double count = 0;      // patch counts (walk steps with free faces)
+  double valence = 0;    // k of each inserted vertex
+  double rank = 0;       // start ranks
+  double open_edge = 0;  // boundary re-entry choices
+  double residual = 0;   // coarse position residuals at insertion
+  uint64_t walk_steps = 0;    // all walk steps
+  uint64_t count_steps = 0;   // walk steps that coded a count
+  uint64_t insertions = 0;
+  uint64_t open_choices = 0;  // patches that coded an open-edge choice
+};
+
 struct EncodeReport {
   std::vector<EncodedRecord> records;
+  StructureBits structure_bits;
   uint64_t plane_bits_raw = 0;    // plane bits and signs, uncoded (one bit each)
   uint64_t plane_bytes_coded = 0; // their context-coded payload (range-coded blocks)
   uint64_t structure_bytes = 0;   // structure records

@@ -3,6 +3,8 @@
 // 11-bit probabilities adapted by 1/32 of the error per bit.
 #include "common/codec/range_coder.h"
 
+#include <cmath>
+
 namespace meshstream {
 namespace {
 
@@ -33,6 +35,10 @@ void RangeEncoder::shift_low() {
 
 void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
   const uint32_t bound = (range_ >> kModelBits) * model.p;
+  if (cost_sink_) {
+    const double p0 = double(model.p) / double(1u << kModelBits);
+    *cost_sink_ -= std::log2(bit == 0 ? p0 : 1.0 - p0);
+  }
   if (bit == 0) {
     range_ = bound;
     model.p = static_cast<uint16_t>(model.p + (((1u << kModelBits) - model.p) >> kMoveBits));
@@ -48,6 +54,7 @@ void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
 }
 
 void RangeEncoder::encode_direct(uint32_t value, int count) {
+  if (cost_sink_) *cost_sink_ += count;
   for (int i = count - 1; i >= 0; --i) {
     range_ >>= 1;
     if ((value >> i) & 1u) low_ += range_;

@@ -32,6 +32,11 @@ class RangeEncoder {
   // Ends the stream; returns the bytes. The encoder is spent afterwards.
   std::vector<uint8_t> finish();
   size_t bytes_so_far() const { return out_.size() + cache_size_; }
+  // Measurement only: while set, every coded bit adds its ideal cost
+  // (-log2 of the probability the model gave it; 1 per direct bit) to
+  // *sink, so an encoder can tell which symbols the bytes went to. Costs one
+  // branch per bit when unset. nullptr stops counting.
+  void set_cost_sink(double* sink) { cost_sink_ = sink; }
 
  private:
   void shift_low();
@@ -41,6 +46,7 @@ class RangeEncoder {
   uint64_t cache_size_ = 1;
   bool first_ = true;  // the first byte LZMA emits is always 0: we drop it
   std::vector<uint8_t> out_;
+  double* cost_sink_ = nullptr;
 };
 
 // The decoder side is defined here, inline: a record's decoding loop can
