@@ -152,24 +152,7 @@ class LayerBuilder {
     uint32_t best_apex = kNone;
     for (uint32_t a = 0; a < k; ++a) {
       const uint32_t apex = ring_[a];
-      m_.star(apex, apex_ring_, apex_corners_);
       bool ok = true;
-      if (k == 3 && !boundary) {
-        // The single new triangle must not already exist (a tetrahedron's
-        // last vertex): look for a face of the apex holding both others.
-        const uint32_t b = ring_[(a + 1) % 3], c = ring_[(a + 2) % 3];
-        for (uint32_t corner : apex_corners_) {
-          const uint32_t x = m_.vertex(EditableMesh::next(corner));
-          const uint32_t y = m_.vertex(EditableMesh::prev(corner));
-          if ((x == b && y == c) || (x == c && y == b)) ok = false;
-        }
-      } else {
-        for (uint32_t j = 2; j + 2 <= k && ok; ++j) {
-          const uint32_t w = ring_[(a + j) % k];
-          if (std::find(apex_ring_.begin(), apex_ring_.end(), w) != apex_ring_.end()) ok = false;
-        }
-      }
-      if (!ok) continue;
       double worst = 1e300;
       for (uint32_t j = 1; j + 1 < k && ok; ++j) {
         const Vec3i A = p[apex], B = p[ring_[(a + j) % k]], C = p[ring_[(a + j + 1) % k]];
@@ -192,12 +175,29 @@ class LayerBuilder {
       if (!ok) continue;
       // The fan from `apex` is the half-edge collapse of v into it: least
       // quadric error wins, triangle shape (worst in [0, 0.29]) breaks
-      // near-ties worth up to ~3 grid steps.
+      // near-ties worth up to ~3 grid steps. The first best in ring order.
       const double score = kShapeWeight * worst - std::sqrt(quadrics[v].mean_error(p[apex]));
-      if (best_apex == kNone || score > best_quality) {
-        best_quality = score;
-        best_apex = a;
+      if (best_apex != kNone && score <= best_quality) continue;
+      // Only an apex that would win pays for its star (the edge checks).
+      m_.star(apex, apex_ring_, apex_corners_);
+      if (k == 3 && !boundary) {
+        // The single new triangle must not already exist (a tetrahedron's
+        // last vertex): look for a face of the apex holding both others.
+        const uint32_t b = ring_[(a + 1) % 3], c = ring_[(a + 2) % 3];
+        for (uint32_t corner : apex_corners_) {
+          const uint32_t x = m_.vertex(EditableMesh::next(corner));
+          const uint32_t y = m_.vertex(EditableMesh::prev(corner));
+          if ((x == b && y == c) || (x == c && y == b)) ok = false;
+        }
+      } else {
+        for (uint32_t j = 2; j + 2 <= k && ok; ++j) {
+          const uint32_t w = ring_[(a + j) % k];
+          if (std::find(apex_ring_.begin(), apex_ring_.end(), w) != apex_ring_.end()) ok = false;
+        }
       }
+      if (!ok) continue;
+      best_quality = score;
+      best_apex = a;
     }
     if (best_apex != kNone) error = quadrics[v].mean_error(p[ring_[best_apex]]);
     return best_apex;
