@@ -55,16 +55,17 @@ struct IncrementalDecoder::State {
     if (h.base_coder != kBaseCoderOwn && h.base_coder != kBaseCoderDraco) {
       return make_error(ErrorCode::kUnsupported, "unknown base mesh coder " + std::to_string(h.base_coder));
     }
-    if (h.extra.empty() || (h.extra[0] != kRefinementFormatPlain && h.extra[0] != kRefinementFormat)) {
+    if (h.extra.empty() || h.extra[0] < kRefinementFormatPlain || h.extra[0] > kRefinementFormat) {
       return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
     }
     format = h.extra[0];
-    const uint8_t geometry_id = format == kRefinementFormat ? kGeometryCoderEmbedded : kGeometryCoderRangeAverage;
+    const bool embedded = format >= kRefinementFormatEmbedded;
+    const uint8_t geometry_id = embedded ? kGeometryCoderEmbedded : kGeometryCoderRangeAverage;
     if (h.structure_coder != kStructureCoderRange || h.geometry_coder != geometry_id) {
       return make_error(ErrorCode::kUnsupported, "unknown refinement coder ids");
     }
     base_shift = 0;
-    if (format == kRefinementFormat) {
+    if (embedded) {
       if (h.extra.size() < 2 || h.extra[1] > kMaxBaseShift || h.extra[1] >= h.quant_bits) {
         return make_error(ErrorCode::kCorrupt, "stream header has no valid base shift");
       }

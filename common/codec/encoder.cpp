@@ -185,7 +185,9 @@ class StructureWriter {
  public:
   // `bits` (optional) receives the cost of each symbol class.
   StructureWriter(RefinementState& state, EncoderTruth& truth, uint8_t format, StructureBits* bits)
-      : s_(state), t_(truth), format_(format), bits_(bits) {}
+      : s_(state), t_(truth), format_(format), bits_(bits) {
+    s_.models.v_models = format >= 3;
+  }
 
   bool layer_open() const { return remaining_ > 0; }
 
@@ -248,13 +250,19 @@ class StructureWriter {
           ++bits_->count_steps;
           enc.set_cost_sink(&bits_->count);
         }
-        m.patch_count[count_context(s_, u, free_faces)].encode(enc, std::min(count, 3u));
-        if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
+        if (m.v_models) {
+          count_model3(s_, u, free_faces).encode(enc, std::min(count, 3u));
+          if (count >= 3) m.patch_count_extra3.encode(enc, count - 3);
+        } else {
+          m.patch_count[count_context(s_, u, free_faces)].encode(enc, std::min(count, 3u));
+          if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
+        }
       } else if (count > 0) {
         return make_error(ErrorCode::kInvalidMesh, "internal: patch at a vertex without free faces");
       }
       s_.last_count = count;
       patches_.resize(count);
+      uint32_t free_left = free_faces;
       geometry_.resize(count);
       for (uint32_t j = 0; j < count; ++j) {
         const Removal& r = removals_[order_[j].second];
@@ -263,12 +271,23 @@ class StructureWriter {
           ++bits_->insertions;
           enc.set_cost_sink(&bits_->valence);
         }
-        m.valence[std::min(ring_size, 12u)].encode(enc, k - 3);
-        rank_patch_starts(s_.mesh, u, star_ring_, used_, k, candidates_);
+        if (m.v_models) {
+          valence_model3(s_, ring_size, free_left).encode(enc, k - 3);
+        } else {
+          m.valence[std::min(ring_size, 12u)].encode(enc, k - 3);
+        }
+        free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
+        rank_patch_starts(s_.mesh, u, star_ring_, used_, k, candidates_, scores_);
         const auto it = std::find(candidates_.begin(), candidates_.end(), order_[j].first);
         if (it == candidates_.end()) return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
         if (bits_) enc.set_cost_sink(&bits_->rank);
-        encode_start_rank(m, enc, k, static_cast<uint32_t>(it - candidates_.begin()));
+        const uint32_t rank = static_cast<uint32_t>(it - candidates_.begin());
+        if (format_ >= 3) {
+          const size_t c = candidates_.size();
+          encode_start_rank3(m, enc, start_rank_context(k, c, scores_[0], c > 1 ? scores_[1] : -1), c, rank);
+        } else {
+          encode_start_rank(m, enc, k, rank);
+        }
         for (uint32_t f = 0; f + 2 < k; ++f) used_[(order_[j].first + f) % faces] = 1;
         if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k, patches_[j]) ||
             patches_[j].ring != r.ring) {
@@ -285,7 +304,11 @@ class StructureWriter {
             ++bits_->open_choices;
             enc.set_cost_sink(&bits_->open_edge);
           }
-          m.open_edge.encode(enc, choice);
+          if (m.v_models) {
+            m.open_edge3.encode(enc, choice);
+          } else {
+            m.open_edge.encode(enc, choice);
+          }
         } else if (r.open != kNone) {
           return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
         }
@@ -347,6 +370,7 @@ class StructureWriter {
   std::vector<ResolvedPatch> patches_;
   std::vector<VertexGeometry> geometry_;
   std::vector<uint8_t> used_;
+  std::vector<int64_t> scores_;
 };
 
 // A plane step's true bits without coding them (for estimates).

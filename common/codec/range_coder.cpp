@@ -53,6 +53,26 @@ void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
   }
 }
 
+void RangeEncoder::encode_bit(BitModelV& model, uint32_t bit) {
+  const uint32_t p = model.state & ((1u << kModelBits) - 1);
+  const uint32_t bound = (range_ >> kModelBits) * p;
+  if (cost_sink_) {
+    const double p0 = double(p) / double(1u << kModelBits);
+    *cost_sink_ -= std::log2(bit == 0 ? p0 : 1.0 - p0);
+  }
+  if (bit == 0) {
+    range_ = bound;
+  } else {
+    low_ += bound;
+    range_ -= bound;
+  }
+  model.state = bit_model_next(model.state, bit);
+  while (range_ < kTop) {
+    range_ <<= 8;
+    shift_low();
+  }
+}
+
 void RangeEncoder::encode_direct(uint32_t value, int count) {
   if (cost_sink_) *cost_sink_ += count;
   for (int i = count - 1; i >= 0; --i) {
@@ -84,7 +104,8 @@ std::vector<uint8_t> RangeEncoder::finish() {
   return std::move(out_);
 }
 
-void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
+template <class Model>
+void AdaptiveUIntModelT<Model>::encode(RangeEncoder& enc, uint32_t value) {
   const uint64_t v = uint64_t(value) + 1;  // >= 1, so it has a leading one
   int len = 0;
   while ((v >> len) > 1) ++len;  // v in [2^len, 2^(len+1))
@@ -107,12 +128,18 @@ void AdaptiveUIntModel::encode(RangeEncoder& enc, uint32_t value) {
   if (rest > 0) enc.encode_direct(static_cast<uint32_t>(v & ((uint64_t(1) << rest) - 1)), rest);
 }
 
-void AdaptiveIntModel::encode(RangeEncoder& enc, int32_t value) {
+template <class Model>
+void AdaptiveIntModelT<Model>::encode(RangeEncoder& enc, int32_t value) {
   enc.encode_bit(zero, value == 0 ? 0 : 1);
   if (value == 0) return;
   enc.encode_bit(sign, value < 0 ? 1 : 0);
   const uint32_t mag = value < 0 ? static_cast<uint32_t>(-int64_t(value)) : static_cast<uint32_t>(value);
   magnitude.encode(enc, mag - 1);
 }
+
+template struct AdaptiveUIntModelT<BitModel>;
+template struct AdaptiveUIntModelT<BitModelV>;
+template struct AdaptiveIntModelT<BitModel>;
+template struct AdaptiveIntModelT<BitModelV>;
 
 }  // namespace meshstream

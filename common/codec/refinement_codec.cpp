@@ -9,6 +9,7 @@
 #include "common/codec/decimate.h"
 
 namespace meshstream {
+
 namespace {
 
 Status bad(const std::string& what) { return make_error(ErrorCode::kCorrupt, what); }
@@ -158,7 +159,11 @@ void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const R
     out.mag[a] = mag;
     if (mag > 0 && r < 0) out.negative |= uint8_t(1u << a);
     if (role == 0 && ctx.flip) q = -q;
-    models.residual[bucket][role].encode(enc, q);
+    if (models.v_models) {
+      models.residual3[bucket][role].encode(enc, q);
+    } else {
+      models.residual[bucket][role].encode(enc, q);
+    }
   }
 }
 
@@ -177,7 +182,7 @@ MESHSTREAM_DECODE_INLINE bool decode_residual_inline(RefinementModels& models, R
   out.normal_axis = static_cast<uint8_t>(ctx.axis[0]);
   for (int role = 0; role < 3; ++role) {
     const int a = ctx.axis[role];
-    int64_t q = models.residual[bucket][role].decode(dec);
+    int64_t q = models.v_models ? models.residual3[bucket][role].decode(dec) : models.residual[bucket][role].decode(dec);
     if (role == 0 && ctx.flip) q = -q;
     const int64_t mag = q < 0 ? -q : q;
     if ((mag << shift) > int64_t(max_coordinate)) return false;
@@ -327,6 +332,15 @@ void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vecto
   sort_patch_starts(out, scratch.score);
 }
 
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
+                       std::vector<int64_t>& scores) {
+  StartScratch scratch(static_cast<uint32_t>(used.size()));
+  score_patch_starts(mesh, apex, star_ring, used, k, out, scratch);
+  sort_patch_starts(out, scratch.score);
+  scores.assign(scratch.score, scratch.score + out.size());
+}
+
 uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
                             const std::vector<uint8_t>& used, uint32_t k, uint32_t rank,
                             std::vector<uint32_t>& scratch_starts) {
@@ -364,6 +378,18 @@ void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint3
   } else {
     tree.encode(enc, 15);
     m.start_rank_big.encode(enc, rank - 15);
+  }
+}
+
+void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context, size_t candidates,
+                        uint32_t rank) {
+  if (candidates <= 1) return;
+  BitTreeModel<4, BitModelV>& tree = m.start_rank3[context];
+  if (rank < 15) {
+    tree.encode(enc, rank);
+  } else {
+    tree.encode(enc, 15);
+    m.start_rank_big3.encode(enc, rank - 15);
   }
 }
 
@@ -492,6 +518,53 @@ std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, 
   return out;
 }
 
+namespace {
+
+MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline3(RefinementModels& m, RangeDecoder& dec,
+                                                            uint32_t context) {
+  const uint32_t rank = m.start_rank3[context].decode(dec);
+  return rank < 15 ? rank : 15 + m.start_rank_big3.decode(dec);
+}
+
+// Format 3's decoder side of the start: the candidates are scored first
+// (their number and the lead of the best score are the rank's context),
+// then the rank is read (nothing for a single candidate) and its start
+// picked, the best by a linear scan. kNone when the rank is out of range.
+template <class DecodeRank>
+MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, uint32_t apex,
+                                                      const std::vector<uint32_t>& star_ring,
+                                                      const std::vector<uint8_t>& used, uint32_t k,
+                                                      std::vector<uint32_t>& starts, DecodeRank&& decode_rank,
+                                                      uint32_t& rank) {
+  StartScratch scratch(static_cast<uint32_t>(used.size()));
+  score_patch_starts(mesh, apex, star_ring, used, k, starts, scratch);
+  const size_t n = starts.size();
+  if (n == 0) {
+    rank = 0;
+    return kNone;
+  }
+  // The best (first of the largest: ties keep the smaller r, as the stable
+  // sort orders them) and the second best score.
+  size_t best = 0;
+  int64_t second = -1;
+  for (size_t i = 1; i < n; ++i) {
+    const int64_t sc = scratch.score[i];
+    if (sc > scratch.score[best]) {
+      second = scratch.score[best];
+      best = i;
+    } else if (sc > second) {
+      second = sc;
+    }
+  }
+  rank = n > 1 ? decode_rank(start_rank_context(k, n, scratch.score[best], second)) : 0;
+  if (rank >= n) return kNone;
+  if (rank == 0) return starts[best];
+  sort_patch_starts(starts, scratch.score);
+  return starts[rank];
+}
+
+}  // namespace
+
 Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
                                uint32_t expected_vertices, uint32_t expected_faces,
                                AppliedRecord& applied) {
@@ -539,6 +612,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
 
   RangeDecoder dec(payload.subspan(pos));
   RefinementModels& m = state.models;
+  m.v_models = state.format >= 3;
   EditableMesh& mesh = state.mesh;
   std::vector<uint32_t> star_ring, star_corners;
   std::vector<ResolvedPatch> patches;
@@ -572,8 +646,13 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     const uint32_t free_faces = free_face_count(state, u);
     uint32_t count = 0;
     if (free_faces > 0) {
-      count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
-      if (count == 3) count += m.patch_count_extra.decode(dec);
+      if (m.v_models) {
+        count = count_model3(state, u, free_faces).decode(dec);
+        if (count == 3) count += m.patch_count_extra3.decode(dec);
+      } else {
+        count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
+        if (count == 3) count += m.patch_count_extra.decode(dec);
+      }
     }
     state.last_count = count;
     if (count == 0) continue;
@@ -605,13 +684,22 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     patches.resize(count);
     positions.resize(count);
     opens.resize(count);
+    uint32_t free_left = free_faces;
     for (uint32_t i = 0; i < count; ++i) {
-      const uint32_t k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
-      // The rank depends only on k, so it is read first: the decoder then
-      // needs only the start of that rank, most often the best one (a
-      // linear scan), not the whole ordered list the encoder searches.
-      const uint32_t rank = decode_start_rank_inline(m, dec, k);
-      const uint32_t r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
+      const uint32_t k = (m.v_models ? valence_model3(state, ring_size, free_left).decode(dec)
+                                     : m.valence[std::min(ring_size, 12u)].decode(dec)) + 3;
+      uint32_t rank = 0, r = kNone;
+      if (state.format < 3) {
+        // The rank depends only on k, so it is read first: the decoder then
+        // needs only the start of that rank, most often the best one (a
+        // linear scan), not the whole ordered list the encoder searches.
+        rank = decode_start_rank_inline(m, dec, k);
+        r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
+      } else {
+        r = select_patch_start3(mesh, u, star_ring, used_faces, k, candidates,
+                                [&](uint32_t context) { return decode_start_rank_inline3(m, dec, context); }, rank);
+      }
+      free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
       if (r == kNone) {
         return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
                     std::to_string(k) + ", start rank " + std::to_string(rank) + ") does not fit its star of " +
@@ -624,7 +712,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
       opens[i] = kNone;
       patch_boundary_edges(mesh, patches[i], open_edges);
       if (!open_edges.empty()) {
-        const uint32_t choice = m.open_edge.decode(dec);
+        const uint32_t choice = m.v_models ? m.open_edge3.decode(dec) : m.open_edge.decode(dec);
         if (choice > open_edges.size()) {
           return fail("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
                                  std::to_string(choice) + " of " + std::to_string(open_edges.size()));

@@ -22,6 +22,10 @@
 // A record covers a run of the walk (a batch); the first record of a layer
 // restarts the walk. Record payload: u8 flags (bit 0: starts a layer),
 // varint walk steps, varint insertions, then one range-coded block.
+// Format 3 (kRefinementFormat) keeps this layout and codes the same symbols
+// through models that learn faster at first (BitModelV), with the valence
+// also by the apex's free faces and the start rank by the number of
+// candidate runs and the lead of the best (docs/hcs-format.md).
 #pragma once
 
 #include <algorithm>
@@ -46,6 +50,18 @@ struct RefinementModels {
   BitTreeModel<4> valence[13];       // k - 3 (k <= 18), by min(apex ring size, 12)
   AdaptiveIntModel residual[kScaleContexts][3];
   AdaptiveUIntModel open_edge;       // 0 interior vertex, i+1: re-enters boundary edge i
+  // Format 3 codes every refinement symbol through models whose adaptation
+  // slows as they learn (BitModelV), with finer contexts for valences and
+  // start ranks (valence_model3, start_rank_context). Plane records keep
+  // GeometryModels in every format.
+  bool v_models = false;  // format >= 3: use the models below (set by the coders)
+  BitTreeModel<2, BitModelV> patch_count3[8 * 2 * 3 * 4];  // by count_context
+  AdaptiveUIntModelV patch_count_extra3;
+  BitTreeModel<4, BitModelV> valence3[13 * 8];     // by valence_model3
+  BitTreeModel<4, BitModelV> start_rank3[6 * 3 * 4];  // by start_rank_context
+  AdaptiveUIntModelV start_rank_big3;
+  AdaptiveIntModelV residual3[kScaleContexts][3];
+  AdaptiveUIntModelV open_edge3;
 };
 
 struct RefinementState {
@@ -83,7 +99,8 @@ struct RefinementState {
   std::vector<VertexGeometry> geometry;
   GeometryModels geometry_models;
   // Refinement record format (header extra[0]): 1 = issue I's records (no
-  // shift field, no plane records), 2 = embedded geometry.
+  // shift field, no plane records), 2 = embedded geometry, 3 = the same
+  // records through RefinementModels' format-3 models and contexts.
   uint8_t format = 2;
 
   // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
@@ -127,6 +144,35 @@ inline uint32_t count_context(const RefinementState& s, uint32_t u, uint32_t fre
   const uint32_t val = std::min<uint32_t>(s.vertices[u].valence, 12);
   const uint32_t vb = val <= 5 ? 0 : val == 6 ? 1 : val <= 8 ? 2 : 3;
   return ((std::min<uint32_t>(free_faces, 7) * 2 + (s.last_count > 0 ? 1 : 0)) * 3 + age) * 4 + vb;
+}
+
+// Format 3's model of the patch count: count_context's, adapting by
+// BitModelV. (Tried and dropped, no gain over 13 meshes: whether u has
+// faces taken in this layer — never, the layers' removals are independent
+// — the count two walk steps back, and the number of u's free faces whose
+// two other vertices the walk has already visited, which only a patch at u
+// could still use.)
+inline BitTreeModel<2, BitModelV>& count_model3(RefinementState& s, uint32_t u, uint32_t free_faces) {
+  return s.models.patch_count3[count_context(s, u, free_faces)];
+}
+
+// Format 3's model of k - 3 for a patch at apex u: by u's ring size (as
+// format 2) and the free faces of u left for it (min 7; k - 2 of them
+// become the fan, after the patches already read at u).
+inline BitTreeModel<4, BitModelV>& valence_model3(RefinementState& s, uint32_t ring_size, uint32_t free_left) {
+  return s.models.valence3[std::min(ring_size, 12u) * 8 + std::min<uint32_t>(free_left, 7)];
+}
+
+// Format 3's context of a start rank: k, the number of candidate runs
+// (1 codes nothing) and how far the best run's score leads the second's.
+// (candidates 2, 3-4, 5+; best/second below 1.25, 2, 4, or more).
+// Scores are sums of at most 15 squared grid lengths (< 2^46 at 20 bits):
+// the products cannot overflow.
+inline uint32_t start_rank_context(uint32_t k, size_t candidates, int64_t best, int64_t second) {
+  const uint32_t kb = std::min(k - 3, 5u);
+  const uint32_t cb = candidates <= 2 ? 0 : candidates <= 4 ? 1 : 2;
+  const uint32_t gap = 4 * best < 5 * second ? 0 : best < 2 * second ? 1 : best < 4 * second ? 2 : 3;
+  return (kb * 3 + cb) * 4 + gap;
 }
 
 
@@ -195,6 +241,14 @@ int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring,
 // order list. Returns its id; appends written face slots to `touched`.
 // The rank of a patch's start among rank_patch_starts' candidates.
 void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint32_t rank);
+// Format 3: nothing when there is one candidate, else through the model of
+// start_rank_context.
+void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context, size_t candidates,
+                        uint32_t rank);
+// rank_patch_starts with the candidates' scores in the same order.
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
+                       std::vector<int64_t>& scores);
 uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k);
 
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,

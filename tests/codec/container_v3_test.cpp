@@ -350,10 +350,12 @@ TEST(ContainerV3, TrailingOrMissingIndexBytesAreRefused) {
   auto full = read_stream_index(clean);
   ASSERT_TRUE(full);
   // The decoder reads as many bytes as the encoder wrote before dropping up
-  // to 4 trailing zeros, so up to that many extra bytes take the zeros'
-  // place (they decode the same symbols); 5 never fit.
+  // to 4 trailing zeros, so up to that many extra zero bytes take the
+  // dropped zeros' place (they decode the same symbols); 5 never fit. (Other
+  // byte values would change the last symbols, which may then read all the
+  // bytes and fail a count check instead: refused, but not as "trailing".)
   std::vector<uint8_t> longer = clean;
-  longer.insert(longer.begin() + a.coded_at + a.length, 5, uint8_t(0x5A));
+  longer.insert(longer.begin() + a.coded_at + a.length, 5, uint8_t(0));
   put_u32(longer, a.count_at + 4, uint32_t(a.length + 5));
   reseal_checksums(longer);
   auto index = read_stream_index(longer);
