@@ -436,7 +436,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
                                   const DecimationResult& dec, const EncodeOptions& options,
                                   uint32_t record_bytes, double plane_calibration, EncodeReport* report) {
   const int bits = grid.bits;
-  const uint8_t format = kRefinementFormat;
+  const uint8_t format = options.refinement_format == 0 ? kRefinementFormat
+                                                        : static_cast<uint8_t>(options.refinement_format);
   const int base_shift =
       options.embedded ? std::clamp(options.base_shift < 0 ? bits - 10 : options.base_shift, 0,
                                     std::min(kMaxBaseShift, bits - 1))
@@ -677,6 +678,11 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
 
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,
                                         EncodeReport* report) {
+  if (options.refinement_format != 0 && options.refinement_format != kRefinementFormatEmbedded &&
+      options.refinement_format != kRefinementFormat) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "refinement format " + std::to_string(options.refinement_format) + " cannot be written (2 or 3)");
+  }
   auto grid = make_grid(mesh, options.quant_bits);
   if (!grid) return tl::unexpected(grid.error());
   if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());

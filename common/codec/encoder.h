@@ -43,6 +43,10 @@ struct EncodeOptions {
   // worse than 0 on every mesh tried (more plane records and index entries,
   // see docs/hcs-format.md); kept for experiments.
   int insertion_shift = 0;
+  // Refinement record format written: 0 = kRefinementFormat (3); 2 =
+  // format 2's models, kept as the peer benchmarks compare against (same
+  // records, slower-learning models). Anything else is kInvalidArgument.
+  int refinement_format = 0;
 };
 
 // The balances the automatic choice tries, the first is encoded first (see

@@ -42,14 +42,26 @@ inline constexpr uint32_t kBitModelVSeenShift = 11;
 inline constexpr uint32_t kBitModelVSeenMax = 14;
 // Adaptation shift of a BitModelV that has seen `n` bits (n <= 14).
 inline constexpr uint32_t bit_model_rate(uint32_t n) { return 2 + (n >= 2) + (n >= 6) + (n >= 14); }
-// The model's state after coding `bit`.
-MESHSTREAM_MODEL_INLINE uint16_t bit_model_next(uint32_t state, uint32_t bit) {
-  const uint32_t n = state >> kBitModelVSeenShift;
+// The model's state after coding a 0 / a 1 (one function per bit, so the
+// decoder updates inside the branch that found the bit).
+MESHSTREAM_MODEL_INLINE uint16_t bit_model_after0(uint32_t state) {
   const uint32_t p = state & 2047u;
-  const uint32_t rate = bit_model_rate(n);
-  const uint32_t q = bit == 0 ? p + ((2048u - p) >> rate) : p - (p >> rate);
-  const uint32_t seen = n + (n < kBitModelVSeenMax ? 1u : 0u);
-  return static_cast<uint16_t>(q | (seen << kBitModelVSeenShift));
+  if (state >= (kBitModelVSeenMax << kBitModelVSeenShift)) {
+    // Learned (most bits of a large mesh): BitModel's update, which keeps
+    // p within 11 bits, so the count bits above stay as they are.
+    return static_cast<uint16_t>(state + ((2048u - p) >> 5));
+  }
+  const uint32_t n = state >> kBitModelVSeenShift;  // < kBitModelVSeenMax
+  return static_cast<uint16_t>((p + ((2048u - p) >> bit_model_rate(n))) | ((n + 1) << kBitModelVSeenShift));
+}
+MESHSTREAM_MODEL_INLINE uint16_t bit_model_after1(uint32_t state) {
+  const uint32_t p = state & 2047u;
+  if (state >= (kBitModelVSeenMax << kBitModelVSeenShift)) return static_cast<uint16_t>(state - (p >> 5));
+  const uint32_t n = state >> kBitModelVSeenShift;
+  return static_cast<uint16_t>((p - (p >> bit_model_rate(n))) | ((n + 1) << kBitModelVSeenShift));
+}
+MESHSTREAM_MODEL_INLINE uint16_t bit_model_next(uint32_t state, uint32_t bit) {
+  return bit == 0 ? bit_model_after0(state) : bit_model_after1(state);
 }
 
 class RangeEncoder {
@@ -114,13 +126,14 @@ class RangeDecoder {
     uint32_t bit;
     if (code_ < bound) {
       range_ = bound;
+      model.state = bit_model_after0(model.state);
       bit = 0;
     } else {
       code_ -= bound;
       range_ -= bound;
+      model.state = bit_model_after1(model.state);
       bit = 1;
     }
-    model.state = bit_model_next(model.state, bit);
     while (range_ < (1u << 24)) {
       range_ <<= 8;
       code_ = (code_ << 8) | next_byte();

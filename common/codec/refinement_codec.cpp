@@ -159,11 +159,7 @@ void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const R
     out.mag[a] = mag;
     if (mag > 0 && r < 0) out.negative |= uint8_t(1u << a);
     if (role == 0 && ctx.flip) q = -q;
-    if (models.v_models) {
-      models.residual3[bucket][role].encode(enc, q);
-    } else {
-      models.residual[bucket][role].encode(enc, q);
-    }
+    models.residual[bucket][role].encode(enc, q);
   }
 }
 
@@ -182,7 +178,7 @@ MESHSTREAM_DECODE_INLINE bool decode_residual_inline(RefinementModels& models, R
   out.normal_axis = static_cast<uint8_t>(ctx.axis[0]);
   for (int role = 0; role < 3; ++role) {
     const int a = ctx.axis[role];
-    int64_t q = models.v_models ? models.residual3[bucket][role].decode(dec) : models.residual[bucket][role].decode(dec);
+    int64_t q = models.residual[bucket][role].decode(dec);
     if (role == 0 && ctx.flip) q = -q;
     const int64_t mag = q < 0 ? -q : q;
     if ((mag << shift) > int64_t(max_coordinate)) return false;
@@ -565,6 +561,159 @@ MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, 
 
 }  // namespace
 
+// The range-coded block of a structure record, after its header: one
+// instance per model family (V: format 3's models), so the decoding loop,
+// inlined whole, holds no per-symbol format branches.
+template <bool V>
+Status decode_structure_block(RefinementState& state, std::span<const uint8_t> block, const RecordHeader& h,
+                              uint32_t expected_vertices, uint32_t expected_faces, AppliedRecord& applied) {
+  RangeDecoder dec(block);
+  RefinementModels& m = state.models;
+  EditableMesh& mesh = state.mesh;
+  std::vector<uint32_t> star_ring, star_corners;
+  std::vector<ResolvedPatch> patches;
+  std::vector<VertexGeometry> positions;
+  std::vector<uint32_t> opens, open_edges, candidates;
+  std::vector<uint8_t> used_faces;
+  uint32_t inserted = 0;
+  // On error the state is left half-applied: the caller discards it (the
+  // decoder's output mesh is only updated after a record succeeds).
+  auto fail = [&](const std::string& what) -> Status { return bad(what); };
+
+  for (uint32_t step = 0; step < h.walk_steps; ++step) {
+    while (state.cursor != kNone && state.vertices[state.cursor].layer == state.layer) {
+      state.cursor = state.vertices[state.cursor].next;
+    }
+    if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
+    const uint32_t u = state.cursor;
+    state.cursor = state.vertices[u].next;
+    // The order list jumps around memory: start loading what the next two
+    // walk vertices need while this one is decoded (the entry and start
+    // corner of the one after next, the first star face of the next, whose
+    // entry and corner were asked for one step ago).
+    if (state.cursor != kNone) {
+      const uint32_t after = state.vertices[state.cursor].next;
+      if (after != kNone) {
+        __builtin_prefetch(&state.vertices[after]);
+        mesh.prefetch_vertex(after);
+      }
+      mesh.prefetch_first_face(state.cursor);
+    }
+    const uint32_t free_faces = free_face_count(state, u);
+    uint32_t count = 0;
+    if (free_faces > 0) {
+      if constexpr (V) {
+        count = count_model3(state, u, free_faces).decode(dec);
+        if (count == 3) count += m.patch_count_extra3.decode(dec);
+      } else {
+        count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
+        if (count == 3) count += m.patch_count_extra.decode(dec);
+      }
+    }
+    state.last_count = count;
+    if (count == 0) continue;
+    mesh.star(u, star_ring, star_corners);
+    // Positions (patch scores), start corners (insert_vertex) and entries
+    // (apply_patch) of the ring are read after some bits are decoded: ask
+    // for them now.
+    for (uint32_t r : star_ring) {
+      mesh.prefetch_vertex(r);
+      __builtin_prefetch(&state.vertices[r]);
+    }
+    // So are the faces beyond the star's outer edges (insert_vertex links
+    // the new faces to them), which are also in the stars of the ring
+    // vertices the walk visits next. Their corners sit next to what star()
+    // just read, so asking costs no wait.
+    for (uint32_t c : star_corners) {
+      const uint32_t o = mesh.opposite(c);
+      if (o != kNone) mesh.prefetch_corner(o);
+    }
+    const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
+    const uint32_t faces = static_cast<uint32_t>(star_corners.size());
+    if (mark_taken_faces(state, star_ring, faces, used_faces) != free_faces) {
+      return fail("internal: free face counts disagree");
+    }
+    if (count > free_faces || inserted + count > h.insertions) {
+      return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
+                  " patches, more than it or the record holds");
+    }
+    patches.resize(count);
+    positions.resize(count);
+    opens.resize(count);
+    uint32_t free_left = free_faces;
+    for (uint32_t i = 0; i < count; ++i) {
+      uint32_t k;
+      if constexpr (V) {
+        k = valence_model3(state, ring_size, free_left).decode(dec) + 3;
+      } else {
+        k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
+      }
+      uint32_t rank = 0, r = kNone;
+      if constexpr (!V) {
+        // The rank depends only on k, so it is read first: the decoder then
+        // needs only the start of that rank, most often the best one (a
+        // linear scan), not the whole ordered list the encoder searches.
+        rank = decode_start_rank_inline(m, dec, k);
+        r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
+      } else {
+        r = select_patch_start3(mesh, u, star_ring, used_faces, k, candidates,
+                                [&](uint32_t context) { return decode_start_rank_inline3(m, dec, context); }, rank);
+      }
+      free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
+      if (r == kNone) {
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
+                    std::to_string(k) + ", start rank " + std::to_string(rank) + ") does not fit its star of " +
+                    std::to_string(faces) + " faces");
+      }
+      if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " does not fit");
+      }
+      for (uint32_t j = 0, f = r; j + 2 < k; ++j, f = f + 1 == faces ? 0 : f + 1) used_faces[f] = 1;
+      opens[i] = kNone;
+      patch_boundary_edges(mesh, patches[i], open_edges);
+      if (!open_edges.empty()) {
+        uint32_t choice;
+        if constexpr (V) {
+          choice = m.open_edge3.decode(dec);
+        } else {
+          choice = m.open_edge.decode(dec);
+        }
+        if (choice > open_edges.size()) {
+          return fail("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
+                                 std::to_string(choice) + " of " + std::to_string(open_edges.size()));
+        }
+        if (choice > 0) opens[i] = open_edges[choice - 1];
+      }
+      const Vec3i pred = predict_position(mesh, patches[i].ring);
+      const ResidualContext ctx = residual_context(mesh, patches[i].ring);
+      const int shift = insertion_shift(state, patches[i].ring, static_cast<int>(h.min_shift));
+      if (!decode_residual_inline(m, dec, ctx, pred, shift, state.max_coordinate, positions[i])) {
+        return fail("vertex position outside the quantization grid at vertex " +
+                               std::to_string(u));
+      }
+    }
+    if (dec.exhausted_badly()) return fail("refinement record data ends early");
+    for (uint32_t i = 0; i < count; ++i) {
+      const uint32_t v = apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
+      applied.added_vertices.push_back(v);
+    }
+    inserted += count;
+  }
+  if (inserted != h.insertions) {
+    return fail("refinement record holds " + std::to_string(inserted) + " insertions, its header says " +
+                           std::to_string(h.insertions));
+  }
+  if (dec.exhausted_badly()) return fail("refinement record data ends early");
+  if (mesh.vertex_count() != expected_vertices || mesh.face_slot_count() != expected_faces) {
+    return fail("refinement record yields " + std::to_string(mesh.vertex_count()) +
+                           " vertices and " + std::to_string(mesh.face_slot_count()) +
+                           " faces, the index says " + std::to_string(expected_vertices) + " and " +
+                           std::to_string(expected_faces));
+  }
+  return {};
+}
+
+
 Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
                                uint32_t expected_vertices, uint32_t expected_faces,
                                AppliedRecord& applied) {
@@ -610,142 +759,10 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     return bad("first refinement record does not start a layer");
   }
 
-  RangeDecoder dec(payload.subspan(pos));
-  RefinementModels& m = state.models;
-  m.v_models = state.format >= 3;
-  EditableMesh& mesh = state.mesh;
-  std::vector<uint32_t> star_ring, star_corners;
-  std::vector<ResolvedPatch> patches;
-  std::vector<VertexGeometry> positions;
-  std::vector<uint32_t> opens, open_edges, candidates;
-  std::vector<uint8_t> used_faces;
-  uint32_t inserted = 0;
-  // On error the state is left half-applied: the caller discards it (the
-  // decoder's output mesh is only updated after a record succeeds).
-  auto fail = [&](const std::string& what) -> Status { return bad(what); };
-
-  for (uint32_t step = 0; step < h.walk_steps; ++step) {
-    while (state.cursor != kNone && state.vertices[state.cursor].layer == state.layer) {
-      state.cursor = state.vertices[state.cursor].next;
-    }
-    if (state.cursor == kNone) return fail("refinement walk runs past the last vertex");
-    const uint32_t u = state.cursor;
-    state.cursor = state.vertices[u].next;
-    // The order list jumps around memory: start loading what the next two
-    // walk vertices need while this one is decoded (the entry and start
-    // corner of the one after next, the first star face of the next, whose
-    // entry and corner were asked for one step ago).
-    if (state.cursor != kNone) {
-      const uint32_t after = state.vertices[state.cursor].next;
-      if (after != kNone) {
-        __builtin_prefetch(&state.vertices[after]);
-        mesh.prefetch_vertex(after);
-      }
-      mesh.prefetch_first_face(state.cursor);
-    }
-    const uint32_t free_faces = free_face_count(state, u);
-    uint32_t count = 0;
-    if (free_faces > 0) {
-      if (m.v_models) {
-        count = count_model3(state, u, free_faces).decode(dec);
-        if (count == 3) count += m.patch_count_extra3.decode(dec);
-      } else {
-        count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
-        if (count == 3) count += m.patch_count_extra.decode(dec);
-      }
-    }
-    state.last_count = count;
-    if (count == 0) continue;
-    mesh.star(u, star_ring, star_corners);
-    // Positions (patch scores), start corners (insert_vertex) and entries
-    // (apply_patch) of the ring are read after some bits are decoded: ask
-    // for them now.
-    for (uint32_t r : star_ring) {
-      mesh.prefetch_vertex(r);
-      __builtin_prefetch(&state.vertices[r]);
-    }
-    // So are the faces beyond the star's outer edges (insert_vertex links
-    // the new faces to them), which are also in the stars of the ring
-    // vertices the walk visits next. Their corners sit next to what star()
-    // just read, so asking costs no wait.
-    for (uint32_t c : star_corners) {
-      const uint32_t o = mesh.opposite(c);
-      if (o != kNone) mesh.prefetch_corner(o);
-    }
-    const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
-    const uint32_t faces = static_cast<uint32_t>(star_corners.size());
-    if (mark_taken_faces(state, star_ring, faces, used_faces) != free_faces) {
-      return fail("internal: free face counts disagree");
-    }
-    if (count > free_faces || inserted + count > h.insertions) {
-      return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
-                  " patches, more than it or the record holds");
-    }
-    patches.resize(count);
-    positions.resize(count);
-    opens.resize(count);
-    uint32_t free_left = free_faces;
-    for (uint32_t i = 0; i < count; ++i) {
-      const uint32_t k = (m.v_models ? valence_model3(state, ring_size, free_left).decode(dec)
-                                     : m.valence[std::min(ring_size, 12u)].decode(dec)) + 3;
-      uint32_t rank = 0, r = kNone;
-      if (state.format < 3) {
-        // The rank depends only on k, so it is read first: the decoder then
-        // needs only the start of that rank, most often the best one (a
-        // linear scan), not the whole ordered list the encoder searches.
-        rank = decode_start_rank_inline(m, dec, k);
-        r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
-      } else {
-        r = select_patch_start3(mesh, u, star_ring, used_faces, k, candidates,
-                                [&](uint32_t context) { return decode_start_rank_inline3(m, dec, context); }, rank);
-      }
-      free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
-      if (r == kNone) {
-        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
-                    std::to_string(k) + ", start rank " + std::to_string(rank) + ") does not fit its star of " +
-                    std::to_string(faces) + " faces");
-      }
-      if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
-        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " does not fit");
-      }
-      for (uint32_t j = 0, f = r; j + 2 < k; ++j, f = f + 1 == faces ? 0 : f + 1) used_faces[f] = 1;
-      opens[i] = kNone;
-      patch_boundary_edges(mesh, patches[i], open_edges);
-      if (!open_edges.empty()) {
-        const uint32_t choice = m.v_models ? m.open_edge3.decode(dec) : m.open_edge.decode(dec);
-        if (choice > open_edges.size()) {
-          return fail("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
-                                 std::to_string(choice) + " of " + std::to_string(open_edges.size()));
-        }
-        if (choice > 0) opens[i] = open_edges[choice - 1];
-      }
-      const Vec3i pred = predict_position(mesh, patches[i].ring);
-      const ResidualContext ctx = residual_context(mesh, patches[i].ring);
-      const int shift = insertion_shift(state, patches[i].ring, static_cast<int>(h.min_shift));
-      if (!decode_residual_inline(m, dec, ctx, pred, shift, state.max_coordinate, positions[i])) {
-        return fail("vertex position outside the quantization grid at vertex " +
-                               std::to_string(u));
-      }
-    }
-    if (dec.exhausted_badly()) return fail("refinement record data ends early");
-    for (uint32_t i = 0; i < count; ++i) {
-      const uint32_t v = apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
-      applied.added_vertices.push_back(v);
-    }
-    inserted += count;
-  }
-  if (inserted != h.insertions) {
-    return fail("refinement record holds " + std::to_string(inserted) + " insertions, its header says " +
-                           std::to_string(h.insertions));
-  }
-  if (dec.exhausted_badly()) return fail("refinement record data ends early");
-  if (mesh.vertex_count() != expected_vertices || mesh.face_slot_count() != expected_faces) {
-    return fail("refinement record yields " + std::to_string(mesh.vertex_count()) +
-                           " vertices and " + std::to_string(mesh.face_slot_count()) +
-                           " faces, the index says " + std::to_string(expected_vertices) + " and " +
-                           std::to_string(expected_faces));
-  }
-  return {};
+  state.models.v_models = state.format >= 3;
+  const std::span<const uint8_t> block = payload.subspan(pos);
+  return state.models.v_models ? decode_structure_block<true>(state, block, h, expected_vertices, expected_faces, applied)
+                               : decode_structure_block<false>(state, block, h, expected_vertices, expected_faces, applied);
 }
 
 }  // namespace meshstream

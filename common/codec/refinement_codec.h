@@ -50,17 +50,18 @@ struct RefinementModels {
   BitTreeModel<4> valence[13];       // k - 3 (k <= 18), by min(apex ring size, 12)
   AdaptiveIntModel residual[kScaleContexts][3];
   AdaptiveUIntModel open_edge;       // 0 interior vertex, i+1: re-enters boundary edge i
-  // Format 3 codes every refinement symbol through models whose adaptation
-  // slows as they learn (BitModelV), with finer contexts for valences and
-  // start ranks (valence_model3, start_rank_context). Plane records keep
-  // GeometryModels in every format.
+  // Format 3 codes the structure symbols (counts, valences, ranks, open
+  // edges) through models whose adaptation slows as they learn (BitModelV),
+  // with finer contexts for valences and start ranks (valence_model3,
+  // start_rank_context). Residuals keep `residual` (BitModelV there saved
+  // 0.2 % of the stream but cost 2-3 % of decode time), plane records
+  // GeometryModels, in every format.
   bool v_models = false;  // format >= 3: use the models below (set by the coders)
   BitTreeModel<2, BitModelV> patch_count3[8 * 2 * 3 * 4];  // by count_context
   AdaptiveUIntModelV patch_count_extra3;
   BitTreeModel<4, BitModelV> valence3[13 * 8];     // by valence_model3
   BitTreeModel<4, BitModelV> start_rank3[6 * 3 * 4];  // by start_rank_context
   AdaptiveUIntModelV start_rank_big3;
-  AdaptiveIntModelV residual3[kScaleContexts][3];
   AdaptiveUIntModelV open_edge3;
 };
 

@@ -178,7 +178,9 @@ TEST(HostileStream, ResealedPlaneRecordCorruption) {
   std::vector<size_t> planes;
   for (size_t i = 1; i < index->records.size(); ++i)
     if (clean[index->records[i].offset] == kRecordPlane) planes.push_back(i);
-  ASSERT_GT(planes.size(), 2u) << "the sample stream has plane records";
+  // How many depends on the encoder's record order (format 3's stream has
+  // 2, format 2's had more); two are victims enough for 300 trials.
+  ASSERT_GE(planes.size(), 2u) << "the sample stream has plane records";
   std::mt19937 rng(21);
   int errors = 0;
   for (int trial = 0; trial < 300; ++trial) {
