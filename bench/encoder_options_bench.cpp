@@ -60,6 +60,9 @@ std::vector<Variant> all_variants() {
   add("default", "the encoder's defaults", [](EncodeOptions&) {});
   add("base-shift-0", "exact base (12-bit)", [](EncodeOptions& o) { o.base_shift = 0; });
   add("base-shift-4", "8-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 4; });
+  add("base-shift-3", "9-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 3; });
+  add("base-shift-5", "7-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 5; });
+  add("base-shift-6", "6-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 6; });
   add("base-150", "decimate to about 150 base vertices", [](EncodeOptions& o) { o.target_base_vertices = 150; });
   add("base-600", "decimate to about 600 base vertices", [](EncodeOptions& o) { o.target_base_vertices = 600; });
   add("insertion-shift-2", "inserted vertices 2 bits coarser, sharpened by plane records",
