@@ -20,6 +20,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/real_mesh_list.h"
 #include "bench/codec/measurements.h"
 #include "bench/codec/rate_distortion.h"
 #include "bench/codec/report.h"
@@ -36,11 +37,7 @@
 namespace meshstream::bench {
 namespace {
 
-// The "real models" of ../shared/meshes/MANIFEST.md.
-const std::vector<std::string> kRealMeshes = {
-    "bun_zipper.ply", "bunny.off",       "bunny.stl",       "armadillo.obj", "fandisk.off",
-    "crank.off",      "casting.off",     "mask.off",        "hemisphere.off", "skull.obj",
-    "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"};
+// A quick run: a scan, a CAD part and a casting.
 const std::vector<std::string> kQuickMeshes = {"bunny.off", "fandisk.off", "casting.off"};
 
 struct Settings {
@@ -286,15 +283,6 @@ MeshMeasurements measure_mesh(const std::string& name, const Settings& s) {
   if (!m.rd_error.empty()) std::printf("%-16s rate-distortion: %s\n", name.c_str(), m.rd_error.c_str());
   std::fflush(stdout);
   return m;
-}
-
-std::vector<std::string> split_commas(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
 }
 
 }  // namespace

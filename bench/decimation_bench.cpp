@@ -38,6 +38,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/real_mesh_list.h"
 #include "bench/codec/timing.h"
 #include "bench/peers/draco_peer.h"
 #include "bench/peers/meshopt_lod.h"
@@ -53,10 +54,6 @@
 namespace meshstream::bench {
 namespace {
 
-const std::vector<std::string> kRealMeshes = {
-    "bun_zipper.ply", "bunny.off",       "bunny.stl",       "armadillo.obj", "fandisk.off",
-    "crank.off",      "casting.off",     "mask.off",        "hemisphere.off", "skull.obj",
-    "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"};
 constexpr double kFractions[3] = {1.0 / 64, 1.0 / 16, 1.0 / 4};
 const char* const kLabels[3] = {"1/64", "1/16", "1/4"};
 
@@ -457,14 +454,6 @@ void write_markdown(const std::string& path, const std::vector<MeshRow>& rows, c
           << l.ours_bytes_at_chain << ") | " << fmt("%.3g", l.ours_rms_at_chain) << " |\n";
     }
   }
-}
-
-std::vector<std::string> split_commas(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 }  // namespace

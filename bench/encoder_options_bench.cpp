@@ -23,6 +23,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench/real_mesh_list.h"
 #include "bench/peers/draco_peer.h"
 #include "bench/peers/meshopt_lod.h"
 #include "common/codec/container.h"
@@ -35,10 +36,6 @@
 namespace meshstream::bench {
 namespace {
 
-const std::vector<std::string> kRealMeshes = {
-    "bun_zipper.ply", "bunny.off",       "bunny.stl",       "armadillo.obj", "fandisk.off",
-    "crank.off",      "casting.off",     "mask.off",        "hemisphere.off", "skull.obj",
-    "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"};
 constexpr double kChainFractions[] = {1.0 / 64, 1.0 / 16, 1.0 / 4};
 constexpr const char* kChainLabels[] = {"1/64", "1/16", "1/4"};
 constexpr size_t kPoints = 3;
@@ -253,16 +250,6 @@ void write_report(const std::filesystem::path& file, const std::vector<MeshRow>&
     md << " |\n";
   }
   std::ofstream(file) << md.str();
-}
-
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
 }
 
 }  // namespace
