@@ -439,7 +439,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   const uint8_t format = options.refinement_format == 0 ? kRefinementFormat
                                                         : static_cast<uint8_t>(options.refinement_format);
   const int base_shift =
-      options.embedded ? std::clamp(options.base_shift < 0 ? bits - 10 : options.base_shift, 0,
+      options.embedded ? std::clamp(options.base_shift < 0 ? bits - 8 : options.base_shift, 0,
                                     std::min(kMaxBaseShift, bits - 1))
                        : 0;
   std::vector<Vec3i> coarse(q.size());

@@ -27,8 +27,9 @@ struct EncodeOptions {
   // insertion, no plane records (kept as a peer for the benchmark).
   bool embedded = true;
   // Low bits of the base positions sent later as plane records; -1 =
-  // automatic (quant_bits - 10: a 10-bit base measured best between 0 and
-  // 6 on the bunny, fandisk, casting and skull). Embedded only.
+  // automatic (quant_bits - 8: an 8-bit base; bench/encoder_options_bench
+  // on the 13 real meshes, after container 3's small index, scores shift 4
+  // best of 0 and 2..6 at 12 bits). Embedded only.
   int base_shift = -1;
   // How much the record ordering's distortion proxy values plane records
   // against structure records (encoder.cpp). 0 = automatic: the streams of
@@ -67,7 +68,7 @@ inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 6;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3 (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank contexts)
+inline constexpr uint32_t kEncoderVersion = 7;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3 (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank contexts); 7: 8-bit base by default
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {
