@@ -151,7 +151,8 @@ TEST(PlaneRecordUpdate, PositionUpdatesEqualAFullRefreshAfterEveryRecord) {
       std::sort(moved.begin(), moved.end());
       std::sort(expected.begin(), expected.end());
       EXPECT_EQ(moved, expected) << "record " << r;
-      EXPECT_FALSE(moved.empty()) << "record " << r;
+      // A plane record may move no vertex (a shift 1 -> 0 step whose bits are
+      // all zero): the equality above is the property, not a non-empty list.
     }
     ASSERT_TRUE(same_positions_and_faces(mirror, full)) << "mirror differs after record " << r;
 
