@@ -233,16 +233,23 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
                       "implausible record count " + std::to_string(record_count));
   }
   const size_t index_start = count_at;  // the index CRC covers the count too
-  // Every version allocates the entries only once the index bytes are there
-  // and checked: a hostile count costs no memory before.
-  if (version == 1) {
-    const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
-    if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
-    index.records.resize(record_count);
+  // The tail every version's index shares: wait until the index (ending at
+  // `index_end`) and its u32 CRC are all there, check that CRC, and note
+  // that record 0 starts right after it.
+  auto check_index_and_set_payload_offset = [&](size_t index_end) -> Status {
+    if (auto s = need(index_end + 4); !s) return s;
     if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
       return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
     }
     index.payload_offset = index_end + 4;
+    return {};
+  };
+  // Every version allocates the entries only once the index bytes are there
+  // and checked: a hostile count costs no memory before.
+  if (version == 1) {
+    const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
+    if (auto s = check_index_and_set_payload_offset(index_end); !s) return tl::unexpected(s.error());
+    index.records.resize(record_count);
     for (uint32_t i = 0; i < record_count; ++i) {
       const uint8_t* e = in.data() + count_at + 4 + size_t(i) * kIndexEntryBytes;
       RecordEntry& r = index.records[i];
@@ -264,11 +271,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     }
     const size_t entries_at = count_at + 8;
     const size_t index_end = entries_at + index_bytes;
-    if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
-    if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
-      return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
-    }
-    index.payload_offset = index_end + 4;
+    if (auto s = check_index_and_set_payload_offset(index_end); !s) return tl::unexpected(s.error());
     auto records = decode_record_index(in.subspan(entries_at, index_bytes), record_count, index.payload_offset);
     if (!records) return tl::unexpected(records.error());
     index.records = std::move(*records);
@@ -284,11 +287,7 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     }
     const size_t entries_at = count_at + 8;
     const size_t index_end = entries_at + index_bytes;
-    if (auto s = need(index_end + 4); !s) return tl::unexpected(s.error());
-    if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
-      return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
-    }
-    index.payload_offset = index_end + 4;
+    if (auto s = check_index_and_set_payload_offset(index_end); !s) return tl::unexpected(s.error());
     index.records.resize(record_count);
     size_t pos = entries_at;
     uint64_t offset = index.payload_offset, vertices = 0, faces = 0;

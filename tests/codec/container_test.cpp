@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "common/codec/crc32.h"
+#include "tests/codec/container_test_util.h"
 
 namespace meshstream {
 namespace {
@@ -58,11 +59,7 @@ TEST(Container, EveryShortPrefixIsTruncatedNotAnError) {
   std::vector<uint8_t> bytes = sample_stream(nullptr);
   auto full = read_stream_index(bytes);
   ASSERT_TRUE(full);
-  for (size_t n = 0; n < full->payload_offset; ++n) {
-    auto index = read_stream_index(std::span(bytes).first(n));
-    ASSERT_FALSE(index);
-    EXPECT_EQ(index.error().code, ErrorCode::kTruncated) << "prefix " << n;
-  }
+  testing::expect_every_short_prefix_truncated(bytes, full->payload_offset);
 }
 
 TEST(Container, EveryFlippedHeaderBitIsDetected) {

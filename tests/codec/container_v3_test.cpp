@@ -14,6 +14,7 @@
 #include "common/codec/encoder.h"
 #include "common/codec/record_index_coder.h"
 #include "tests/codec/codec_test_util.h"
+#include "tests/codec/container_test_util.h"
 
 namespace meshstream {
 namespace {
@@ -167,11 +168,7 @@ TEST(ContainerV3, EveryShortPrefixIsTruncated) {
   const auto& bytes = encoded_stream();
   auto full = read_stream_index(bytes);
   ASSERT_TRUE(full);
-  for (size_t n = 0; n < full->payload_offset; ++n) {
-    auto index = read_stream_index(std::span(bytes).first(n));
-    ASSERT_FALSE(index);
-    EXPECT_EQ(index.error().code, ErrorCode::kTruncated) << "prefix " << n;
-  }
+  expect_every_short_prefix_truncated(bytes, full->payload_offset);
   // From the end of the index on, the records inside the span get their CRC.
   for (size_t n : {full->payload_offset, full->records[1].offset + full->records[1].size}) {
     auto index = read_stream_index(std::span(bytes).first(n));
