@@ -64,8 +64,12 @@ std::vector<Variant> all_variants() {
   add("base-600", "decimate to about 600 base vertices", [](EncodeOptions& o) { o.target_base_vertices = 600; });
   add("insertion-shift-2", "inserted vertices 2 bits coarser, sharpened by plane records",
       [](EncodeOptions& o) { o.insertion_shift = 2; });
-  add("calibration-1", "plane balance fixed at 1 (no measured choice)", [](EncodeOptions& o) { o.plane_calibration = 1; });
-  add("calibration-3", "plane balance fixed at 3 (no measured choice)", [](EncodeOptions& o) { o.plane_calibration = 3; });
+  add("calibration-1", "displacement estimate, plane balance 1 (no measured choice)", [](EncodeOptions& o) { o.plane_calibration = 1; });
+  add("calibration-3", "displacement estimate, plane balance 3 (no measured choice)", [](EncodeOptions& o) { o.plane_calibration = 3; });
+  add("surface-1", "surface-distance estimate, plane balance 1 (no measured choice)", [](EncodeOptions& o) { o.distortion_estimate = 2; o.plane_calibration = 1; });
+  add("displacement-auto", "displacement estimate, balance 1 or 3 by measurement (the encoder before the surface estimate)", [](EncodeOptions& o) {
+    o.distortion_estimate = 1;
+  });
   add("issue-1-order", "no bit planes: every position exact at insertion", [](EncodeOptions& o) { o.embedded = false; });
   return v;
 }

@@ -54,6 +54,7 @@ struct MeshMeasurements {
   uint32_t ours_plane_records = 0;
   uint64_t ours_largest_record = 0;  // beyond the base
   uint32_t ours_base_shift = 0;
+  int ours_distortion_estimate = 0;  // the ordering the encoder's measured choice kept (1 or 2)
   // Prefix equals the encoder's model at every record boundary (hashes).
   bool ours_model_matches = false;
   // RMS along the measured curve: the largest rise between consecutive

@@ -78,8 +78,9 @@ inline void write_markdown(const std::filesystem::path& path,
      << "imports, cleaned by `import_mesh` (so Draco and ours code the very same mesh), "
      << "positions quantized to " << s.quant_bits << " bits by both. *Ours* is the default "
      << "`encode_hcs` stream (issue 5: successive-approximation bit planes, records ordered by "
-        "estimated distortion drop per byte, the estimate's plane weight chosen between 3 and 1 "
-        "by the measured surface distance of decoded prefixes, `rd_measure.h`; the encode times "
+        "estimated distortion drop per byte, the estimate (vertex displacement or distance to the "
+        "original surface) chosen by the measured surface distance of decoded prefixes, "
+        "`rd_measure.h`; the encode times "
         "include that measurement); *issue I order* is the same encoder with "
         "`EncodeOptions::embedded = false` (every position exact at insertion, no plane records, "
         "same record sizes). Draco runs in-process (`draco::ExpertEncoder`, edgebreaker, speed = "
@@ -126,16 +127,19 @@ inline void write_markdown(const std::filesystem::path& path,
         "binary arithmetic coding, `embedded_geometry.h`); *raw* is what the same plane bits and "
         "signs would take uncoded. *Model* = the decoder's mesh after every record hashes to what "
         "the encoder's model predicted (`EncodeReport`). *Worst RMS rise*: largest increase of RMS "
-        "between consecutive measured points of the curve below.\n\n"
-     << "| mesh | records | plane records | required | largest record | base shift | structure bytes "
+        "between consecutive measured points of the curve below. *Estimate*: the distortion estimate of "
+        "the record ordering the encoder's measured choice kept (displacement or surface distance, "
+        "`docs/hcs-format.md`).\n\n"
+     << "| mesh | records | plane records | required | largest record | base shift | estimate | structure bytes "
         "| plane bytes (coded / raw) | model | worst RMS rise |\n"
-     << "|---|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
+     << "|---|---:|---:|---:|---:|---:|---|---:|---:|---|---:|\n";
   for (const MeshMeasurements& m : all) {
     if (!m.error.empty() || !m.ours_error.empty() || m.ours_bytes == 0) continue;
     md << "| " << m.name << " | " << m.ours_records << " | " << m.ours_plane_records << " | "
        << std::min<uint32_t>(m.vertices / 50, 200) + 1 << " | "
        << fmt("%.2f %%", 100.0 * m.ours_largest_record / m.ours_bytes) << " | " << m.ours_base_shift << " | "
-       << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / " << m.ours_plane_raw_bytes << " | "
+       << (m.ours_distortion_estimate == 2 ? "surface" : m.ours_distortion_estimate == 1 ? "displacement" : "?")
+       << " | " << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / " << m.ours_plane_raw_bytes << " | "
        << (m.ours_model_matches ? "matches" : "**differs**") << " | "
        << fmt("%.1f %%", 100 * m.ours_worst_rms_rise) << " |\n";
   }

@@ -23,6 +23,8 @@
 #include "common/codec/quantize.h"
 #include "common/codec/rd_measure.h"
 #include "common/codec/refinement_codec.h"
+#include "common/metrics/bvh.h"
+#include "common/metrics/closest_point.h"
 
 namespace meshstream {
 namespace {
@@ -147,15 +149,41 @@ struct EncoderTruth {
   // (refinement is not uniform: flat regions stay coarse) or no decay.
   std::vector<double> weight;
   std::vector<Vec3f> input_normal;  // by input id
+  // The original surface in grid units; when set, a vertex's error is its
+  // distance to that surface instead of its displacement from its truth.
+  const TriangleBvh* surface = nullptr;
 };
 
 // Squared error of a displaced vertex for the distortion estimate. The
 // whole vector counts: weighting tangential slip down (it mostly slides the
 // surface within itself) measured worse on CAD meshes, where a vertex on a
 // crease slides across the other face.
-double surface_error2(Vec3i recon, Vec3i truth) {
+double displacement_error2(Vec3i recon, Vec3i truth) {
   const double e[3] = {double(recon.x) - truth.x, double(recon.y) - truth.y, double(recon.z) - truth.z};
   return e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+}
+
+Vec3d grid_point(Vec3i p) { return {double(p.x), double(p.y), double(p.z)}; }
+
+// A shown vertex's squared error: its distance to the original surface, or
+// (no surface) its displacement from its true position.
+double placement_error2(const EncoderTruth& t, Vec3i recon, Vec3i truth) {
+  if (t.surface) return t.surface->closest(grid_point(recon)).squared_distance;
+  return displacement_error2(recon, truth);
+}
+
+// Squared distance from `p` to the fan of `ring` (ring[0], ring[i], ring[i+1]):
+// the faces a patch replaces.
+double fan_distance2(const std::vector<Vec3i>& pos, const std::vector<uint32_t>& ring, Vec3i p) {
+  const Vec3d q = grid_point(p);
+  double best = std::numeric_limits<double>::infinity();
+  const Vec3d a = grid_point(pos[ring[0]]);
+  for (size_t i = 1; i + 1 < ring.size(); ++i) {
+    const Vec3d c = closest_point_on_triangle(q, a, grid_point(pos[ring[i]]), grid_point(pos[ring[i + 1]]));
+    const double dx = c.x - q.x, dy = c.y - q.y, dz = c.z - q.z;
+    best = std::min(best, dx * dx + dy * dy + dz * dz);
+  }
+  return best;
 }
 
 // Area of the fan/star polygon `ring` (sum of triangle areas from ring[0]).
@@ -334,7 +362,8 @@ class StructureWriter {
                              double(r.position.z) - pred.z};
         const double dn = d[0] * nrm.x + d[1] * nrm.y + d[2] * nrm.z;
         const Vec3i recon = reconstruct(g, s_.max_coordinate);
-        drop += area * (dn * dn - surface_error2(recon, r.position)) / 6.0;
+        const double before = t_.surface ? fan_distance2(s_.mesh.positions(), patches_[j].ring, r.position) : dn * dn;
+        drop += area * (before - placement_error2(t_, recon, r.position)) / 6.0;
         const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
         inserted.push_back({r.vertex, v});
         t_.position.push_back(r.position);
@@ -405,7 +434,7 @@ void evaluate_group(const RefinementState& s, const EncoderTruth& t, PlaneGroup&
     plane_step(scratch, io, geo, prev_new, s.max_coordinate);
     const Vec3i after = reconstruct(geo, s.max_coordinate);
     g.scaled_drop += t.weight[v] *
-                     (surface_error2(before, t.position[v]) - surface_error2(after, t.position[v])) / 6.0;
+                     (placement_error2(t, before, t.position[v]) - placement_error2(t, after, t.position[v])) / 6.0;
   }
 }
 
@@ -434,7 +463,8 @@ struct EncodedStream {
 
 Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
                                   const DecimationResult& dec, const EncodeOptions& options,
-                                  uint32_t record_bytes, double plane_calibration, EncodeReport* report) {
+                                  uint32_t record_bytes, double plane_calibration, EncodeReport* report,
+                                  const TriangleBvh* surface) {
   const int bits = grid.bits;
   const uint8_t format = options.refinement_format == 0 ? kRefinementFormat
                                                         : static_cast<uint8_t>(options.refinement_format);
@@ -461,6 +491,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   // Encoder-side truth, in decoder ids.
   EncoderTruth truth;
   truth.input_normal = vertex_normals(q, mesh.triangles);
+  truth.surface = surface;
   {
     std::vector<double> star_area(base_n, 0.0);
     for (const Triangle& f : base.decoded.faces) {
@@ -494,6 +525,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   if (report) {
     report->records.clear();
     report->base_shift = static_cast<uint32_t>(base_shift);
+    report->ordering = {plane_calibration, surface ? 2 : 1};
     report->plane_bits_raw = report->plane_bytes_coded = report->structure_bytes = 0;
     report->structure_bits = StructureBits{};
     report->records.push_back({false, base_n, uint32_t(base.bytes.size()), hash_state(*state), 0});
@@ -683,6 +715,10 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
     return make_error(ErrorCode::kInvalidArgument,
                       "refinement format " + std::to_string(options.refinement_format) + " cannot be written (2 or 3)");
   }
+  if (options.distortion_estimate < 0 || options.distortion_estimate > 2) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "distortion estimate " + std::to_string(options.distortion_estimate) + " is not 0, 1 or 2");
+  }
   auto grid = make_grid(mesh, options.quant_bits);
   if (!grid) return tl::unexpected(grid.error());
   if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
@@ -694,6 +730,27 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
   const DecimationResult dec = decimate_layers(std::move(*editable), dopt);
+  // The orderings to encode: every candidate that agrees with the fixed
+  // options, or the one the options fix.
+  const bool measured = options.embedded && options.plane_calibration <= 0;
+  std::vector<RecordOrdering> orderings;
+  if (measured) {
+    for (const RecordOrdering& c : kOrderingCandidates)
+      if (options.distortion_estimate == 0 || options.distortion_estimate == c.distortion_estimate)
+        orderings.push_back(c);
+  } else {
+    orderings.push_back({options.plane_calibration, options.distortion_estimate == 2 ? 2 : 1});
+  }
+  // The original in grid units, for the surface-distance estimate.
+  TriangleBvh grid_surface;
+  if (std::any_of(orderings.begin(), orderings.end(), [](const RecordOrdering& o) { return o.distortion_estimate == 2; })) {
+    Mesh grid_mesh;
+    grid_mesh.triangles = mesh.triangles;
+    grid_mesh.positions.reserve(q.size());
+    for (const Vec3i& p : q) grid_mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
+    grid_surface = TriangleBvh::build(grid_mesh);
+  }
+  auto surface_for = [&](const RecordOrdering& o) { return o.distortion_estimate == 2 ? &grid_surface : nullptr; };
 
   // Granularity (issue II): at least min(n / 50, 200) record boundaries and
   // no refinement record above 2 % of the stream. Automatic record sizes
@@ -701,8 +758,6 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   // shrink when the result misses either bound.
   const uint32_t n = mesh.vertex_count();
   const bool automatic = options.record_bytes == 0;
-  const bool measured = options.embedded && options.plane_calibration <= 0;
-  const double first_calibration = measured ? kPlaneCalibrations[0] : options.plane_calibration;
   const double estimate = 20.0 * n / 8.0;
   // Plane records add to the count; each record costs an index entry (about
   // 1.5 bytes, container 3) and a 4-byte CRC trailer.
@@ -715,15 +770,16 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
                                     : std::max<uint32_t>(options.record_bytes, 16);
   EncodedStream chosen;
   for (int attempt = 0;; ++attempt) {
-    auto encoded = encode_once(mesh, *grid, q, dec, options, record_bytes, first_calibration, report);
+    auto encoded = encode_once(mesh, *grid, q, dec, options, record_bytes, orderings[0].plane_calibration, report,
+                               surface_for(orderings[0]));
     if (!encoded) return tl::unexpected(encoded.error());
     chosen = std::move(*encoded);
     if (!automatic || granular(chosen) || attempt >= 3 || record_bytes <= 16) break;
     record_bytes = std::max<uint32_t>(16, static_cast<uint32_t>(record_bytes * 0.75));
   }
-  if (!measured) return std::move(chosen.bytes);
+  if (orderings.size() < 2) return std::move(chosen.bytes);
 
-  // Rate-distortion by measurement (rd_measure.h): the other balances at
+  // Rate-distortion by measurement (rd_measure.h): the other orderings at
   // the same record size, judged at the same byte budgets by the surface
   // distance of their decoded prefixes to the original.
   Mesh reference;  // the quantized original, from the positions already quantized
@@ -736,11 +792,10 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   auto chosen_curve = measure->curve(chosen.bytes, reference_bytes);
   if (!chosen_curve) return tl::unexpected(chosen_curve.error());
   double chosen_score = RdMeasure::score(*chosen_curve);
-  for (double calibration : kPlaneCalibrations) {
-    if (calibration == first_calibration) continue;
+  for (size_t i = 1; i < orderings.size(); ++i) {
     EncodeReport candidate_report;
-    auto candidate = encode_once(mesh, *grid, q, dec, options, record_bytes, calibration,
-                                 report ? &candidate_report : nullptr);
+    auto candidate = encode_once(mesh, *grid, q, dec, options, record_bytes, orderings[i].plane_calibration,
+                                 report ? &candidate_report : nullptr, surface_for(orderings[i]));
     if (!candidate) return tl::unexpected(candidate.error());
     if (automatic && granular(chosen) && !granular(*candidate)) continue;
     auto curve = measure->curve(candidate->bytes, reference_bytes);

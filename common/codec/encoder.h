@@ -31,14 +31,18 @@ struct EncodeOptions {
   // on the 13 real meshes, after container 3's small index, scores shift 4
   // best of 0 and 2..6 at 12 bits). Embedded only.
   int base_shift = -1;
-  // How much the record ordering's distortion proxy values plane records
-  // against structure records (encoder.cpp). 0 = automatic: the streams of
-  // kPlaneCalibrations are decoded at log-spaced budgets and the one with
-  // the smallest measured surface distance to the original wins
-  // (rd_measure.h; one extra encode and 10 distance measurements: about 4x
-  // the time of a fixed balance).
-  // Embedded only.
+  // How much the record ordering's distortion estimate values plane
+  // records against structure records (encoder.cpp). 0 = automatic: the
+  // streams of the kOrderingCandidates are decoded at log-spaced budgets and
+  // the one with the smallest measured surface distance to the original
+  // wins (rd_measure.h; one encode and 5 distance measurements a candidate).
+  // A fixed balance encodes once. Embedded only.
   double plane_calibration = 0;
+  // How a vertex's error enters that estimate: 0 = as chosen (automatic:
+  // measured among the candidates; fixed balance: displacement),
+  // 1 = displacement from its true position, 2 = squared distance to the
+  // original surface. Embedded only; anything else is kInvalidArgument.
+  int distortion_estimate = 0;
   // Low residual bits of inserted vertices left to plane records (at least;
   // a vertex is never sharper than its ring). Embedded only. 1-8 measured
   // worse than 0 on every mesh tried (more plane records and index entries,
@@ -50,10 +54,18 @@ struct EncodeOptions {
   int refinement_format = 0;
 };
 
-// The balances the automatic choice tries, the first is encoded first (see
-// EncodeOptions). Measured on the real models: 1 wins on most scans, 3 on
-// skull and casting; 10 never won by more than 0.1 % and was dropped (cost).
-inline constexpr double kPlaneCalibrations[] = {3.0, 1.0};
+// The record orderings the automatic choice tries (EncodeOptions), the
+// first is encoded first. Measured on the 13 real meshes
+// (bench/encoder_options_bench): the displacement estimate wins on some
+// scans (skull), the surface-distance estimate on CAD parts, where vertices
+// slide within flat faces and displacement overvalues new vertices (fandisk
+// at the LOD chain's 1/16 point: 3.7 -> 1.1 x the chain's RMS). Balance 3,
+// the earlier choice's other candidate, no longer won with these two.
+struct RecordOrdering {
+  double plane_calibration;
+  int distortion_estimate;  // 1 or 2, as EncodeOptions
+};
+inline constexpr RecordOrdering kOrderingCandidates[] = {{1.0, 1}, {1.0, 2}};
 
 // Ids written in the stream header (`structure_coder`, `geometry_coder`).
 inline constexpr uint8_t kStructureCoderRange = 1;  // adaptive binary range coder
@@ -68,7 +80,7 @@ inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 7;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3 (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank contexts); 7: 8-bit base by default
+inline constexpr uint32_t kEncoderVersion = 8;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3 (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank contexts); 7: 8-bit base by default; 8: surface-distance ordering candidate
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {
@@ -104,6 +116,9 @@ struct EncodeReport {
   uint64_t plane_bytes_coded = 0; // their context-coded payload (range-coded blocks)
   uint64_t structure_bytes = 0;   // structure records
   uint32_t base_shift = 0;
+  // The record ordering the stream was written with (the measured choice's
+  // winner when automatic).
+  RecordOrdering ordering{0, 0};
 };
 
 // Encodes a clean manifold mesh (see import.h). kInvalidArgument for bad

@@ -24,10 +24,18 @@ TEST(EmbeddedStream, EveryPrefixEqualsTheEncoderModel) {
   int which = 0;
   for (const Mesh& mesh : embedded_meshes()) {
     ++which;
+    // The automatic ordering, then each distortion estimate alone (a fixed
+    // balance encodes once), with either base coder.
+    for (int estimate : {0, 1, 2})
     for (bool draco : {true, false}) {
-      SCOPED_TRACE("mesh " + std::to_string(which) + (draco ? ", Draco base" : ", own base"));
+      SCOPED_TRACE("mesh " + std::to_string(which) + (draco ? ", Draco base" : ", own base") + ", estimate " +
+                   std::to_string(estimate));
       EncodeOptions options;
       options.allow_draco_base = draco;
+      if (estimate != 0) {
+        options.plane_calibration = 1;
+        options.distortion_estimate = estimate;
+      }
       EncodeReport report;
       auto bytes = encode_hcs(mesh, options, &report);
       ASSERT_TRUE(bytes) << bytes.error().message;
@@ -71,6 +79,17 @@ TEST(EmbeddedStream, EveryPrefixEqualsTheEncoderModel) {
       EXPECT_EQ(sorted_positions(dec.mesh()), sorted_positions(*reference));
       EXPECT_EQ(canonical_faces(dec.mesh()), canonical_faces(*reference));
     }
+  }
+}
+
+TEST(EmbeddedStream, UnknownDistortionEstimatesAreRefused) {
+  for (int estimate : {-1, 3, 100}) {
+    EncodeOptions options;
+    options.distortion_estimate = estimate;
+    auto refused = encode_hcs(icosphere(2), options);
+    ASSERT_FALSE(refused) << estimate;
+    EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(refused.error().message.find("distortion estimate"), std::string::npos);
   }
 }
 

@@ -28,13 +28,14 @@ class RdMeasureOnDemo : public ::testing::Test {
   std::optional<RdMeasure> measure;
 };
 
-TEST_F(RdMeasureOnDemo, AutomaticBalanceIsTheBestMeasuredCandidate) {
+TEST_F(RdMeasureOnDemo, AutomaticOrderingIsTheBestMeasuredCandidate) {
   EncodeOptions automatic;
   auto chosen = encode_hcs(mesh, automatic);
   ASSERT_TRUE(chosen);
-  // Budgets relative to the default balance's stream, as the encoder does.
+  // Budgets relative to the first candidate's stream, as the encoder does.
   EncodeOptions first;
-  first.plane_calibration = kPlaneCalibrations[0];
+  first.plane_calibration = kOrderingCandidates[0].plane_calibration;
+  first.distortion_estimate = kOrderingCandidates[0].distortion_estimate;
   auto default_stream = encode_hcs(mesh, first);
   ASSERT_TRUE(default_stream);
   const uint64_t reference_bytes = default_stream->size();
@@ -42,14 +43,15 @@ TEST_F(RdMeasureOnDemo, AutomaticBalanceIsTheBestMeasuredCandidate) {
   ASSERT_TRUE(chosen_curve);
   const double chosen_score = RdMeasure::score(*chosen_curve);
   bool equals_a_candidate = false;
-  for (double calibration : kPlaneCalibrations) {
+  for (const RecordOrdering& candidate : kOrderingCandidates) {
     EncodeOptions fixed;
-    fixed.plane_calibration = calibration;
+    fixed.plane_calibration = candidate.plane_calibration;
+    fixed.distortion_estimate = candidate.distortion_estimate;
     auto stream = encode_hcs(mesh, fixed);
     ASSERT_TRUE(stream);
     auto curve = measure->curve(*stream, reference_bytes);
     ASSERT_TRUE(curve);
-    EXPECT_LE(chosen_score, RdMeasure::score(*curve) + 1e-12) << "calibration " << calibration;
+    EXPECT_LE(chosen_score, RdMeasure::score(*curve) + 1e-12) << "balance " << candidate.plane_calibration << ", estimate " << candidate.distortion_estimate;
     equals_a_candidate = equals_a_candidate || *stream == *chosen;
   }
   EXPECT_TRUE(equals_a_candidate);
