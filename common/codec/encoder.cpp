@@ -152,6 +152,16 @@ struct EncoderTruth {
   // The original surface in grid units; when set, a vertex's error is its
   // distance to that surface instead of its displacement from its truth.
   const TriangleBvh* surface = nullptr;
+  // Per vertex, the surface errors of the last two positions asked about
+  // (a group's next plane is evaluated again when the group grows, and its
+  // "after" becomes the next evaluation's "before"), and the triangle found
+  // last, which starts the next search nearby.
+  struct CachedError {
+    Vec3i position[2];
+    double error2[2] = {-1, -1};
+    uint32_t triangle = TriangleBvh::kNoHint;
+  };
+  std::vector<CachedError> cached;
 };
 
 // Squared error of a displaced vertex for the distortion estimate. The
@@ -165,11 +175,23 @@ double displacement_error2(Vec3i recon, Vec3i truth) {
 
 Vec3d grid_point(Vec3i p) { return {double(p.x), double(p.y), double(p.z)}; }
 
-// A shown vertex's squared error: its distance to the original surface, or
-// (no surface) its displacement from its true position.
-double placement_error2(const EncoderTruth& t, Vec3i recon, Vec3i truth) {
-  if (t.surface) return t.surface->closest(grid_point(recon)).squared_distance;
-  return displacement_error2(recon, truth);
+// Decoder vertex v's squared error when shown at `recon`: its distance to
+// the original surface, or (no surface) its displacement from its true
+// position. Surface answers are remembered (EncoderTruth::cached).
+double vertex_error2(EncoderTruth& t, uint32_t v, Vec3i recon) {
+  if (!t.surface) return displacement_error2(recon, t.position[v]);
+  if (recon == t.position[v]) return 0;  // an original vertex lies on the original surface
+  if (t.cached.size() <= v) t.cached.resize(v + 1);
+  EncoderTruth::CachedError& c = t.cached[v];
+  for (int i = 0; i < 2; ++i)
+    if (c.error2[i] >= 0 && c.position[i] == recon) return c.error2[i];
+  const ClosestHit hit = t.surface->closest(grid_point(recon), c.triangle);
+  c.triangle = hit.triangle;
+  c.position[1] = c.position[0];
+  c.error2[1] = c.error2[0];
+  c.position[0] = recon;
+  c.error2[0] = hit.squared_distance;
+  return hit.squared_distance;
 }
 
 // Squared distance from `p` to the fan of `ring` (ring[0], ring[i], ring[i+1]):
@@ -363,12 +385,12 @@ class StructureWriter {
         const double dn = d[0] * nrm.x + d[1] * nrm.y + d[2] * nrm.z;
         const Vec3i recon = reconstruct(g, s_.max_coordinate);
         const double before = t_.surface ? fan_distance2(s_.mesh.positions(), patches_[j].ring, r.position) : dn * dn;
-        drop += area * (before - placement_error2(t_, recon, r.position)) / 6.0;
         const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
         inserted.push_back({r.vertex, v});
         t_.position.push_back(r.position);
         t_.residual.push_back({r.position.x - pred.x, r.position.y - pred.y, r.position.z - pred.z});
         t_.weight.push_back(area * std::sqrt(double(vertices_before + count)));
+        drop += area * (before - vertex_error2(t_, v, recon)) / 6.0;
       }
       insertions += count;
       remaining_ -= count;
@@ -418,7 +440,7 @@ struct PlaneGroup {
   double scaled_drop = 0;    // estimated drop of its next plane x vertex count
 };
 
-void evaluate_group(const RefinementState& s, const EncoderTruth& t, PlaneGroup& g) {
+void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g) {
   g.pending = 0;
   g.top_plane = 0;
   g.scaled_drop = 0;
@@ -434,7 +456,7 @@ void evaluate_group(const RefinementState& s, const EncoderTruth& t, PlaneGroup&
     plane_step(scratch, io, geo, prev_new, s.max_coordinate);
     const Vec3i after = reconstruct(geo, s.max_coordinate);
     g.scaled_drop += t.weight[v] *
-                     (placement_error2(t, before, t.position[v]) - placement_error2(t, after, t.position[v])) / 6.0;
+                     (vertex_error2(t, v, before) - vertex_error2(t, v, after)) / 6.0;
   }
 }
 
