@@ -56,11 +56,13 @@ struct EncodeOptions {
 
 // The record orderings the automatic choice tries (EncodeOptions), the
 // first is encoded first. Measured on the 13 real meshes
-// (bench/encoder_options_bench): the displacement estimate wins on some
-// scans (skull), the surface-distance estimate on CAD parts, where vertices
-// slide within flat faces and displacement overvalues new vertices (fandisk
-// at the LOD chain's 1/16 point: 3.7 -> 1.1 x the chain's RMS). Balance 3,
-// the earlier choice's other candidate, no longer won with these two.
+// (bench/encoder_options_bench, bench/report/codec.md): the surface-distance
+// estimate is kept for 8, among them every CAD part, where vertices slide
+// within flat faces and displacement overvalues new vertices (fandisk at
+// the LOD chain's 1/16 point: 3.7 -> 1.1 x the chain's RMS); displacement
+// for 5 scans (skull: 0.86 against 1.09 at the 1/64 point). Balance 3, the
+// earlier choice's other candidate, no longer won with these two; balances
+// 0.5 and 2 did not pay either.
 struct RecordOrdering {
   double plane_calibration;
   int distortion_estimate;  // 1 or 2, as EncodeOptions
