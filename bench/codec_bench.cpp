@@ -129,6 +129,7 @@ std::vector<uint8_t> measure_ours(const Mesh& mesh, const Settings& s, MeshMeasu
     m.ours_structure_bytes = report.structure_bytes;
     m.ours_plane_bytes = report.plane_bytes_coded;
     m.ours_plane_raw_bytes = report.plane_bits_raw / 8;
+    m.ours_plane_plain_bytes = report.plane_bytes_plain;
     m.ours_base_shift = report.base_shift;
     m.ours_distortion_estimate = report.ordering.distortion_estimate;
     for (const EncodedRecord& r : report.records) m.ours_plane_records += r.plane ? 1 : 0;

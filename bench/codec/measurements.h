@@ -51,6 +51,7 @@ struct MeshMeasurements {
 
   // Embedded stream details (issue 5).
   uint64_t ours_structure_bytes = 0, ours_plane_bytes = 0, ours_plane_raw_bytes = 0;
+  uint64_t ours_plane_plain_bytes = 0;  // the plane bits through issue I's kind of coder
   uint32_t ours_plane_records = 0;
   uint64_t ours_largest_record = 0;  // beyond the base
   uint32_t ours_base_shift = 0;

@@ -124,14 +124,15 @@ inline void write_markdown(const std::filesystem::path& path,
   md << "\n### The embedded stream: granularity and parts\n\n"
      << "Records beyond the base must number at least min(n/50, 200) and none may exceed 2 % of the "
         "stream (issue 5). Plane records carry one bit plane of a batch's positions (context-adaptive "
-        "binary arithmetic coding, `embedded_geometry.h`); *raw* is what the same plane bits and "
-        "signs would take uncoded. *Model* = the decoder's mesh after every record hashes to what "
+        "binary arithmetic coding, `embedded_geometry.h`: *context*); *plain* is the same bits through "
+        "issue I's kind of coder (adaptive binary models by plane only, no axis, significance or "
+        "neighbour contexts), *raw* what they would take uncoded. *Model* = the decoder's mesh after every record hashes to what "
         "the encoder's model predicted (`EncodeReport`). *Worst RMS rise*: largest increase of RMS "
         "between consecutive measured points of the curve below. *Estimate*: the distortion estimate of "
         "the record ordering the encoder's measured choice kept (displacement or surface distance, "
         "`docs/hcs-format.md`).\n\n"
      << "| mesh | records | plane records | required | largest record | base shift | estimate | structure bytes "
-        "| plane bytes (coded / raw) | model | worst RMS rise |\n"
+        "| plane bytes (context / plain / raw) | model | worst RMS rise |\n"
      << "|---|---:|---:|---:|---:|---:|---|---:|---:|---|---:|\n";
   for (const MeshMeasurements& m : all) {
     if (!m.error.empty() || !m.ours_error.empty() || m.ours_bytes == 0) continue;
@@ -139,7 +140,7 @@ inline void write_markdown(const std::filesystem::path& path,
        << std::min<uint32_t>(m.vertices / 50, 200) + 1 << " | "
        << fmt("%.2f %%", 100.0 * m.ours_largest_record / m.ours_bytes) << " | " << m.ours_base_shift << " | "
        << (m.ours_distortion_estimate == 2 ? "surface" : m.ours_distortion_estimate == 1 ? "displacement" : "?")
-       << " | " << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / " << m.ours_plane_raw_bytes << " | "
+       << " | " << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / " << m.ours_plane_plain_bytes << " / " << m.ours_plane_raw_bytes << " | "
        << (m.ours_model_matches ? "matches" : "**differs**") << " | "
        << fmt("%.1f %%", 100 * m.ours_worst_rms_rise) << " |\n";
   }

@@ -431,6 +431,46 @@ struct PlaneBitOracle {
   uint32_t sign(BitModel&, int axis) { return residual[axis] < 0 ? 1u : 0u; }
 };
 
+// Issue I's kind of coder for plane bits (EncodeReport::plane_bytes_plain):
+// one adaptive model per plane and one for signs, persisting across records
+// like the context models.
+struct PlainPlaneModels {
+  BitModel bit[kMaxShift + 1];
+  BitModel sign;
+};
+
+struct PlainPlaneWriter {
+  RangeEncoder& enc;
+  PlainPlaneModels& m;
+  Vec3i residual;
+  uint32_t bit(BitModel&, int axis, int below) {
+    const uint32_t b = (uint32_t(std::abs(residual[axis])) >> below) & 1u;
+    enc.encode_bit(m.bit[below], b);
+    return b;
+  }
+  uint32_t sign(BitModel&, int axis) {
+    const uint32_t b = residual[axis] < 0 ? 1u : 0u;
+    enc.encode_bit(m.sign, b);
+    return b;
+  }
+};
+
+// Bytes of the next plane step of vertices [first, first + count) through
+// the plain coder (the state is not changed; `models` learn).
+size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32_t first, uint32_t count,
+                         PlainPlaneModels& models) {
+  RangeEncoder enc;
+  GeometryModels unused;
+  uint8_t prev_new = 0;
+  for (uint32_t v = first; v < first + count; ++v) {
+    VertexGeometry geo = s.geometry[v];
+    if (geo.shift == 0) continue;
+    PlainPlaneWriter io{enc, models, t.residual[v]};
+    plane_step(unused, io, geo, prev_new, s.max_coordinate);
+  }
+  return enc.finish().size();
+}
+
 // A run of vertex ids refined together by plane records (a batch).
 struct PlaneGroup {
   uint32_t first = 0, count = 0;
@@ -548,7 +588,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
     report->records.clear();
     report->base_shift = static_cast<uint32_t>(base_shift);
     report->ordering = {plane_calibration, surface ? 2 : 1};
-    report->plane_bits_raw = report->plane_bytes_coded = report->structure_bytes = 0;
+    report->plane_bits_raw = report->plane_bytes_coded = report->plane_bytes_plain = report->structure_bytes = 0;
     report->structure_bits = StructureBits{};
     report->records.push_back({false, base_n, uint32_t(base.bytes.size()), hash_state(*state), 0});
   }
@@ -584,6 +624,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   double plane_bits_per_step[kMaxShift + 1];
   std::fill(std::begin(plane_bits_per_step), std::end(plane_bits_per_step), 3.0);
   std::vector<std::pair<uint32_t, uint32_t>> inserted;
+  PlainPlaneModels plain_models;
   const double record_overhead = 6.0;  // header and range coder flush, bytes
 
   while (true) {
@@ -641,6 +682,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
       for (int a = 0; a < 3; ++a)
         sign_bits += geo.mag[a] == 0 && ((uint32_t(std::abs(truth.residual[v][a])) >> (geo.shift - 1)) & 1u);
     }
+    if (report) report->plane_bytes_plain += plain_plane_bytes(*state, truth, g.first, g.count, plain_models);
     f.payload = write_plane_record(*state, g.first, g.count, truth.residual);
     f.vertices = state->mesh.vertex_count();
     f.faces = state->mesh.face_slot_count();

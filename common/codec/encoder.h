@@ -116,6 +116,10 @@ struct EncodeReport {
   StructureBits structure_bits;
   uint64_t plane_bits_raw = 0;    // plane bits and signs, uncoded (one bit each)
   uint64_t plane_bytes_coded = 0; // their context-coded payload (range-coded blocks)
+  // The same bits through issue I's kind of coder, for comparison: adaptive
+  // binary models by plane only (no axis role, significance or neighbour
+  // contexts), one block per record.
+  uint64_t plane_bytes_plain = 0;
   uint64_t structure_bytes = 0;   // structure records
   uint32_t base_shift = 0;
   // The record ordering the stream was written with (the measured choice's
