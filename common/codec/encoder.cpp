@@ -11,9 +11,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <future>
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
 #include <unordered_map>
 
 #include "common/codec/base_coder.h"
@@ -832,20 +835,42 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   };
   uint32_t record_bytes = automatic ? static_cast<uint32_t>(std::clamp(estimate / wanted, 32.0, 8192.0))
                                     : std::max<uint32_t>(options.record_bytes, 16);
+  auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report) {
+    return encode_once(mesh, *grid, q, dec, options, bytes, orderings[i].plane_calibration, candidate_report,
+                       surface_for(orderings[i]));
+  };
+  // The other candidates run on their own threads (they share only
+  // read-only inputs) at the first record size while the first candidate
+  // settles the record size; one that settles elsewhere is encoded again.
+  const bool parallel = orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
+  const uint32_t first_record_bytes = record_bytes;
+  std::vector<EncodeReport> candidate_reports(orderings.size());
+  auto report_of = [&](size_t i) { return report ? &candidate_reports[i] : nullptr; };
+  std::vector<std::future<Result<EncodedStream>>> early;  // destroyed (joined) before what it reads
+  if (parallel) {
+    for (size_t i = 1; i < orderings.size(); ++i)
+      early.push_back(std::async(std::launch::async, encode_candidate, i, first_record_bytes, report_of(i)));
+  }
   EncodedStream chosen;
   for (int attempt = 0;; ++attempt) {
-    auto encoded = encode_once(mesh, *grid, q, dec, options, record_bytes, orderings[0].plane_calibration, report,
-                               surface_for(orderings[0]));
+    auto encoded = encode_candidate(0, record_bytes, report);
     if (!encoded) return tl::unexpected(encoded.error());
     chosen = std::move(*encoded);
     if (!automatic || granular(chosen) || attempt >= 3 || record_bytes <= 16) break;
     record_bytes = std::max<uint32_t>(16, static_cast<uint32_t>(record_bytes * 0.75));
   }
   if (orderings.size() < 2) return std::move(chosen.bytes);
+  std::vector<EncodedStream> candidates(orderings.size());
+  for (size_t i = 1; i < orderings.size(); ++i) {
+    auto candidate = parallel ? early[i - 1].get() : encode_candidate(i, record_bytes, report_of(i));
+    if (parallel && record_bytes != first_record_bytes) candidate = encode_candidate(i, record_bytes, report_of(i));
+    if (!candidate) return tl::unexpected(candidate.error());
+    candidates[i] = std::move(*candidate);
+  }
 
   // Rate-distortion by measurement (rd_measure.h): the other orderings at
   // the same record size, judged at the same byte budgets by the surface
-  // distance of their decoded prefixes to the original.
+  // distance of their decoded prefixes to the original (in parallel too).
   Mesh reference;  // the quantized original, from the positions already quantized
   reference.triangles = mesh.triangles;
   reference.positions.reserve(q.size());
@@ -853,22 +878,26 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   auto measure = RdMeasure::prepare(reference);
   if (!measure) return tl::unexpected(measure.error());
   const uint64_t reference_bytes = chosen.bytes.size();
-  auto chosen_curve = measure->curve(chosen.bytes, reference_bytes);
-  if (!chosen_curve) return tl::unexpected(chosen_curve.error());
-  double chosen_score = RdMeasure::score(*chosen_curve);
-  for (size_t i = 1; i < orderings.size(); ++i) {
-    EncodeReport candidate_report;
-    auto candidate = encode_once(mesh, *grid, q, dec, options, record_bytes, orderings[i].plane_calibration,
-                                 report ? &candidate_report : nullptr, surface_for(orderings[i]));
-    if (!candidate) return tl::unexpected(candidate.error());
-    if (automatic && granular(chosen) && !granular(*candidate)) continue;
-    auto curve = measure->curve(candidate->bytes, reference_bytes);
+  auto score_of = [&](const std::vector<uint8_t>& bytes) -> Result<double> {
+    auto curve = measure->curve(bytes, reference_bytes);
     if (!curve) return tl::unexpected(curve.error());
-    const double score = RdMeasure::score(*curve);
-    if (score < chosen_score) {
-      chosen_score = score;
-      chosen = std::move(*candidate);
-      if (report) *report = std::move(candidate_report);
+    return RdMeasure::score(*curve);
+  };
+  std::vector<std::future<Result<double>>> other_scores;  // joined before `measure` goes
+  for (size_t i = 1; i < orderings.size(); ++i) {
+    other_scores.push_back(std::async(parallel ? std::launch::async : std::launch::deferred, score_of,
+                                      std::cref(candidates[i].bytes)));
+  }
+  auto chosen_score = score_of(chosen.bytes);
+  if (!chosen_score) return tl::unexpected(chosen_score.error());
+  for (size_t i = 1; i < orderings.size(); ++i) {
+    auto score = other_scores[i - 1].get();
+    if (!score) return tl::unexpected(score.error());
+    if (automatic && granular(chosen) && !granular(candidates[i])) continue;
+    if (*score < *chosen_score) {
+      chosen_score = *score;
+      chosen = std::move(candidates[i]);
+      if (report) *report = std::move(candidate_reports[i]);
     }
   }
   return std::move(chosen.bytes);

@@ -48,6 +48,10 @@ struct EncodeOptions {
   // worse than 0 on every mesh tried (more plane records and index entries,
   // see docs/hcs-format.md); kept for experiments.
   int insertion_shift = 0;
+  // Threads for the automatic ordering's candidates: 0 = as many as help
+  // (one a candidate, when the machine has more than one core), 1 = one
+  // after the other. The stream is the same either way.
+  uint32_t threads = 0;
   // Refinement record format written: 0 = kRefinementFormat (3); 2 =
   // format 2's models, kept as the peer benchmarks compare against (same
   // records, slower-learning models). Anything else is kInvalidArgument.

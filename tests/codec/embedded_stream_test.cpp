@@ -82,6 +82,26 @@ TEST(EmbeddedStream, EveryPrefixEqualsTheEncoderModel) {
   }
 }
 
+// The automatic ordering's candidates may run on threads: the stream (and
+// the report) must not depend on it.
+TEST(EmbeddedStream, CandidatesOnThreadsGiveTheSameStream) {
+  for (const Mesh& mesh : embedded_meshes()) {
+    EncodeOptions serial;
+    serial.threads = 1;
+    EncodeOptions threaded;
+    threaded.threads = 0;
+    EncodeReport serial_report, threaded_report;
+    auto a = encode_hcs(mesh, serial, &serial_report);
+    auto b = encode_hcs(mesh, threaded, &threaded_report);
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(*a, *b);
+    ASSERT_EQ(serial_report.records.size(), threaded_report.records.size());
+    for (size_t i = 0; i < serial_report.records.size(); ++i)
+      EXPECT_EQ(serial_report.records[i].position_hash, threaded_report.records[i].position_hash) << i;
+    EXPECT_EQ(serial_report.ordering.distortion_estimate, threaded_report.ordering.distortion_estimate);
+  }
+}
+
 TEST(EmbeddedStream, UnknownDistortionEstimatesAreRefused) {
   for (int estimate : {-1, 3, 100}) {
     EncodeOptions options;
