@@ -19,6 +19,7 @@
 
 #include "client/connection.h"
 #include "client/decoded_stream.h"
+#include "client/stream_facts.h"
 
 namespace meshstream::client {
 
@@ -47,25 +48,6 @@ struct StreamTarget {
   Budget budget;
   uint32_t max_chunk_bytes = 0;  // 0 = server default
   ReconnectPolicy reconnect;
-};
-
-// What the header said, kept from the first connection.
-struct StreamFacts {
-  std::string model;
-  uint64_t total_bytes = 0;
-  uint64_t start_offset = 0;
-  uint64_t end_offset = 0;
-  uint64_t payload_offset = 0;
-  uint32_t end_record = 0;
-  uint32_t records_total = 0;
-  uint32_t vertices = 0;
-  uint32_t faces = 0;
-  uint32_t base_vertices = 0;
-  uint32_t base_faces = 0;
-  uint32_t quant_bits = 0;
-  std::vector<uint64_t> record_end;        // stream offset after record i
-  std::vector<uint32_t> record_vertices;   // cumulative, per record
-  std::vector<uint32_t> record_faces;
 };
 
 // Bytes per second over the last second of reads.

@@ -25,6 +25,7 @@ Result<CatalogModel> make_model(std::string name, std::string source, std::strin
   model.origin = std::move(origin);
   model.bytes = std::move(bytes);
   model.index = std::move(*index);
+  model.compact = make_compact_index(model.index);
   return model;
 }
 

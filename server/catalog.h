@@ -13,6 +13,7 @@
 
 #include "common/base/result.h"
 #include "common/codec/container.h"
+#include "server/compact_index.h"
 #include "server/mapped_file.h"
 
 namespace meshstream::server {
@@ -23,13 +24,17 @@ struct CatalogModel {
   std::string origin;  // file path or demo description, for logs
   std::shared_ptr<const StreamBytes> bytes;
   StreamIndex index;
+  // The index coded once for StreamRequest.compact_index (empty coded: the
+  // arrays are sent).
+  CompactIndex compact;
 
   std::span<const uint8_t> stream() const { return bytes->bytes(); }
 };
 
 // Checks that `bytes` hold one complete, intact `.hcs` stream: the index
 // parses, its total equals the byte count, every record's CRC matches.
-// Errors name `origin`. O(bytes) for the CRCs.
+// Also codes the index for compact headers (make_compact_index; a refusal
+// is not an error). Errors name `origin`. O(bytes) for the CRCs.
 Result<CatalogModel> make_model(std::string name, std::string source, std::string origin,
                                 std::shared_ptr<const StreamBytes> bytes);
 

@@ -46,6 +46,11 @@ int main(int argc, char** argv) {
     spdlog::info("serving {} ({}, {} vertices, {} bytes, {} records)", model->name, model->source,
                  model->index.header.vertex_count, model->index.total_bytes(),
                  model->index.records.size());
+    if (model->compact.coded.empty()) {
+      spdlog::warn("{}: its record index cannot be coded compactly ({}); its headers carry the "
+                   "arrays",
+                   model->name, model->compact.refused);
+    }
   }
 
   Server server(options, catalog);

@@ -275,7 +275,7 @@ void Session::handle_stream(const v1::StreamRequest& request) {
   }
   ++starting_;
   shared_.first_chunks->stream_starting(Clock::now());
-  push(StartStream{model, *plan, chunk, Clock::now()}, 0);
+  push(StartStream{model, *plan, chunk, Clock::now(), request.compact_index()}, 0);
 }
 
 // ------------------------------------------------------------------ writer
@@ -309,8 +309,31 @@ awaitable<bool> Session::write_end(int reason) {
 
 namespace {
 
+// StreamHeader.records (proto/meshstream.proto, RecordIndex): the coded
+// form computed at load when the client asked for it and the model has one,
+// else the four arrays as always.
+void fill_record_index(const CatalogModel& model, bool compact, v1::RecordIndex& records) {
+  const StreamIndex& index = model.index;
+  if (compact && !model.compact.coded.empty()) {
+    records.set_coded(model.compact.coded.data(), model.compact.coded.size());
+    records.set_count(static_cast<uint32_t>(index.records.size()));
+    return;
+  }
+  const int n = static_cast<int>(index.records.size());
+  records.mutable_sizes()->Reserve(n);
+  records.mutable_vertices()->Reserve(n);
+  records.mutable_faces()->Reserve(n);
+  records.mutable_crc32()->Reserve(n);
+  for (const RecordEntry& r : index.records) {
+    records.add_sizes(r.size);
+    records.add_vertices(r.vertices);
+    records.add_faces(r.faces);
+    records.add_crc32(r.crc32);
+  }
+}
+
 std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& plan,
-                                  size_t chunk_bytes) {
+                                  size_t chunk_bytes, bool compact_index) {
   const StreamIndex& index = model.index;
   const StreamHeader& h = index.header;
   v1::ServerMessage out;
@@ -336,18 +359,7 @@ std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& p
   bounds->set_max_z(h.bounds.max.z);
   header->set_container_version(index.version);  // a catalog may hold older streams
   header->set_max_chunk_bytes(static_cast<uint32_t>(chunk_bytes));
-  v1::RecordIndex* records = header->mutable_records();
-  const int n = static_cast<int>(index.records.size());
-  records->mutable_sizes()->Reserve(n);
-  records->mutable_vertices()->Reserve(n);
-  records->mutable_faces()->Reserve(n);
-  records->mutable_crc32()->Reserve(n);
-  for (const RecordEntry& r : index.records) {
-    records->add_sizes(r.size);
-    records->add_vertices(r.vertices);
-    records->add_faces(r.faces);
-    records->add_crc32(r.crc32);
-  }
+  fill_record_index(model, compact_index, *header->mutable_records());
   return proto::encode_frame(out);
 }
 
@@ -392,7 +404,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
         if (models_.find(model.name) == std::string::npos) {
           models_ += models_.empty() ? model.name : "," + model.name;
         }
-        pending_header_ = header_frame(model, start->plan, start->chunk_bytes);
+        pending_header_ = header_frame(model, start->plan, start->chunk_bytes, start->compact_index);
       } else {  // CancelStream
         if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
       }

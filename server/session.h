@@ -80,6 +80,7 @@ class Session : public std::enable_shared_from_this<Session> {
     StreamPlan plan;
     size_t chunk_bytes;
     Clock::time_point requested;  // when its request was read
+    bool compact_index = false;   // StreamRequest.compact_index
   };
   struct CancelStream {};
   using Item = std::variant<Frame, StartStream, CancelStream>;
