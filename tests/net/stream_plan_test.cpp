@@ -120,6 +120,29 @@ TEST(StreamPlan, ChunksTileTheRangeOnBoundaries) {
   }
 }
 
+// The base mesh is the first mesh a client can show, and it decodes a chunk
+// only once the whole chunk is there: the chunk that completes the base
+// ends with it, even when later records would still fit. Later chunks pack.
+TEST(StreamPlan, TheChunkThatCompletesTheBaseEndsThere) {
+  const StreamIndex index = make_index(200, 60000, 1500);  // small records: many would fit
+  auto plan = plan_stream(index, 0, {});
+  ASSERT_TRUE(plan);
+  const ChunkCut first = next_chunk(index, *plan, 0, 65536);
+  EXPECT_EQ(first.end, end_of(index, 0));
+  EXPECT_EQ(first.records_complete, 1u);
+  const ChunkCut second = next_chunk(index, *plan, first.end, 65536);
+  EXPECT_GT(second.records_complete, 2u) << "records after the base still pack together";
+  // A prefix and base larger than the limit: the prefix alone, then the
+  // base in pieces, the last piece ending at the base's end.
+  uint64_t position = 0;
+  ChunkCut cut;
+  do {
+    cut = next_chunk(index, *plan, position, 512);
+    position = cut.end;
+  } while (cut.records_complete == 0);
+  EXPECT_EQ(cut.end, end_of(index, 0));
+}
+
 TEST(TokenBucket, PacesToTheRate) {
   using Clock = TokenBucket::Clock;
   auto now = Clock::now();
