@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "common/codec/container.h"
+#include "common/codec/record_index_coder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/export.h"
 #include "common/mesh/procedural.h"
@@ -211,6 +212,32 @@ int main(int argc, char** argv) {
       end.mutable_end()->set_reason(v1::StreamEnd::COMPLETE);
       append(t, end);
       write(out / "client_frames" / ("stream_" + std::to_string(pieces)), with_trailer(t, 0x40));
+    }
+    // The compact record index (StreamRequest.compact_index) the client
+    // asks for: the same stream behind a header with RecordIndex.coded.
+    {
+      v1::ServerMessage compact = header;
+      v1::RecordIndex& records = *compact.mutable_header()->mutable_records();
+      records.Clear();
+      auto coded = encode_record_index(index->records);
+      if (coded) {
+        records.set_coded(coded->data(), coded->size());
+        records.set_count(static_cast<uint32_t>(index->records.size()));
+        v1::StreamHeader& ch = *compact.mutable_header();
+        ch.set_payload_offset(index->payload_offset);
+        ch.set_end_offset(index->total_bytes());
+        ch.set_end_record(static_cast<uint32_t>(index->records.size()));
+        ch.set_vertices(index->records.back().vertices);
+        ch.set_faces(index->records.back().faces);
+        std::vector<uint8_t> t;
+        append(t, hello);
+        append(t, compact);
+        v1::ServerMessage chunk;
+        chunk.mutable_chunk()->set_offset(0);
+        chunk.mutable_chunk()->set_data(sample_stream.data(), sample_stream.size());
+        append(t, chunk);
+        write(out / "client_frames" / "stream_compact_index", with_trailer(t, 0x40));
+      }
     }
     v1::ServerMessage error;
     error.mutable_error()->set_code(v1::Error::UNKNOWN_MODEL);

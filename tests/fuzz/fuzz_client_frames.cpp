@@ -1,8 +1,9 @@
 // Fuzz target: what the client does with a server's bytes: the
 // ServerMessage frame reader of proto/framing.h with the client's limit,
 // then the client's handling of each message as in
-// client/stream_client.cpp (StreamClient::attempt): a header sets the
-// resume point of the DecodedStream, a chunk at the expected offset is fed
+// client/stream_client.cpp (StreamClient::attempt): a header's facts are
+// read (facts_from_header: either record index form, the compact one
+// range-decoded) and it sets the resume point of the DecodedStream, a chunk at the expected offset is fed
 // to it (the decoder that turns network bytes into the displayed mesh).
 // StreamClient itself owns a socket, so the same calls are made directly.
 //
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "client/decoded_stream.h"
+#include "client/stream_facts.h"
 #include "proto/framing.h"
 
 namespace {
@@ -47,6 +49,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!*message) break;
       const auto& m = **message;
       if (m.has_header()) {
+        auto facts = client::facts_from_header(m.header());
+        if (!facts) {
+          broken = true;  // the client ends the run with the facts' error
+          break;
+        }
+        check(facts->record_end.size() == facts->records_total);
         if (!decoded.resume_at(m.header().start_offset())) {
           broken = true;
           break;
