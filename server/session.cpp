@@ -432,7 +432,10 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       s.yielded = false;
       const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
       const size_t size = static_cast<size_t>(cut.end - s.position);
-      const auto delay = s.bucket.take(size, Clock::now());
+      // The stream header goes out with the first chunk and is paced with it,
+      // so --rate behaves like a slow link (the header is most of what a
+      // client waits for before its first mesh when the index is not compact).
+      const auto delay = s.bucket.take(size + pending_header_.size(), Clock::now());
       if (delay > Clock::duration::zero()) {
         pacing_timer_.expires_after(delay);
         boost::system::error_code ignored;

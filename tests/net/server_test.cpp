@@ -567,6 +567,37 @@ TEST(NetServer, RatePacingMakesArrivalProgressive) {
   EXPECT_GT(r.chunks.size(), 10u);  // many small paced chunks
 }
 
+// --rate stands for a slow link: the stream header (here the arrays form of
+// the record index, about 12 bytes a record) is paced with the first chunk,
+// not sent for free. The bucket starts with one chunk's worth (the header's
+// max_chunk_bytes); the rest of header + first chunk waits for the rate.
+TEST(NetServer, RatePacingChargesTheStreamHeader) {
+  constexpr double kRate = 4000;
+  ServerProcess server;
+  ASSERT_TRUE(server.start(base_args({"--rate", "4000"}), log_path("rate_header"))) << server.log();
+  TestClient c;
+  ASSERT_TRUE(c.connect(server.port()));
+  ASSERT_TRUE(c.hello());
+  v1::ServerMessage m;
+  ASSERT_EQ(c.read(m), ReadEnd::kMessage);
+  const auto start = Clock::now();
+  ASSERT_TRUE(c.stream("small"));
+  v1::ServerMessage header, chunk;
+  ASSERT_EQ(c.read(header), ReadEnd::kMessage);
+  ASSERT_TRUE(header.has_header());
+  ASSERT_EQ(c.read(chunk), ReadEnd::kMessage);
+  ASSERT_TRUE(chunk.has_chunk());
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const double paced = double(header.ByteSizeLong()) + double(chunk.chunk().data().size()) -
+                       double(header.header().max_chunk_bytes());
+  // Without the header charged this would arrive after (first chunk -
+  // burst) / rate: the bound below tells the two apart.
+  const double header_bytes = double(header.ByteSizeLong());
+  ASSERT_LT(paced - header_bytes, 0.8 * paced) << "test setup: the header must be a fair share of the paced bytes";
+  EXPECT_GT(seconds, 0.8 * paced / kRate) << "header " << header_bytes << " B and first chunk "
+                                           << chunk.chunk().data().size() << " B arrived faster than the rate";
+}
+
 TEST(NetServer, SigtermMidStreamShutsDownCleanly) {
   ServerProcess server;
   ASSERT_TRUE(server.start(base_args({"--rate", "1000000"}), log_path("sigterm"))) << server.log();
