@@ -575,11 +575,7 @@ TEST(NetServer, RatePacingChargesTheStreamHeader) {
   constexpr double kRate = 4000;
   ServerProcess server;
   ASSERT_TRUE(server.start(base_args({"--rate", "4000"}), log_path("rate_header"))) << server.log();
-  TestClient c;
-  ASSERT_TRUE(c.connect(server.port()));
-  ASSERT_TRUE(c.hello());
-  v1::ServerMessage m;
-  ASSERT_EQ(c.read(m), ReadEnd::kMessage);
+  TestClient c = greeted_client(server.port());
   const auto start = Clock::now();
   ASSERT_TRUE(c.stream("small"));
   v1::ServerMessage header, chunk;
