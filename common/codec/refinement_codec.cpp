@@ -197,6 +197,75 @@ MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, 
   return rank < 15 ? rank : 15 + m.start_rank_big.decode(dec);
 }
 
+// What the decoder needs of a resolved patch's ring before reading the
+// residual: predict_position, residual_context and insertion_shift, in one
+// pass over the ring (each of the three walked it and reloaded the same
+// positions). The same integers: the sums run in the same order, and the
+// normal skips only the two cross products that are zero (those with the
+// apex itself, whose offset from the apex is 0). The divisions by k are
+// 32-bit when the dividends fit (they do for grid coordinates < 2^20 and
+// k <= 16), which gives the same quotients as the 64-bit ones.
+struct InsertionPrediction {
+  Vec3i predicted;
+  ResidualContext ctx;
+  int shift = 0;
+};
+
+void predict_insertion(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift,
+                       InsertionPrediction& out) {
+  const Vec3i* p = s.mesh.positions().data();
+  const uint8_t* vertex_shift = s.vertex_shift.data();
+  const size_t k = ring.size();
+  const Vec3i o = p[ring[0]];
+  int64_t sx = o.x, sy = o.y, sz = o.z;
+  int shift = std::max<int>(min_shift, vertex_shift[ring[0]]);
+  int64_t total = 0;
+  int64_t n0 = 0, n1 = 0, n2 = 0;
+  int64_t px = 0, py = 0, pz = 0;  // the previous ring vertex's offset from the apex
+  Vec3i a = o;
+  for (size_t i = 1; i < k; ++i) {
+    const uint32_t u = ring[i];
+    const Vec3i b = p[u];
+    sx += b.x;
+    sy += b.y;
+    sz += b.z;
+    shift = std::max<int>(shift, vertex_shift[u]);
+    total += std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
+    const int64_t dx = int64_t(b.x) - o.x, dy = int64_t(b.y) - o.y, dz = int64_t(b.z) - o.z;
+    n0 += py * dz - pz * dy;
+    n1 += pz * dx - px * dz;
+    n2 += px * dy - py * dx;
+    px = dx;
+    py = dy;
+    pz = dz;
+    a = b;
+  }
+  total += std::abs(int64_t(a.x) - o.x) + std::abs(int64_t(a.y) - o.y) + std::abs(int64_t(a.z) - o.z);
+
+  const int64_t sum[3] = {sx, sy, sz};
+  const int64_t kk = static_cast<int64_t>(k);
+  for (int c = 0; c < 3; ++c) {
+    const int64_t num = sum[c] + kk / 2;
+    out.predicted[c] = num >= 0 && num <= int64_t(UINT32_MAX)
+                           ? static_cast<int32_t>(uint32_t(num) / uint32_t(k))
+                           : static_cast<int32_t>(num / kk);
+  }
+  ResidualContext& ctx = out.ctx;
+  ctx = ResidualContext{};
+  const uint64_t mean = (uint64_t(total) <= UINT32_MAX ? uint64_t(uint32_t(total) / uint32_t(k))
+                                                       : uint64_t(total) / k) + 1;
+  ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
+  const int64_t n[3] = {n0, n1, n2};
+  const int64_t m[3] = {std::abs(n0), std::abs(n1), std::abs(n2)};
+  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
+  int* ax = ctx.axis;
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  ctx.flip = n[ctx.axis[0]] < 0;
+  out.shift = shift;
+}
+
 }  // namespace
 
 bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
@@ -217,15 +286,27 @@ uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>&
   const size_t n = star_ring.size();
   // Face i joins ring entries i and i+1 (the last wraps to 0 when interior).
   const uint32_t* layer = s.vertex_layer.data();
-  const bool first_new = layer[star_ring[0]] == s.layer;
+  const uint32_t* ring = star_ring.data();
+  const uint32_t current = s.layer;
+  uint8_t* out = used.data();
+  const bool first_new = layer[ring[0]] == current;
   bool prev_new = first_new;
   uint32_t free_faces = 0;
-  for (uint32_t i = 0; i < faces; ++i) {
-    const bool next_new = i + 1 < n ? layer[star_ring[i + 1]] == s.layer : first_new;
+  // Faces whose far entry is ring[i + 1] (all but an interior star's last,
+  // which closes onto ring[0]), then that last one: no wrap test per face.
+  const uint32_t open_faces = faces < n ? faces : static_cast<uint32_t>(n) - 1;
+  for (uint32_t i = 0; i < open_faces; ++i) {
+    const bool next_new = layer[ring[i + 1]] == current;
     const bool taken = prev_new || next_new;
-    used[i] = taken ? 1 : 0;
+    out[i] = taken ? 1 : 0;
     free_faces += taken ? 0 : 1;
     prev_new = next_new;
+  }
+  for (uint32_t i = open_faces; i < faces; ++i) {
+    const bool taken = prev_new || first_new;
+    out[i] = taken ? 1 : 0;
+    free_faces += taken ? 0 : 1;
+    prev_new = first_new;
   }
   return free_faces;
 }
@@ -233,33 +314,50 @@ uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>&
 namespace {
 
 // Scratch of the start scoring: on the stack for ordinary stars, on the
-// heap for huge ones.
+// heap for huge ones. The decoder keeps one for a whole record (prepare per
+// star) instead of building one per patch.
 struct StartScratch {
   static constexpr uint32_t kSmall = 64;
   int64_t edge_small[2 * kSmall], score_small[kSmall];  // edge: wrapped copy after the end
+  uint32_t start_small[kSmall];
   std::vector<int64_t> edge_big, score_big;
+  std::vector<uint32_t> start_big;
   int64_t* edge = edge_small;
   int64_t* score = score_small;
-  explicit StartScratch(uint32_t faces) {
+  uint32_t* start = start_small;
+  StartScratch() = default;
+  explicit StartScratch(uint32_t faces) { prepare(faces); }
+  StartScratch(const StartScratch&) = delete;
+  StartScratch& operator=(const StartScratch&) = delete;
+  void prepare(uint32_t faces) {
     if (faces > kSmall) {
-      edge_big.resize(2 * size_t(faces));
-      score_big.resize(faces);
+      if (score_big.size() < faces) {
+        edge_big.resize(2 * size_t(faces));
+        score_big.resize(faces);
+        start_big.resize(faces);
+      }
       edge = edge_big.data();
       score = score_big.data();
+      start = start_big.data();
+    } else {
+      edge = edge_small;
+      score = score_small;
+      start = start_small;
     }
   }
 };
 
-// The candidate starts of rank_patch_starts in increasing r, with their
-// scores in `score` (score[i] belongs to out[i]), unsorted.
-void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                        const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
-                        StartScratch& scratch) {
-  out.clear();
+// The candidate starts of rank_patch_starts in increasing r into
+// scratch.start, with their scores in scratch.score (score[i] belongs to
+// start[i]), unsorted; returns their number. The scratch is prepared for
+// used.size() faces. Raw arrays: a push_back per candidate cost more than
+// the scoring of it.
+uint32_t score_patch_starts_raw(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                                const std::vector<uint8_t>& used, uint32_t k, StartScratch& scratch) {
   const uint32_t faces = static_cast<uint32_t>(used.size());
   const uint32_t fan = k - 2;
   const bool boundary = mesh.is_boundary(apex);
-  if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return;
+  if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return 0;
   const Vec3i* p = mesh.positions().data();
   auto l2 = [&](uint32_t a, uint32_t b) {
     const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y, dz = int64_t(p[a].z) - p[b].z;
@@ -267,14 +365,16 @@ void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vect
   };
   int64_t* edge = scratch.edge;
   int64_t* score = scratch.score;
+  uint32_t* out = scratch.start;
+  uint32_t n = 0;
   const uint32_t last_start = boundary ? faces - fan : faces - 1;
   const size_t ring_n = star_ring.size();
   if (k == 3) {
     for (uint32_t r = 0; r <= last_start; ++r) {
       if (used[r]) continue;
       const uint32_t b = r + 1 < ring_n ? r + 1 : 0;
-      score[out.size()] = l2(star_ring[r], star_ring[b]);
-      out.push_back(r);
+      score[n] = l2(star_ring[r], star_ring[b]);
+      out[n++] = r;
     }
   } else {
     // Squared apex edge lengths, then a sliding sum over the k-3 diagonals
@@ -291,8 +391,8 @@ void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vect
     uint32_t far = fan < faces ? fan : 0;  // (r + fan) wrapped, maintained without division
     for (uint32_t r = 0; r <= last_start; ++r) {
       if (used_in_run == 0) {
-        score[out.size()] = window;
-        out.push_back(r);
+        score[n] = window;
+        out[n++] = r;
       }
       // Slide the run one face on: drop face r and diagonal r+1, add the next.
       window += edge[r + fan] - edge[r + 1];
@@ -301,11 +401,20 @@ void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vect
       if (++far == faces) far = 0;
     }
   }
+  return n;
+}
+
+// The same into a vector (the encoder's side).
+void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+                        const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
+                        StartScratch& scratch) {
+  const uint32_t n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
+  out.assign(scratch.start, scratch.start + n);
 }
 
 // Larger score first, ties by r (stable insertion sort: runs are few).
-void sort_patch_starts(std::vector<uint32_t>& out, int64_t* score) {
-  for (size_t i = 1; i < out.size(); ++i) {
+void sort_patch_starts(uint32_t* out, size_t n, int64_t* score) {
+  for (size_t i = 1; i < n; ++i) {
     const int64_t sc = score[i];
     const uint32_t r = out[i];
     size_t j = i;
@@ -317,6 +426,10 @@ void sort_patch_starts(std::vector<uint32_t>& out, int64_t* score) {
     score[j] = sc;
     out[j] = r;
   }
+}
+
+void sort_patch_starts(std::vector<uint32_t>& out, int64_t* score) {
+  sort_patch_starts(out.data(), out.size(), score);
 }
 
 }  // namespace
@@ -412,8 +525,12 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
       e.taken_layer = state.layer;
       e.taken = 0;
     }
-    const uint32_t before = i == 0 ? k - 1 : i - 1;  // no division: this runs per ring vertex
-    e.taken += (i != open ? 1u : 0u) + (before != open ? 1u : 0u);
+    if (open == kNone) {
+      e.taken += 2;  // interior: both faces at R_i hold v
+    } else {
+      const uint32_t before = i == 0 ? k - 1 : i - 1;  // no division: this runs per ring vertex
+      e.taken += (i != open ? 1u : 0u) + (before != open ? 1u : 0u);
+    }
   }
   state.vertices[apex].valence = state.vertices[apex].valence + 4 - k;
   state.vertices[patch.ring[1]].valence += 1;
@@ -530,11 +647,11 @@ template <class DecodeRank>
 MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, uint32_t apex,
                                                       const std::vector<uint32_t>& star_ring,
                                                       const std::vector<uint8_t>& used, uint32_t k,
-                                                      std::vector<uint32_t>& starts, DecodeRank&& decode_rank,
+                                                      StartScratch& scratch, DecodeRank&& decode_rank,
                                                       uint32_t& rank) {
-  StartScratch scratch(static_cast<uint32_t>(used.size()));
-  score_patch_starts(mesh, apex, star_ring, used, k, starts, scratch);
-  const size_t n = starts.size();
+  scratch.prepare(static_cast<uint32_t>(used.size()));
+  const size_t n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
+  const uint32_t* starts = scratch.start;
   if (n == 0) {
     rank = 0;
     return kNone;
@@ -555,8 +672,8 @@ MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, 
   rank = n > 1 ? decode_rank(start_rank_context(k, n, scratch.score[best], second)) : 0;
   if (rank >= n) return kNone;
   if (rank == 0) return starts[best];
-  sort_patch_starts(starts, scratch.score);
-  return starts[rank];
+  sort_patch_starts(scratch.start, n, scratch.score);
+  return scratch.start[rank];
 }
 
 }  // namespace
@@ -575,6 +692,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
   std::vector<VertexGeometry> positions;
   std::vector<uint32_t> opens, open_edges, candidates;
   std::vector<uint8_t> used_faces;
+  StartScratch start_scratch;
   uint32_t inserted = 0;
   // On error the state is left half-applied: the caller discards it (the
   // decoder's output mesh is only updated after a record succeeds).
@@ -637,9 +755,14 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
       return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
                   " patches, more than it or the record holds");
     }
-    patches.resize(count);
-    positions.resize(count);
-    opens.resize(count);
+    // Grown, never shrunk: a patch's ring and corner vectors keep their
+    // storage from one walk vertex to the next (resizing down and up again
+    // freed and reallocated them). Only the first `count` entries are used.
+    if (patches.size() < count) {
+      patches.resize(count);
+      positions.resize(count);
+      opens.resize(count);
+    }
     uint32_t free_left = free_faces;
     for (uint32_t i = 0; i < count; ++i) {
       uint32_t k;
@@ -656,8 +779,10 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
         rank = decode_start_rank_inline(m, dec, k);
         r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
       } else {
-        r = select_patch_start3(mesh, u, star_ring, used_faces, k, candidates,
-                                [&](uint32_t context) { return decode_start_rank_inline3(m, dec, context); }, rank);
+        r = select_patch_start3(mesh, u, star_ring, used_faces, k, start_scratch,
+                                [&](uint32_t context) __attribute__((always_inline)) {
+                                  return decode_start_rank_inline3(m, dec, context);
+                                }, rank);
       }
       free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
       if (r == kNone) {
@@ -684,10 +809,10 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
         }
         if (choice > 0) opens[i] = open_edges[choice - 1];
       }
-      const Vec3i pred = predict_position(mesh, patches[i].ring);
-      const ResidualContext ctx = residual_context(mesh, patches[i].ring);
-      const int shift = insertion_shift(state, patches[i].ring, static_cast<int>(h.min_shift));
-      if (!decode_residual_inline(m, dec, ctx, pred, shift, state.max_coordinate, positions[i])) {
+      InsertionPrediction prediction;
+      predict_insertion(state, patches[i].ring, static_cast<int>(h.min_shift), prediction);
+      if (!decode_residual_inline(m, dec, prediction.ctx, prediction.predicted, prediction.shift,
+                                  state.max_coordinate, positions[i])) {
         return fail("vertex position outside the quantization grid at vertex " +
                                std::to_string(u));
       }
