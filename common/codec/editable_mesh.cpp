@@ -169,27 +169,60 @@ uint32_t EditableMesh::insert_vertex(const std::vector<uint32_t>& ring,
   opposite_.resize(3 * (first_new + appended), kNone);
   if (!dead_.empty()) dead_.resize(first_new + appended, 0);
 
-  // Ring indices wrap with compares, not `% k`: a division by a variable
-  // costs tens of cycles, and this loop runs for every inserted vertex.
-  for (uint32_t i = 0; i < k; ++i) {
-    if (i == open) continue;
-    const uint32_t f = slot[i];
-    const uint32_t after = i + 1 == k ? 0 : i + 1, before = i == 0 ? k - 1 : i - 1;
-    set_face(f, {v, ring[i], ring[after]});
-    const uint32_t b = 3 * f;
-    set_opposite(b, o[i]);
-    if (o[i] != kNone) set_opposite(o[i], b);
-    set_opposite(b + 1, after == open ? kNone : 3 * slot[after] + 2);
-    set_opposite(b + 2, before == open ? kNone : 3 * slot[before] + 1);
-    if (touched) touched->push_back(f);
+  if (open == kNone) {
+    // Interior (nearly every insertion): no face is skipped, and the ring
+    // and slot arrays are extended by one entry each way so the loop needs
+    // no wrap tests. Same writes in the same order as the general loop.
+    uint32_t ring_ext[kMaxPatchValence + 1], slot_ext[kMaxPatchValence + 2];
+    for (uint32_t i = 0; i < k; ++i) {
+      ring_ext[i] = ring[i];
+      slot_ext[i + 1] = slot[i];
+    }
+    ring_ext[k] = ring[0];
+    slot_ext[0] = slot[k - 1];
+    slot_ext[k + 1] = slot[0];
+    Triangle* faces = faces_.data();
+    uint32_t* opposite = opposite_.data();
+    for (uint32_t i = 0; i < k; ++i) {
+      const uint32_t f = slot_ext[i + 1];
+      faces[f] = {v, ring_ext[i], ring_ext[i + 1]};
+      const uint32_t b = 3 * f;
+      opposite[b] = o[i];
+      if (o[i] != kNone) opposite[o[i]] = b;
+      opposite[b + 1] = 3 * slot_ext[i + 2] + 2;
+      opposite[b + 2] = 3 * slot_ext[i] + 1;
+    }
+    if (touched) touched->insert(touched->end(), slot_ext + 1, slot_ext + 1 + k);
+  } else {
+    // Ring indices wrap with compares, not `% k`: a division by a variable
+    // costs tens of cycles, and this loop runs for every inserted vertex.
+    for (uint32_t i = 0; i < k; ++i) {
+      if (i == open) continue;
+      const uint32_t f = slot[i];
+      const uint32_t after = i + 1 == k ? 0 : i + 1, before = i == 0 ? k - 1 : i - 1;
+      set_face(f, {v, ring[i], ring[after]});
+      const uint32_t b = 3 * f;
+      set_opposite(b, o[i]);
+      if (o[i] != kNone) set_opposite(o[i], b);
+      set_opposite(b + 1, after == open ? kNone : 3 * slot[after] + 2);
+      set_opposite(b + 2, before == open ? kNone : 3 * slot[before] + 1);
+      if (touched) touched->push_back(f);
+    }
   }
   // The new vertex starts at the face after its open edge (any face if interior).
   vertex_corner_[v] = open == kNone ? 3 * slot[0] : 3 * slot[open + 1 == k ? 0 : open + 1];
   uint32_t fan_face[kMaxPatchValence];
-  for (uint32_t j = 0; j + 2 < k; ++j) fan_face[j] = face_of(fan_corners[j]);
+  // A 64-bit filter of the fan's face ids (bit f % 64): most start corners
+  // lie outside the fan, and the filter says so without the scan.
+  uint64_t fan_filter = 0;
+  for (uint32_t j = 0; j + 2 < k; ++j) {
+    fan_face[j] = face_of(fan_corners[j]);
+    fan_filter |= uint64_t(1) << (fan_face[j] & 63u);
+  }
   auto in_fan = [&](uint32_t c) {
     if (c == kNone) return false;
     const uint32_t f = face_of(c);
+    if (!((fan_filter >> (f & 63u)) & 1u)) return false;
     for (uint32_t j = 0; j + 2 < k; ++j)
       if (fan_face[j] == f) return true;
     return false;
