@@ -111,6 +111,24 @@ Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ri
   return out;
 }
 
+// The context from a ring's mean L1 edge length + 1 (`mean`) and its
+// summed normal `n` (residual_context and predict_insertion share it).
+MESHSTREAM_DECODE_INLINE static ResidualContext residual_context_from(uint64_t mean, const int64_t n[3]) {
+  ResidualContext ctx;
+  // log2 of the mean L1 edge length, in integers: octave buckets (finer
+  // buckets measured slightly worse: too little data per model).
+  ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
+  // Axes by |normal component|, largest first; ties keep axis order.
+  const int64_t m[3] = {std::abs(n[0]), std::abs(n[1]), std::abs(n[2])};
+  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
+  int* ax = ctx.axis;
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  ctx.flip = n[ctx.axis[0]] < 0;
+  return ctx;
+}
+
 ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
   const Vec3i* p = mesh.positions().data();
   int64_t total = 0;
@@ -128,20 +146,7 @@ ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uin
     n[2] += ax * by - ay * bx;
     a = b;
   }
-  ResidualContext ctx;
-  // log2 of the mean L1 edge length, in integers: octave buckets (finer
-  // buckets measured slightly worse: too little data per model).
-  const uint64_t mean = uint64_t(total) / k + 1;
-  ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
-  // Axes by |normal component|, largest first; ties keep axis order.
-  const int64_t m[3] = {std::abs(n[0]), std::abs(n[1]), std::abs(n[2])};
-  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
-  int* ax = ctx.axis;
-  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
-  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
-  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
-  ctx.flip = n[ctx.axis[0]] < 0;
-  return ctx;
+  return residual_context_from(uint64_t(total) / k + 1, n);
 }
 
 void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
@@ -250,19 +255,10 @@ void predict_insertion(const RefinementState& s, const std::vector<uint32_t>& ri
                            ? static_cast<int32_t>(uint32_t(num) / uint32_t(k))
                            : static_cast<int32_t>(num / kk);
   }
-  ResidualContext& ctx = out.ctx;
-  ctx = ResidualContext{};
   const uint64_t mean = (uint64_t(total) <= UINT32_MAX ? uint64_t(uint32_t(total) / uint32_t(k))
                                                        : uint64_t(total) / k) + 1;
-  ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
   const int64_t n[3] = {n0, n1, n2};
-  const int64_t m[3] = {std::abs(n0), std::abs(n1), std::abs(n2)};
-  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
-  int* ax = ctx.axis;
-  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
-  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
-  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
-  ctx.flip = n[ctx.axis[0]] < 0;
+  out.ctx = residual_context_from(mean, n);
   out.shift = shift;
 }
 
