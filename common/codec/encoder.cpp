@@ -365,11 +365,11 @@ class StructureWriter {
         } else if (r.open != kNone) {
           return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
         }
-        const Vec3i pred = predict_position(s_.mesh, patches_[j].ring);
-        const int shift = format_ >= 2 ? insertion_shift(s_, patches_[j].ring, min_shift) : 0;
+        InsertionPrediction prediction;
+        predict_insertion(s_, patches_[j].ring, min_shift, prediction);
+        const int shift = format_ >= 2 ? prediction.shift : 0;
         if (bits_) enc.set_cost_sink(&bits_->residual);
-        encode_coarse_residual(m, enc, residual_context(s_.mesh, patches_[j].ring), r.position, pred, shift,
-                               geometry_[j]);
+        encode_coarse_residual(m, enc, prediction.ctx, r.position, prediction.predicted, shift, geometry_[j]);
       }
       enc.set_cost_sink(nullptr);
       const uint32_t vertices_before = s_.mesh.vertex_count();

@@ -100,55 +100,6 @@ bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<ui
   return true;
 }
 
-Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
-  int64_t s[3] = {0, 0, 0};
-  const auto& p = mesh.positions();
-  for (uint32_t u : ring)
-    for (int a = 0; a < 3; ++a) s[a] += p[u][a];
-  const int64_t k = static_cast<int64_t>(ring.size());
-  Vec3i out;
-  for (int a = 0; a < 3; ++a) out[a] = static_cast<int32_t>((s[a] + k / 2) / k);  // coordinates >= 0
-  return out;
-}
-
-// The context from a ring's mean L1 edge length + 1 (`mean`) and its
-// summed normal `n` (residual_context and predict_insertion share it).
-MESHSTREAM_DECODE_INLINE static ResidualContext residual_context_from(uint64_t mean, const int64_t n[3]) {
-  ResidualContext ctx;
-  // log2 of the mean L1 edge length, in integers: octave buckets (finer
-  // buckets measured slightly worse: too little data per model).
-  ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
-  // Axes by |normal component|, largest first; ties keep axis order.
-  const int64_t m[3] = {std::abs(n[0]), std::abs(n[1]), std::abs(n[2])};
-  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
-  int* ax = ctx.axis;
-  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
-  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
-  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
-  ctx.flip = n[ctx.axis[0]] < 0;
-  return ctx;
-}
-
-ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring) {
-  const Vec3i* p = mesh.positions().data();
-  int64_t total = 0;
-  int64_t n[3] = {0, 0, 0};
-  const size_t k = ring.size();
-  const Vec3i o = p[ring[0]];
-  Vec3i a = o;
-  for (size_t i = 0; i < k; ++i) {
-    const Vec3i b = i + 1 < k ? p[ring[i + 1]] : o;
-    total += std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
-    const int64_t ax = a.x - o.x, ay = a.y - o.y, az = a.z - o.z;
-    const int64_t bx = b.x - o.x, by = b.y - o.y, bz = b.z - o.z;
-    n[0] += ay * bz - az * by;
-    n[1] += az * bx - ax * bz;
-    n[2] += ax * by - ay * bx;
-    a = b;
-  }
-  return residual_context_from(uint64_t(total) / k + 1, n);
-}
-
 void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const ResidualContext& ctx,
                             Vec3i actual, Vec3i predicted, int shift, VertexGeometry& out) {
   const int bucket = std::max(ctx.scale - shift, 0);
@@ -202,22 +153,14 @@ MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, 
   return rank < 15 ? rank : 15 + m.start_rank_big.decode(dec);
 }
 
-// What the decoder needs of a resolved patch's ring before reading the
-// residual: predict_position, residual_context and insertion_shift, in one
-// pass over the ring (each of the three walked it and reloaded the same
-// positions). The same integers: the sums run in the same order, and the
+// predict_insertion (refinement_codec.h), forced inline into the decoder's
+// record loop. One pass over the ring: the sums run in ring order, and the
 // normal skips only the two cross products that are zero (those with the
 // apex itself, whose offset from the apex is 0). The divisions by k are
 // 32-bit when the dividends fit (they do for grid coordinates < 2^20 and
 // k <= 16), which gives the same quotients as the 64-bit ones.
-struct InsertionPrediction {
-  Vec3i predicted;
-  ResidualContext ctx;
-  int shift = 0;
-};
-
-void predict_insertion(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift,
-                       InsertionPrediction& out) {
+MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s, const std::vector<uint32_t>& ring,
+                                                       int min_shift, InsertionPrediction& out) {
   const Vec3i* p = s.mesh.positions().data();
   const uint8_t* vertex_shift = s.vertex_shift.data();
   const size_t k = ring.size();
@@ -257,8 +200,20 @@ void predict_insertion(const RefinementState& s, const std::vector<uint32_t>& ri
   }
   const uint64_t mean = (uint64_t(total) <= UINT32_MAX ? uint64_t(uint32_t(total) / uint32_t(k))
                                                        : uint64_t(total) / k) + 1;
+  ResidualContext& ctx = out.ctx;
+  ctx = ResidualContext{};
+  // log2 of the mean L1 edge length, in integers: octave buckets (finer
+  // buckets measured slightly worse: too little data per model).
+  ctx.scale = std::clamp(63 - __builtin_clzll(mean), 0, kScaleContexts - 1);
+  // Axes by |normal component|, largest first; ties keep axis order.
   const int64_t n[3] = {n0, n1, n2};
-  out.ctx = residual_context_from(mean, n);
+  const int64_t m[3] = {std::abs(n0), std::abs(n1), std::abs(n2)};
+  auto before = [&](int x, int y) { return m[x] > m[y] || (m[x] == m[y] && x < y); };
+  int* ax = ctx.axis;
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  if (before(ax[2], ax[1])) std::swap(ax[1], ax[2]);
+  if (before(ax[1], ax[0])) std::swap(ax[0], ax[1]);
+  ctx.flip = n[ctx.axis[0]] < 0;
   out.shift = shift;
 }
 
@@ -269,10 +224,9 @@ bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const R
   return decode_residual_inline(models, dec, ctx, predicted, shift, max_coordinate, out);
 }
 
-int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift) {
-  int shift = min_shift;
-  for (uint32_t u : ring) shift = std::max<int>(shift, s.vertex_shift[u]);
-  return shift;
+void predict_insertion(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift,
+                       InsertionPrediction& out) {
+  predict_insertion_inline(s, ring, min_shift, out);
 }
 
 uint32_t mark_taken_faces(const RefinementState& s, const std::vector<uint32_t>& star_ring,
@@ -806,7 +760,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
         if (choice > 0) opens[i] = open_edges[choice - 1];
       }
       InsertionPrediction prediction;
-      predict_insertion(state, patches[i].ring, static_cast<int>(h.min_shift), prediction);
+      predict_insertion_inline(state, patches[i].ring, static_cast<int>(h.min_shift), prediction);
       if (!decode_residual_inline(m, dec, prediction.ctx, prediction.predicted, prediction.shift,
                                   state.max_coordinate, positions[i])) {
         return fail("vertex position outside the quantization grid at vertex " +

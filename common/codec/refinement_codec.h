@@ -206,9 +206,6 @@ uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex, const std::
                             const std::vector<uint8_t>& used, uint32_t k, uint32_t rank,
                             std::vector<uint32_t>& scratch_starts);
 
-// The decoder's prediction of a vertex inserted into `ring`: the rounded
-// average of the ring's positions. Exact integers.
-Vec3i predict_position(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
 // How a residual is modelled: `scale` (log2 of the ring's mean L1 edge
 // length on the grid) picks the model set; the axes are taken in order of
 // the ring normal's components, largest first (role 0 is the axis closest to
@@ -221,7 +218,19 @@ struct ResidualContext {
   int axis[3] = {0, 1, 2};
   bool flip = false;
 };
-ResidualContext residual_context(const EditableMesh& mesh, const std::vector<uint32_t>& ring);
+// What both sides know of a vertex inserted into `ring` before its
+// residual: `predicted`, the rounded average of the ring's positions (exact
+// integers); `ctx`, its residual context; `shift`, the precision it starts
+// with: the coarsest of its ring vertices' (a finer residual would be below
+// the prediction's own uncertainty), at least the record's `min_shift`. One
+// function for the encoder and the decoder, so they cannot disagree. O(k).
+struct InsertionPrediction {
+  Vec3i predicted;
+  ResidualContext ctx;
+  int shift = 0;
+};
+void predict_insertion(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift,
+                       InsertionPrediction& out);
 // The residual of an inserted vertex at insertion, with its `shift` low
 // bits left to plane records: per role the value sign * (|r| >> shift)
 // through the model of scale bucket max(scale - shift, 0). `out` becomes the
@@ -233,10 +242,6 @@ void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const R
 bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
                             Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out);
 
-// The precision a vertex inserted into `ring` starts with: the coarsest of
-// its ring vertices' (a finer residual would be below the prediction's own
-// uncertainty), at least the record's `min_shift`.
-int insertion_shift(const RefinementState& s, const std::vector<uint32_t>& ring, int min_shift);
 
 // Inserts a vertex into a resolved patch and links it after the apex in the
 // order list. Returns its id; appends written face slots to `touched`.
