@@ -442,20 +442,12 @@ struct PlainPlaneModels {
   BitModel sign;
 };
 
+// PlaneBitWriter's bits through the plain models instead of the context ones.
 struct PlainPlaneWriter {
-  RangeEncoder& enc;
+  PlaneBitWriter writer;
   PlainPlaneModels& m;
-  Vec3i residual;
-  uint32_t bit(BitModel&, int axis, int below) {
-    const uint32_t b = (uint32_t(std::abs(residual[axis])) >> below) & 1u;
-    enc.encode_bit(m.bit[below], b);
-    return b;
-  }
-  uint32_t sign(BitModel&, int axis) {
-    const uint32_t b = residual[axis] < 0 ? 1u : 0u;
-    enc.encode_bit(m.sign, b);
-    return b;
-  }
+  uint32_t bit(BitModel&, int axis, int below) { return writer.bit(m.bit[below], axis, below); }
+  uint32_t sign(BitModel&, int axis) { return writer.sign(m.sign, axis); }
 };
 
 // Bytes of the next plane step of vertices [first, first + count) through
@@ -468,7 +460,7 @@ size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32
   for (uint32_t v = first; v < first + count; ++v) {
     VertexGeometry geo = s.geometry[v];
     if (geo.shift == 0) continue;
-    PlainPlaneWriter io{enc, models, t.residual[v]};
+    PlainPlaneWriter io{{enc, t.residual[v]}, models};
     plane_step(unused, io, geo, prev_new, s.max_coordinate);
   }
   return enc.finish().size();
