@@ -33,19 +33,17 @@ void RangeEncoder::shift_low() {
   low_ = (low_ & 0x00FFFFFFu) << 8;
 }
 
-void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
-  const uint32_t bound = (range_ >> kModelBits) * model.p;
+void RangeEncoder::encode_with_probability(uint32_t p0, uint32_t bit) {
+  const uint32_t bound = (range_ >> kModelBits) * p0;
   if (cost_sink_) {
-    const double p0 = double(model.p) / double(1u << kModelBits);
-    *cost_sink_ -= std::log2(bit == 0 ? p0 : 1.0 - p0);
+    const double p = double(p0) / double(1u << kModelBits);
+    *cost_sink_ -= std::log2(bit == 0 ? p : 1.0 - p);
   }
   if (bit == 0) {
     range_ = bound;
-    model.p = static_cast<uint16_t>(model.p + (((1u << kModelBits) - model.p) >> kMoveBits));
   } else {
     low_ += bound;
     range_ -= bound;
-    model.p = static_cast<uint16_t>(model.p - (model.p >> kMoveBits));
   }
   while (range_ < kTop) {
     range_ <<= 8;
@@ -53,24 +51,18 @@ void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
   }
 }
 
-void RangeEncoder::encode_bit(BitModelV& model, uint32_t bit) {
-  const uint32_t p = model.state & ((1u << kModelBits) - 1);
-  const uint32_t bound = (range_ >> kModelBits) * p;
-  if (cost_sink_) {
-    const double p0 = double(p) / double(1u << kModelBits);
-    *cost_sink_ -= std::log2(bit == 0 ? p0 : 1.0 - p0);
-  }
+void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
+  encode_with_probability(model.p, bit);
   if (bit == 0) {
-    range_ = bound;
+    model.p = static_cast<uint16_t>(model.p + (((1u << kModelBits) - model.p) >> kMoveBits));
   } else {
-    low_ += bound;
-    range_ -= bound;
+    model.p = static_cast<uint16_t>(model.p - (model.p >> kMoveBits));
   }
+}
+
+void RangeEncoder::encode_bit(BitModelV& model, uint32_t bit) {
+  encode_with_probability(model.state & ((1u << kModelBits) - 1), bit);
   model.state = bit_model_next(model.state, bit);
-  while (range_ < kTop) {
-    range_ <<= 8;
-    shift_low();
-  }
 }
 
 void RangeEncoder::encode_direct(uint32_t value, int count) {

@@ -80,6 +80,8 @@ class RangeEncoder {
   void set_cost_sink(double* sink) { cost_sink_ = sink; }
 
  private:
+  // Codes `bit` where a 0 has probability p0 / 2048 (both model kinds).
+  void encode_with_probability(uint32_t p0, uint32_t bit);
   void shift_low();
   uint64_t low_ = 0;
   uint32_t range_ = 0xFFFFFFFFu;
