@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -66,6 +68,28 @@ Measures measures(const std::vector<Vec3i>& p, const std::vector<Triangle>& face
   return out;
 }
 
+// `mesh` on a 12-bit grid, decimated with `options`: what the tests look at.
+struct GridDecimation {
+  QuantGrid grid;
+  std::vector<Vec3i> q;  // grid positions, by input id
+  DecimationResult result;
+};
+std::optional<GridDecimation> decimate_on_grid(const Mesh& mesh, const DecimateOptions& options) {
+  auto grid = make_grid(mesh, 12);
+  if (!grid) {
+    ADD_FAILURE() << grid.error().message;
+    return std::nullopt;
+  }
+  GridDecimation out{*grid, quantize_positions(mesh, *grid), {}};
+  auto editable = EditableMesh::build(out.q, mesh.triangles);
+  if (!editable) {
+    ADD_FAILURE() << editable.error().message;
+    return std::nullopt;
+  }
+  out.result = decimate_layers(std::move(*editable), options);
+  return out;
+}
+
 TEST(Decimate, BaseTargetShrinksForSmallMeshesOnly) {
   DecimateOptions share;
   share.max_base_share = 1.0 / 16;
@@ -83,13 +107,11 @@ TEST(Decimate, BaseTargetShrinksForSmallMeshesOnly) {
 // vertices instead of the fixed target.
 TEST(Decimate, SmallMeshBaseHoldsItsShare) {
   const Mesh cube = subdivided_cube(10);  // 602 vertices: 1/16 = 37
-  auto grid = make_grid(cube, 12);
-  ASSERT_TRUE(grid);
-  auto editable = EditableMesh::build(quantize_positions(cube, *grid), cube.triangles);
-  ASSERT_TRUE(editable);
   DecimateOptions options;
   options.max_base_share = 1.0 / 16;
-  const DecimationResult dec = decimate_layers(std::move(*editable), options);
+  const auto decimated = decimate_on_grid(cube, options);
+  ASSERT_TRUE(decimated);
+  const DecimationResult& dec = decimated->result;
   EXPECT_EQ(dec.base_vertices.size(), 37u);
   EXPECT_FALSE(dec.layers.empty());
 }
@@ -101,14 +123,12 @@ TEST(Decimate, SmallMeshBaseHoldsItsShare) {
 TEST(Decimate, FlatFacesAndCreasesDecimateWithoutError) {
   const Mesh cube = subdivided_cube(16);
   ASSERT_EQ(cube.vertex_count(), 6u * 16 * 16 + 2);
-  auto grid = make_grid(cube, 12);
-  ASSERT_TRUE(grid);
-  const std::vector<Vec3i> q = quantize_positions(cube, *grid);
-  auto editable = EditableMesh::build(q, cube.triangles);
-  ASSERT_TRUE(editable) << editable.error().message;
   DecimateOptions options;
   options.target_vertices = 96;  // 1 538 vertices: many layers, all exact
-  const DecimationResult dec = decimate_layers(std::move(*editable), options);
+  const auto decimated = decimate_on_grid(cube, options);
+  ASSERT_TRUE(decimated);
+  const std::vector<Vec3i>& q = decimated->q;
+  const DecimationResult& dec = decimated->result;
   EXPECT_EQ(dec.base_vertices.size(), 96u);
   const Measures before = measures(q, cube.triangles);
   const Measures after = measures(q, dec.base_faces);
@@ -118,7 +138,7 @@ TEST(Decimate, FlatFacesAndCreasesDecimateWithoutError) {
   int corners = 0;
   for (uint32_t v : dec.base_vertices) {
     const Vec3i p = q[v];
-    const int m = grid->max_coordinate();
+    const int m = decimated->grid.max_coordinate();
     corners += (p.x == 0 || p.x == m) && (p.y == 0 || p.y == m) && (p.z == 0 || p.z == m);
   }
   EXPECT_EQ(corners, 8);
@@ -145,14 +165,12 @@ TEST(Decimate, CoarseVerticesGoWhereTheSurfaceBends) {
       m.triangles.push_back({a, c, d});
     }
   }
-  auto grid = make_grid(m, 12);
-  ASSERT_TRUE(grid);
-  const std::vector<Vec3i> q = quantize_positions(m, *grid);
-  auto editable = EditableMesh::build(q, m.triangles);
-  ASSERT_TRUE(editable) << editable.error().message;
   DecimateOptions options;
   options.target_vertices = 100;
-  const DecimationResult dec = decimate_layers(std::move(*editable), options);
+  const auto decimated = decimate_on_grid(m, options);
+  ASSERT_TRUE(decimated);
+  const std::vector<Vec3i>& q = decimated->q;
+  const DecimationResult& dec = decimated->result;
   ASSERT_EQ(dec.base_vertices.size(), 100u);
   int on_bump = 0;
   for (uint32_t v : dec.base_vertices) {
