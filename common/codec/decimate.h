@@ -24,9 +24,11 @@
 // so boundaries keep their shape); removing v into a costs the mean squared
 // distance of a from v's planes, and a inherits v's quadric. Among valid
 // apexes the least error wins (shape breaks near-ties).
-// Importance = log(1 + sqrt(quadric error of the chosen valid apex)
-// + |v - ring average| / 4)
-// + valence / 4, in grid units: the prediction term keeps residuals small,
+// Importance = log(1 + sqrt(e) + |v - ring average| / 20) + valence / 4,
+// in grid units, where e is the quadric error of the chosen valid apex
+// times the area v's quadric stands for over the mean vertex's (decimate.cpp:
+// a removal's share of the squared surface RMS); the prediction term keeps
+// residuals small,
 // the valence term is a regularizer in the spirit of Alliez & Desbrun's
 // valence-driven decimation (2001). Each layer draws its independent set,
 // cheapest first, from the cheapest half of the candidates only, so
@@ -69,11 +71,11 @@ struct DecimateOptions {
   // whole 1/16 point (834 bytes): that point goes from lost to 0.88 x the
   // chain's RMS, nothing else moves. 1/64 and 1/128 were worse (fandisk,
   // casting at 1/16: coarse layers cost more bits a vertex than the base).
-  // Off by default for now: with 1/16, icosphere(4) (2 562 vertices, base
-  // 160) ends on a plane record whose last bits are all 0 and so moves no
-  // vertex (a base vertex's last plane step with bit 0 keeps its
-  // reconstruction), which EmbeddedStream.EveryPrefixEqualsTheEncoderModel
-  // refuses; the encoder (not this file) should merge or drop such records.
+  // Off, and not an EncodeOptions setting: measured again with the 8-bit
+  // base and the surface-distance ordering (bench/encoder_options_bench,
+  // 1/64 to 1/16), no share brought a lost 1/64 point within budget, since
+  // header and record index alone (275-300 bytes on those meshes) take
+  // most of it; at 1/16 and 1/4 the results were mixed.
   double max_base_share = 0;
 };
 
