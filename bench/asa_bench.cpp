@@ -7,8 +7,11 @@
 //
 // Usage: asa_bench [--report-dir DIR] [--quick] [--profile MESH LEVEL uniform|T REPS]
 #include <malloc.h>
+#include <meshoptimizer.h>
 #include <time.h>
 
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/ModifiedButterFlyT.hh>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -23,15 +26,11 @@
 #include <string>
 #include <vector>
 
-#include <meshoptimizer.h>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Tools/Subdivider/Uniform/ModifiedButterFlyT.hh>
-
 #include "common/asa/corner_table.h"
 #include "common/asa/incremental.h"
+#include "common/asa/subdivide.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
-#include "common/asa/subdivide.h"
 #include "common/mesh/adjacency.h"
 #include "common/mesh/import.h"
 #include "common/metrics/distance.h"
@@ -111,7 +110,9 @@ double now_ms() {
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+  return v.empty()
+             ? 0
+             : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
 }
 
 // Peak heap above what was live before `run`, in bytes.
@@ -182,7 +183,8 @@ struct Options {
 int run_profile(const Options& opt) {
   auto imported = import_mesh(testing::test_mesh(opt.profile_mesh));
   if (!imported) {
-    std::fprintf(stderr, "asa_bench: %s: %s\n", opt.profile_mesh.c_str(), imported.error().message.c_str());
+    std::fprintf(stderr, "asa_bench: %s: %s\n", opt.profile_mesh.c_str(),
+                 imported.error().message.c_str());
     return 1;
   }
   const Mesh& mesh = imported->mesh;
@@ -199,9 +201,10 @@ int run_profile(const Options& opt) {
     (void)subdivide_into(mesh, o, ws, result);
     t.push_back(now_ms() - t0);
   }
-  std::printf("%s L%d %s: %u faces, median %.3f ms (%.1f M tri/s) over %d runs\n", opt.profile_mesh.c_str(),
-              o.levels, opt.profile_mode.c_str(), result.mesh.face_count(), median(t),
-              result.mesh.face_count() / median(t) / 1e3, opt.profile_reps);
+  std::printf("%s L%d %s: %u faces, median %.3f ms (%.1f M tri/s) over %d runs\n",
+              opt.profile_mesh.c_str(), o.levels, opt.profile_mode.c_str(),
+              result.mesh.face_count(), median(t), result.mesh.face_count() / median(t) / 1e3,
+              opt.profile_reps);
   return 0;
 }
 
@@ -214,16 +217,18 @@ int main(int argc, char** argv) {
   Options opt;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
-    if (a == "--report-dir" && i + 1 < argc) opt.report_dir = argv[++i];
-    else if (a == "--quick") opt.quick = true;
+    if (a == "--report-dir" && i + 1 < argc)
+      opt.report_dir = argv[++i];
+    else if (a == "--quick")
+      opt.quick = true;
     else if (a == "--profile" && i + 4 < argc) {
       opt.profile_mesh = argv[++i];
       opt.profile_level = std::atoi(argv[++i]);
       opt.profile_mode = argv[++i];
       opt.profile_reps = std::atoi(argv[++i]);
-    }
-    else if (a == "--help" || a == "-h") {
-      std::printf("usage: asa_bench [--report-dir DIR] [--quick] [--profile MESH LEVEL uniform|T REPS]\n");
+    } else if (a == "--help" || a == "-h") {
+      std::printf(
+          "usage: asa_bench [--report-dir DIR] [--quick] [--profile MESH LEVEL uniform|T REPS]\n");
       return 0;
     } else {
       std::fprintf(stderr, "asa_bench: unknown argument %s\n", a.c_str());
@@ -243,25 +248,30 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "asa_bench: real meshes not found (set MESHSTREAM_TEST_MESHES)\n");
     return 1;
   }
-  std::vector<std::string> names = {"bunny.off", "fandisk.off", "armadillo.obj", "casting.off", "mask.off"};
+  std::vector<std::string> names = {"bunny.off", "fandisk.off", "armadillo.obj", "casting.off",
+                                    "mask.off"};
   if (opt.quick) names = {"fandisk.off", "bunny.off"};
   const int max_level = 3;
   const Bandwidth bw = measure_bandwidth();
   std::printf("memory bandwidth: write %.1f GB/s, copy %.1f GB/s\n", bw.write_gbs, bw.copy_gbs);
 
   std::ostringstream uniform_table, asa_table, distance_table, level_table;
-  uniform_table << "| mesh | level | output faces | ours ms | ours M tri/s | OpenMesh ms | OpenMesh M tri/s | "
-                   "speed-up | speed-up incl. OpenMesh's mesh build | ours peak MB | OpenMesh peak MB | write floor ms | ours / floor |\n"
+  uniform_table << "| mesh | level | output faces | ours ms | ours M tri/s | OpenMesh ms | "
+                   "OpenMesh M tri/s | "
+                   "speed-up | speed-up incl. OpenMesh's mesh build | ours peak MB | OpenMesh peak "
+                   "MB | write floor ms | ours / floor |\n"
                    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  asa_table << "| mesh | level | t | vertices | faces | vertices / uniform | time ms | uniform ms (same window) | "
-               "time / uniform | time share / output share | same for the input's corner table alone |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  asa_table
+      << "| mesh | level | t | vertices | faces | vertices / uniform | time ms | uniform ms (same "
+         "window) | "
+         "time / uniform | time share / output share | same for the input's corner table alone |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<double> speedups, speedups_with_build;
   std::ostringstream corner_table_notes;
   std::vector<double> speedup_by_level[4];
-  std::vector<double> asa_share_ratio_by_level[4];  // (time share) / (output share)
+  std::vector<double> asa_share_ratio_by_level[4];    // (time share) / (output share)
   std::vector<double> table_share_ratio_by_level[4];  // the same for the corner table alone
-  std::vector<double> asa_time_ratio;                // ASA time / uniform time
+  std::vector<double> asa_time_ratio;                 // ASA time / uniform time
   for (const std::string& name : names) {
     auto imported = import_mesh(testing::test_mesh(name));
     if (!imported) {
@@ -283,8 +293,8 @@ int main(int argc, char** argv) {
       }
       table_ms = median(t);
     }
-    corner_table_notes << "- " << name << ": " << mesh.face_count() << " faces, corner table " << fmt("%.2f", table_ms)
-                       << " ms\n";
+    corner_table_notes << "- " << name << ": " << mesh.face_count() << " faces, corner table "
+                       << fmt("%.2f", table_ms) << " ms\n";
     for (int level = 1; level <= max_level; ++level) {
       AsaOptions uo;
       uo.uniform = true;
@@ -335,19 +345,23 @@ int main(int argc, char** argv) {
         auto r = subdivide(mesh, uo, fresh);
       });
       const double om_ms = median(theirs);
-      if (om_faces != out_faces) std::fprintf(stderr, "face counts differ: %zu vs %zu\n", om_faces, out_faces);
+      if (om_faces != out_faces)
+        std::fprintf(stderr, "face counts differ: %zu vs %zu\n", om_faces, out_faces);
       const double floor_ms = output_bytes(result.mesh, out_faces) / (bw.write_gbs * 1e6);
       speedups.push_back(om_ms / ours_ms);
       speedups_with_build.push_back((om_ms + om_build_ms) / ours_ms);
       speedup_by_level[level].push_back(om_ms / ours_ms);
-      uniform_table << "| " << name << " | " << level << " | " << out_faces << " | " << fmt("%.2f", ours_ms) << " | "
-                    << fmt("%.1f", out_faces / ours_ms / 1e3) << " | " << fmt("%.1f", om_ms) << " | "
-                    << fmt("%.2f", out_faces / om_ms / 1e3) << " | " << fmt("%.1f", om_ms / ours_ms) << "x | "
+      uniform_table << "| " << name << " | " << level << " | " << out_faces << " | "
+                    << fmt("%.2f", ours_ms) << " | " << fmt("%.1f", out_faces / ours_ms / 1e3)
+                    << " | " << fmt("%.1f", om_ms) << " | " << fmt("%.2f", out_faces / om_ms / 1e3)
+                    << " | " << fmt("%.1f", om_ms / ours_ms) << "x | "
                     << fmt("%.1f", (om_ms + om_build_ms) / ours_ms) << "x | "
-                    << fmt("%.1f", ours_peak / 1048576.0) << " | " << fmt("%.1f", om_peak / 1048576.0) << " | "
-                    << fmt("%.2f", floor_ms) << " | " << fmt("%.1f", ours_ms / floor_ms) << " |\n";
-      std::printf("%s L%d uniform: ours %.2f ms (%.1f M tri/s), OpenMesh %.1f ms (%.2f M tri/s)\n", name.c_str(),
-                  level, ours_ms, out_faces / ours_ms / 1e3, om_ms, out_faces / om_ms / 1e3);
+                    << fmt("%.1f", ours_peak / 1048576.0) << " | "
+                    << fmt("%.1f", om_peak / 1048576.0) << " | " << fmt("%.2f", floor_ms) << " | "
+                    << fmt("%.1f", ours_ms / floor_ms) << " |\n";
+      std::printf("%s L%d uniform: ours %.2f ms (%.1f M tri/s), OpenMesh %.1f ms (%.2f M tri/s)\n",
+                  name.c_str(), level, ours_ms, out_faces / ours_ms / 1e3, om_ms,
+                  out_faces / om_ms / 1e3);
 
       // ASA at the thesis's t values.
       const uint32_t uniform_vertices = result.mesh.vertex_count();
@@ -376,19 +390,22 @@ int main(int argc, char** argv) {
         asa_share_ratio_by_level[level].push_back((ms / uniform_ms) / ffrac);
         table_share_ratio_by_level[level].push_back((table_ms / uniform_ms) / ffrac);
         asa_time_ratio.push_back(ms / uniform_ms);
-        asa_table << "| " << name << " | " << level << " | " << fmt("%.1f", t) << " | " << ar.mesh.vertex_count()
-                  << " | " << ar.mesh.face_count() << " | " << fmt("%.2f", vfrac) << " | " << fmt("%.2f", ms)
-                  << " | " << fmt("%.2f", uniform_ms) << " | " << fmt("%.2f", ms / uniform_ms) << " | "
-                  << fmt("%.2f", (ms / uniform_ms) / ffrac) << " | " << fmt("%.2f", (table_ms / uniform_ms) / ffrac)
-                  << " |\n";
+        asa_table << "| " << name << " | " << level << " | " << fmt("%.1f", t) << " | "
+                  << ar.mesh.vertex_count() << " | " << ar.mesh.face_count() << " | "
+                  << fmt("%.2f", vfrac) << " | " << fmt("%.2f", ms) << " | "
+                  << fmt("%.2f", uniform_ms) << " | " << fmt("%.2f", ms / uniform_ms) << " | "
+                  << fmt("%.2f", (ms / uniform_ms) / ffrac) << " | "
+                  << fmt("%.2f", (table_ms / uniform_ms) / ffrac) << " |\n";
       }
     }
   }
 
   // Incremental updates after decoder-like records against a full run.
   std::ostringstream incremental_table;
-  incremental_table << "| mesh | mode | output faces | full ms | incremental ms per record | speed-up | "
-                       "dirty faces (mean) | region faces (mean) | full fallbacks |\n|---|---|---|---|---|---|---|---|---|\n";
+  incremental_table
+      << "| mesh | mode | output faces | full ms | incremental ms per record | speed-up | "
+         "dirty faces (mean) | region faces (mean) | full fallbacks "
+         "|\n|---|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> incremental_names = {"bunny.off", "armadillo.obj"};
   if (opt.quick) incremental_names = {"bunny.off"};
   for (const std::string& name : incremental_names) {
@@ -424,12 +441,13 @@ int main(int argc, char** argv) {
         fallbacks += inc.last_update().full;
       }
       if (inc_ms.empty()) continue;
-      incremental_table << "| " << name << " | " << (uniform_mode ? "uniform L2" : "ASA t=0.8 L2") << " | "
-                        << inc.result().mesh.face_count() << " | " << fmt("%.2f", median(full_ms)) << " | "
-                        << fmt("%.2f", median(inc_ms)) << " | " << fmt("%.1f", median(full_ms) / median(inc_ms))
-                        << "x | " << fmt("%.0f", dirty / inc_ms.size()) << " | "
-                        << fmt("%.0f", region / inc_ms.size()) << " | " << fallbacks << " / " << inc_ms.size()
-                        << " |\n";
+      incremental_table << "| " << name << " | " << (uniform_mode ? "uniform L2" : "ASA t=0.8 L2")
+                        << " | " << inc.result().mesh.face_count() << " | "
+                        << fmt("%.2f", median(full_ms)) << " | " << fmt("%.2f", median(inc_ms))
+                        << " | " << fmt("%.1f", median(full_ms) / median(inc_ms)) << "x | "
+                        << fmt("%.0f", dirty / inc_ms.size()) << " | "
+                        << fmt("%.0f", region / inc_ms.size()) << " | " << fallbacks << " / "
+                        << inc_ms.size() << " |\n";
       std::printf("%s incremental %s: full %.2f ms, incremental %.2f ms\n", name.c_str(),
                   uniform_mode ? "uniform" : "ASA", median(full_ms), median(inc_ms));
     }
@@ -442,7 +460,8 @@ int main(int argc, char** argv) {
     if (!imported) continue;
     auto stream = encode_hcs(imported->mesh);
     if (!stream) {
-      std::fprintf(stderr, "asa_bench: encode_hcs(%s): %s\n", name.c_str(), stream.error().message.c_str());
+      std::fprintf(stderr, "asa_bench: encode_hcs(%s): %s\n", name.c_str(),
+                   stream.error().message.c_str());
       continue;
     }
     auto index = read_stream_index(*stream);
@@ -483,22 +502,25 @@ int main(int argc, char** argv) {
     double inc_total = 0, full_total = 0;
     for (double x : inc_ms) inc_total += x;
     for (double x : full_ms) full_total += x;
-    incremental_table << "| " << name << " (hcs records, " << inc_ms.size() << " updates) | ASA t=0.8 L2 | "
-                      << inc.result().mesh.face_count() << " (last) | " << fmt("%.2f", median(full_ms)) << " | "
-                      << fmt("%.2f", median(inc_ms)) << " | " << fmt("%.1f", median(full_ms) / median(inc_ms))
-                      << "x (total " << fmt("%.0f", full_total) << " vs " << fmt("%.0f", inc_total) << " ms) | "
-                      << fmt("%.0f", dirty / inc_ms.size()) << " of " << decoder.mesh().face_count() << " | "
-                      << fmt("%.0f", region / inc_ms.size()) << " | " << fallbacks << " / " << inc_ms.size()
-                      << (mismatches ? " (face-count mismatches!)" : "")
-                      << " |\n";
-    std::printf("%s decoder-driven incremental: %zu updates, full %.2f ms, incremental %.2f ms (median)\n",
-                name.c_str(), inc_ms.size(), median(full_ms), median(inc_ms));
+    incremental_table << "| " << name << " (hcs records, " << inc_ms.size()
+                      << " updates) | ASA t=0.8 L2 | " << inc.result().mesh.face_count()
+                      << " (last) | " << fmt("%.2f", median(full_ms)) << " | "
+                      << fmt("%.2f", median(inc_ms)) << " | "
+                      << fmt("%.1f", median(full_ms) / median(inc_ms)) << "x (total "
+                      << fmt("%.0f", full_total) << " vs " << fmt("%.0f", inc_total) << " ms) | "
+                      << fmt("%.0f", dirty / inc_ms.size()) << " of " << decoder.mesh().face_count()
+                      << " | " << fmt("%.0f", region / inc_ms.size()) << " | " << fallbacks << " / "
+                      << inc_ms.size() << (mismatches ? " (face-count mismatches!)" : "") << " |\n";
+    std::printf(
+        "%s decoder-driven incremental: %zu updates, full %.2f ms, incremental %.2f ms (median)\n",
+        name.c_str(), inc_ms.size(), median(full_ms), median(inc_ms));
   }
 
   // Surface distance to the original before and after ASA, on meshes
   // simplified to 1/20 and 1/10 of their triangles (meshoptimizer), standing
   // in for stream prefixes decoded at compression ratios 20 and 10.
-  distance_table << "| mesh | ratio | coarse mesh | faces | variant | output faces | RMS / diag | Hausdorff / diag |\n"
+  distance_table << "| mesh | ratio | coarse mesh | faces | variant | output faces | RMS / diag | "
+                    "Hausdorff / diag |\n"
                     "|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> distance_names = {"bunny.off", "fandisk.off", "armadillo.obj"};
   if (opt.quick) distance_names = {"fandisk.off"};
@@ -532,8 +554,8 @@ int main(int argc, char** argv) {
         std::vector<unsigned> simplified(indices.size());
         const size_t target = indices.size() / ratio / 3 * 3;
         simplified.resize(meshopt_simplify(simplified.data(), indices.data(), indices.size(),
-                                           &original.positions[0].x, original.positions.size(), sizeof(Vec3f),
-                                           target, 1.0f, 0, nullptr));
+                                           &original.positions[0].x, original.positions.size(),
+                                           sizeof(Vec3f), target, 1.0f, 0, nullptr));
         // Compact the vertices the simplified mesh still uses.
         Mesh coarse;
         std::vector<uint32_t> remap(original.positions.size(), kNone);
@@ -550,7 +572,8 @@ int main(int argc, char** argv) {
           coarse.triangles.push_back(t);
         }
         // The simplifier can leave non-manifold edges; repair them as import does.
-        if (clean_mesh(coarse)) sources.push_back({"meshopt 1/" + std::to_string(ratio), std::move(coarse)});
+        if (clean_mesh(coarse))
+          sources.push_back({"meshopt 1/" + std::to_string(ratio), std::move(coarse)});
       }
       for (const Source& source : sources) {
         const Mesh& coarse = source.mesh;
@@ -559,7 +582,11 @@ int main(int argc, char** argv) {
           AsaOptions options;
         };
         std::vector<Variant> variants;
-        variants.push_back({"no ASA", [] { AsaOptions o; o.levels = 0; return o; }()});
+        variants.push_back({"no ASA", [] {
+                              AsaOptions o;
+                              o.levels = 0;
+                              return o;
+                            }()});
         for (int levels : {1, 2}) {
           for (float t : {0.9f, 0.8f}) {
             AsaOptions o;
@@ -587,26 +614,31 @@ int main(int argc, char** argv) {
         for (const Variant& v : variants) {
           auto r = subdivide(coarse, v.options);
           if (!r) {
-            distance_table << "| " << name << " | " << ratio << " | " << source.label << " | " << coarse.face_count()
-                           << " | " << v.label << " | n/a: " << r.error().message << " | | |\n";
+            distance_table << "| " << name << " | " << ratio << " | " << source.label << " | "
+                           << coarse.face_count() << " | " << v.label
+                           << " | n/a: " << r.error().message << " | | |\n";
             continue;
           }
           auto d = surface_distance(original, r->mesh);
           if (!d) continue;
-          if (v.options.levels == 0) base_rms = d->relative_rms();
+          if (v.options.levels == 0)
+            base_rms = d->relative_rms();
           else if (d->relative_rms() < best_rms) {
             best_rms = d->relative_rms();
             best = v.label;
           }
-          distance_table << "| " << name << " | " << ratio << " | " << source.label << " | " << coarse.face_count()
-                         << " | " << v.label << " | " << r->mesh.face_count() << " | "
-                         << fmt("%.3e", d->relative_rms()) << " | " << fmt("%.3e", d->relative_hausdorff()) << " |\n";
-          std::printf("%s 1/%d %s %s: rms %.3e hausdorff %.3e\n", name.c_str(), ratio, source.label.c_str(),
-                      v.label.c_str(), d->relative_rms(), d->relative_hausdorff());
+          distance_table << "| " << name << " | " << ratio << " | " << source.label << " | "
+                         << coarse.face_count() << " | " << v.label << " | " << r->mesh.face_count()
+                         << " | " << fmt("%.3e", d->relative_rms()) << " | "
+                         << fmt("%.3e", d->relative_hausdorff()) << " |\n";
+          std::printf("%s 1/%d %s %s: rms %.3e hausdorff %.3e\n", name.c_str(), ratio,
+                      source.label.c_str(), v.label.c_str(), d->relative_rms(),
+                      d->relative_hausdorff());
         }
         if (base_rms > 0 && !best.empty()) {
-          findings << "- " << name << ", ratio " << ratio << ", " << source.label << ": RMS " << fmt("%.3e", base_rms)
-                   << " without ASA; best variant " << best << " " << fmt("%.3e", best_rms) << " ("
+          findings << "- " << name << ", ratio " << ratio << ", " << source.label << ": RMS "
+                   << fmt("%.3e", base_rms) << " without ASA; best variant " << best << " "
+                   << fmt("%.3e", best_rms) << " ("
                    << fmt("%+.0f", 100.0 * (best_rms / base_rms - 1)) << " %).\n";
         }
       }
@@ -617,74 +649,108 @@ int main(int argc, char** argv) {
   const std::string path = opt.report_dir + "/asa.md";
   std::ofstream out(path);
   out << "## ASA: adaptive modified Butterfly (bench/asa_bench.cpp)\n\n";
-  out << "One process, single thread, same inputs for both libraries. Times are thread CPU time (the machine is shared), medians (ours: 9 runs, 5 above "
-         "3 M output faces; OpenMesh: 3 runs, 1 above 3 M; the two alternate) of the whole call: input adjacency, every level, "
-         "output arrays. Ours runs warm (workspace and result reused, as the client calls it); peak memory is "
-         "the heap high-water mark above the input of a cold call, counted by the same operator-new hook for "
-         "both. OpenMesh: `ModifiedButterflyT<TriMesh, float>` on its default float mesh. Memory bandwidth "
+  out << "One process, single thread, same inputs for both libraries. Times are thread CPU time "
+         "(the machine is shared), medians (ours: 9 runs, 5 above "
+         "3 M output faces; OpenMesh: 3 runs, 1 above 3 M; the two alternate) of the whole call: "
+         "input adjacency, every level, "
+         "output arrays. Ours runs warm (workspace and result reused, as the client calls it); "
+         "peak memory is "
+         "the heap high-water mark above the input of a cold call, counted by the same "
+         "operator-new hook for "
+         "both. OpenMesh: `ModifiedButterflyT<TriMesh, float>` on its default float mesh. Memory "
+         "bandwidth "
          "here: write "
       << fmt("%.1f", bw.write_gbs) << " GB/s, copy " << fmt("%.1f", bw.copy_gbs)
-      << " GB/s (memset/memcpy of 256 MiB); the write floor is the output's bytes (positions, triangles, "
+      << " GB/s (memset/memcpy of 256 MiB); the write floor is the output's bytes (positions, "
+         "triangles, "
          "face kinds) at the write bandwidth.\n\n";
   out << "### Summary\n\n";
   for (int level = 1; level <= max_level; ++level) {
     if (speedup_by_level[level].empty()) continue;
     out << "- Uniform level " << level << ": speed-up over OpenMesh median "
         << fmt("%.1f", median(speedup_by_level[level])) << "x (min "
-        << fmt("%.1f", *std::min_element(speedup_by_level[level].begin(), speedup_by_level[level].end()))
-        << "x); ASA (time share)/(output share) median " << fmt("%.1f", median(asa_share_ratio_by_level[level]))
+        << fmt("%.1f",
+               *std::min_element(speedup_by_level[level].begin(), speedup_by_level[level].end()))
+        << "x); ASA (time share)/(output share) median "
+        << fmt("%.1f", median(asa_share_ratio_by_level[level]))
         << " (the input's corner table alone, which every call builds: "
         << fmt("%.1f", median(table_share_ratio_by_level[level])) << ").\n";
   }
   if (!asa_time_ratio.empty()) {
-    out << "- ASA time / uniform time: at most " << fmt("%.2f", *std::max_element(asa_time_ratio.begin(), asa_time_ratio.end()))
+    out << "- ASA time / uniform time: at most "
+        << fmt("%.2f", *std::max_element(asa_time_ratio.begin(), asa_time_ratio.end()))
         << " over every mesh, level and t (the thesis's ASA was up to 1.31).\n";
   }
   out << "\n### Uniform: ours against OpenMesh\n\n" << uniform_table.str() << "\n";
-  out << "Every call first builds the corner table of the input from plain arrays (and validates it); "
-         "OpenMesh's subdivision time starts from its already built half-edge mesh, whose build is in the "
+  out << "Every call first builds the corner table of the input from plain arrays (and validates "
+         "it); "
+         "OpenMesh's subdivision time starts from its already built half-edge mesh, whose build is "
+         "in the "
          "`incl.` column. That fixed cost, per mesh:\n\n"
       << corner_table_notes.str() << "\n";
   if (!speedups.empty()) {
     out << "Speed-up over OpenMesh: median " << fmt("%.1f", median(speedups)) << "x, min "
         << fmt("%.1f", *std::min_element(speedups.begin(), speedups.end())) << "x, max "
-        << fmt("%.1f", *std::max_element(speedups.begin(), speedups.end())) << "x (subdivision only); "
-        << "including the build of OpenMesh's half-edge mesh from the same arrays (what a caller holding "
+        << fmt("%.1f", *std::max_element(speedups.begin(), speedups.end()))
+        << "x (subdivision only); "
+        << "including the build of OpenMesh's half-edge mesh from the same arrays (what a caller "
+           "holding "
         << "arrays pays; our time always includes building our corner table): median "
         << fmt("%.1f", median(speedups_with_build)) << "x, min "
-        << fmt("%.1f", *std::min_element(speedups_with_build.begin(), speedups_with_build.end())) << "x.\n\n";
+        << fmt("%.1f", *std::min_element(speedups_with_build.begin(), speedups_with_build.end()))
+        << "x.\n\n";
   }
   out << "### ASA against uniform (the thesis's tables 4.1-4.4)\n\n"
-         "`time share / output share` = (ASA time / uniform time) / (ASA faces / uniform faces): at most 1 "
-         "means ASA costs no more per output triangle than uniform. Uniform is timed again in alternation "
-         "with each ASA configuration (same workspace reuse), and the ratios use that time. The last column "
-         "is the ratio the input's corner table alone scores (its build time as the time share): every call, "
-         "ASA or uniform, builds it before any level, and ASA's output is only about 1 to 1.5 times the input "
-         "at any level while uniform's is 4^level times, so that fixed cost alone uses that fraction of the "
-         "target's budget (ratio 1). The rest of ASA (face normals and the flatness test of the input, the "
-         "closure, and at every level a pass over the whole, mostly unchanged mesh: copying kept faces, "
-         "linking their corners) has to fit in what is left, and does not: see the gap between the two "
+         "`time share / output share` = (ASA time / uniform time) / (ASA faces / uniform faces): "
+         "at most 1 "
+         "means ASA costs no more per output triangle than uniform. Uniform is timed again in "
+         "alternation "
+         "with each ASA configuration (same workspace reuse), and the ratios use that time. The "
+         "last column "
+         "is the ratio the input's corner table alone scores (its build time as the time share): "
+         "every call, "
+         "ASA or uniform, builds it before any level, and ASA's output is only about 1 to 1.5 "
+         "times the input "
+         "at any level while uniform's is 4^level times, so that fixed cost alone uses that "
+         "fraction of the "
+         "target's budget (ratio 1). The rest of ASA (face normals and the flatness test of the "
+         "input, the "
+         "closure, and at every level a pass over the whole, mostly unchanged mesh: copying kept "
+         "faces, "
+         "linking their corners) has to fit in what is left, and does not: see the gap between the "
+         "two "
          "columns.\n\n"
       << asa_table.str() << "\n";
   out << "### Incremental updates (the client's case)\n\n"
-         "After each decoder-like record (synthetic rows: a vertex inserted into a random face, one face "
-         "replaced and two appended; `hcs records` rows: our IncrementalDecoder applying the real stream one "
-         "record at a time), `IncrementalSubdivider::update` against a full `subdivide_into` with a warm "
-         "workspace (medians over the updates). A region update pays off when a record's changes are local; "
-         "when they are spread over the surface the dirty region (3 rings around every changed vertex) "
-         "covers much of the mesh and the update falls back to a full run (`full fallbacks`), at the cost of "
+         "After each decoder-like record (synthetic rows: a vertex inserted into a random face, "
+         "one face "
+         "replaced and two appended; `hcs records` rows: our IncrementalDecoder applying the real "
+         "stream one "
+         "record at a time), `IncrementalSubdivider::update` against a full `subdivide_into` with "
+         "a warm "
+         "workspace (medians over the updates). A region update pays off when a record's changes "
+         "are local; "
+         "when they are spread over the surface the dirty region (3 rings around every changed "
+         "vertex) "
+         "covers much of the mesh and the update falls back to a full run (`full fallbacks`), at "
+         "the cost of "
          "the diff. The incremental result is checked equal to the full one face for face "
-         "in tests/asa/asa_incremental_test.cpp. Its cost is the region's subdivision plus an O(output) "
+         "in tests/asa/asa_incremental_test.cpp. Its cost is the region's subdivision plus an "
+         "O(output) "
          "splice (copying the clean patches with renumbered vertices).\n\n"
       << incremental_table.str() << "\n";
   out << "### Does ASA bring a coarse mesh closer to the original?\n\n"
-         "Coarse meshes: `hcs prefix` is our own stream (`encode_hcs`, default options) decoded at compression "
-         "ratio 20 and 10 (`prefix_for_budget` with `kRatio`, the thesis's way of counting); `meshopt` is "
-         "meshoptimizer's `meshopt_simplify` at 1/20 and 1/10 of the triangles (a subset of the original "
-         "vertices), repaired by `clean_mesh` where it left non-manifold edges. Distances: `surface_distance` "
+         "Coarse meshes: `hcs prefix` is our own stream (`encode_hcs`, default options) decoded at "
+         "compression "
+         "ratio 20 and 10 (`prefix_for_budget` with `kRatio`, the thesis's way of counting); "
+         "`meshopt` is "
+         "meshoptimizer's `meshopt_simplify` at 1/20 and 1/10 of the triangles (a subset of the "
+         "original "
+         "vertices), repaired by `clean_mesh` where it left non-manifold edges. Distances: "
+         "`surface_distance` "
          "(common/metrics), symmetric, relative to the original's bounding-box diagonal.\n\n"
-      << distance_table.str() << "\nBest variant against no post-processing, per coarse mesh:\n\n" << findings.str()
-      << "\n";
+      << distance_table.str() << "\nBest variant against no post-processing, per coarse mesh:\n\n"
+      << findings.str() << "\n";
   std::printf("wrote %s\n", path.c_str());
   return 0;
 }

@@ -46,7 +46,9 @@ double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<size_t>(p * double(v.size() - 1) + 0.5))];
 }
-double max_of(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
+double max_of(const std::vector<double>& v) {
+  return v.empty() ? 0 : *std::max_element(v.begin(), v.end());
+}
 
 struct Model {
   std::string name;    // catalog name (file stem)
@@ -108,8 +110,8 @@ bool same_faces(const AsaResult& a, const AsaResult& b) {
   if (a.mesh.triangles.size() != b.mesh.triangles.size()) return false;
   for (size_t f = 0; f < a.mesh.triangles.size(); ++f) {
     for (int i = 0; i < 3; ++i) {
-      if (std::memcmp(&a.mesh.positions[a.mesh.triangles[f][i]], &b.mesh.positions[b.mesh.triangles[f][i]],
-                      sizeof(Vec3f)) != 0)
+      if (std::memcmp(&a.mesh.positions[a.mesh.triangles[f][i]],
+                      &b.mesh.positions[b.mesh.triangles[f][i]], sizeof(Vec3f)) != 0)
         return false;
     }
   }
@@ -132,7 +134,8 @@ std::vector<ReplayRow> replay(const std::string& hcs, const AsaOptions& options)
     const auto t0 = std::chrono::steady_clock::now();
     auto applied = decoder.feed(std::span<const uint8_t>(bytes.data() + at, end - at));
     at = end;
-    return std::make_pair(applied ? *applied : 0u, Ms(std::chrono::steady_clock::now() - t0).count());
+    return std::make_pair(applied ? *applied : 0u,
+                          Ms(std::chrono::steady_clock::now() - t0).count());
   };
   // The index first (its length is known once it parses).
   while (!decoder.index() && at < bytes.size()) feed_to(std::min(bytes.size(), at + 256));
@@ -175,9 +178,12 @@ int main(int argc, char** argv) {
   std::string mesh_override;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--report-dir" && i + 1 < argc) report_dir = argv[++i];
-    else if (a == "--quick") quick = true;
-    else if (a == "--mesh" && i + 1 < argc) mesh_override = argv[++i];
+    if (a == "--report-dir" && i + 1 < argc)
+      report_dir = argv[++i];
+    else if (a == "--quick")
+      quick = true;
+    else if (a == "--mesh" && i + 1 < argc)
+      mesh_override = argv[++i];
     else if (a == "-h" || a == "--help") {
       std::printf("usage: client_bench [--report-dir DIR] [--quick] [--mesh FILE]\n");
       return 0;
@@ -195,12 +201,14 @@ int main(int argc, char** argv) {
     m.origin = origin;
     m.hcs = dir / ("models/" + name + ".hcs");
     if (run({tool_bin(), "encode", input, "-o", m.hcs}, dir / "enc.out", dir / "enc.err") != 0) {
-      std::fprintf(stderr, "client_bench: cannot encode %s: %s\n", input.c_str(), read_text(dir / "enc.err").c_str());
+      std::fprintf(stderr, "client_bench: cannot encode %s: %s\n", input.c_str(),
+                   read_text(dir / "enc.err").c_str());
       return false;
     }
     IncrementalDecoder d;
     const std::string text = read_text(m.hcs);
-    auto ok = d.feed(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+    auto ok = d.feed(
+        std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
     if (!ok || !d.index()) return false;
     m.bytes = text.size();
     m.records = static_cast<uint32_t>(d.index()->records.size());
@@ -211,9 +219,10 @@ int main(int argc, char** argv) {
   };
   // The demo model as `meshstream-server --demo` serves it: the procedural
   // trefoil at 200k faces, encoded with the default options.
-  if (run({tool_bin(), "generate", "demo", "--size", "200000", "-o", dir / "demo.ply"}, dir / "gen.out",
-          dir / "gen.err") != 0 ||
-      !encode(dir / "demo.ply", "demo", "procedural demo model (meshstream generate demo --size 200000)")) {
+  if (run({tool_bin(), "generate", "demo", "--size", "200000", "-o", dir / "demo.ply"},
+          dir / "gen.out", dir / "gen.err") != 0 ||
+      !encode(dir / "demo.ply", "demo",
+              "procedural demo model (meshstream generate demo --size 200000)")) {
     std::fprintf(stderr, "client_bench: no demo model\n");
     return 1;
   }
@@ -222,25 +231,33 @@ int main(int argc, char** argv) {
   if (!mesh_override.empty()) real.push_back(mesh_override);
   const std::string meshes = meshstream::testing::test_mesh_dir();
   if (!meshes.empty()) {
-    for (const char* f : {"dragon_res2.ply", "maneki-neko.off", "armadillo.obj"}) real.push_back(meshes + "/" + f);
+    for (const char* f : {"dragon_res2.ply", "maneki-neko.off", "armadillo.obj"})
+      real.push_back(meshes + "/" + f);
   }
   for (const std::string& path : real) {
-    if (fs::exists(path) && encode(path, fs::path(path).stem().string(), fs::path(path).filename().string())) break;
+    if (fs::exists(path) &&
+        encode(path, fs::path(path).stem().string(), fs::path(path).filename().string()))
+      break;
   }
 
   const std::vector<std::pair<std::string, uint64_t>> rates = {
       {"unthrottled", 0}, {"1 MB/s", 1000000}, {"100 KB/s", 100000}};
   std::ostringstream md;
   md << "## Streaming client (client_bench)\n\n"
-     << "Loopback, the real `meshstream-server` and `meshstream-client --json` (default ASA: 1 level, t = 0.85, "
-        "Zorin rule; path auto). Times are the client's own clock from its start (resolve + connect + Hello) "
+     << "Loopback, the real `meshstream-server` and `meshstream-client --json` (default ASA: 1 "
+        "level, t = 0.85, "
+        "Zorin rule; path auto). Times are the client's own clock from its start (resolve + "
+        "connect + Hello) "
         "to the event. Unthrottled rows are medians of "
      << (quick ? 1 : 3) << " runs; throttled rows one run. Load average when the run started: "
-     << read_text("/proc/loadavg").substr(0, 14) << " (the 2 cores are shared: figures include waiting "
+     << read_text("/proc/loadavg").substr(0, 14)
+     << " (the 2 cores are shared: figures include waiting "
      << "for CPU).\n\n";
   std::vector<std::string> first_display_notes, budget_notes;
-  md << "| model | stream | records | rate | first display ms | half the records ms | end ms | display updates | "
-        "coalesced | decode ms per update (median / max) | ASA ms per update (median / max) | incremental updates |\n"
+  md << "| model | stream | records | rate | first display ms | half the records ms | end ms | "
+        "display updates | "
+        "coalesced | decode ms per update (median / max) | ASA ms per update (median / max) | "
+        "incremental updates |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& [rate_name, rate] : rates) {
     Server server;
@@ -257,12 +274,13 @@ int main(int argc, char** argv) {
       if (quick && rate == 100000 && m.bytes > 600000) continue;
       const int repeats = rate == 0 && !quick ? 3 : 1;
       std::vector<NetRun> runs;
-      for (int i = 0; i < repeats; ++i) runs.push_back(stream_once(server.address(), m.name, dir.path()));
+      for (int i = 0; i < repeats; ++i)
+        runs.push_back(stream_once(server.address(), m.name, dir.path()));
       std::vector<double> first, half, end;
       for (const NetRun& r : runs) {
         if (!r.ok) {
-          std::fprintf(stderr, "client_bench: %s at %s failed: %s\n", m.name.c_str(), rate_name.c_str(),
-                       r.error.c_str());
+          std::fprintf(stderr, "client_bench: %s at %s failed: %s\n", m.name.c_str(),
+                       rate_name.c_str(), r.error.c_str());
           continue;
         }
         first.push_back(r.first_ms);
@@ -270,39 +288,47 @@ int main(int argc, char** argv) {
         end.push_back(r.end_ms);
       }
       if (first.empty()) continue;
-      const NetRun& r = *std::find_if(runs.begin(), runs.end(), [](const NetRun& x) { return x.ok; });
+      const NetRun& r =
+          *std::find_if(runs.begin(), runs.end(), [](const NetRun& x) { return x.ok; });
       if (rate == 0) {
         first_display_notes.push_back(m.name + " " + fmt("%.1f", median(first)) + " ms (runs: " +
                                       [&] {
                                         std::string all;
-                                        for (double f : first) all += (all.empty() ? "" : ", ") + fmt("%.1f", f);
+                                        for (double f : first)
+                                          all += (all.empty() ? "" : ", ") + fmt("%.1f", f);
                                         return all;
                                       }() +
                                       ")");
       }
-      std::printf("%s %s: first %.1f ms, half %.1f ms, end %.1f ms, %u updates, %u coalesced\n", m.name.c_str(),
-                  rate_name.c_str(), median(first), median(half), median(end), r.updates, r.coalesced);
-      md << "| " << m.name << " | " << fmt("%.0f", double(m.bytes) / 1000.0) << " KB | " << m.records << " | "
-         << rate_name << " | " << fmt("%.1f", median(first)) << " | " << fmt("%.1f", median(half)) << " | "
-         << fmt("%.1f", median(end)) << " | " << r.updates << " | " << r.coalesced << " | "
-         << fmt("%.2f", median(r.decode_ms)) << " / " << fmt("%.2f", max_of(r.decode_ms)) << " | "
-         << fmt("%.2f", median(r.asa_ms)) << " / " << fmt("%.2f", max_of(r.asa_ms)) << " | " << r.incremental
-         << " |\n";
+      std::printf("%s %s: first %.1f ms, half %.1f ms, end %.1f ms, %u updates, %u coalesced\n",
+                  m.name.c_str(), rate_name.c_str(), median(first), median(half), median(end),
+                  r.updates, r.coalesced);
+      md << "| " << m.name << " | " << fmt("%.0f", double(m.bytes) / 1000.0) << " KB | "
+         << m.records << " | " << rate_name << " | " << fmt("%.1f", median(first)) << " | "
+         << fmt("%.1f", median(half)) << " | " << fmt("%.1f", median(end)) << " | " << r.updates
+         << " | " << r.coalesced << " | " << fmt("%.2f", median(r.decode_ms)) << " / "
+         << fmt("%.2f", max_of(r.decode_ms)) << " | " << fmt("%.2f", median(r.asa_ms)) << " / "
+         << fmt("%.2f", max_of(r.asa_ms)) << " | " << r.incremental << " |\n";
     }
     server.stop();
   }
-  md << "\nA display update's decode ms is the decoder time of every record merged into it (coalesced "
+  md << "\nA display update's decode ms is the decoder time of every record merged into it "
+        "(coalesced "
         "records included).\n\n";
 
   // Replay: both ASA paths on the same inputs, record by record.
   AsaOptions options;  // the client's defaults
   md << "### Per record, both ASA paths on the same input (in-process replay)\n\n"
      << "Every record applied alone (no coalescing), then the display mesh computed by a full "
-        "`subdivide_into` and by `IncrementalSubdivider::update` (it falls back to a full run itself when "
+        "`subdivide_into` and by `IncrementalSubdivider::update` (it falls back to a full run "
+        "itself when "
         "more than 25 % of the faces are dirty); results compared face for face.\n\n"
-     << "| model | records | display faces at end | decode ms (median / p95 / max) | full ASA ms (median / p95 / max) "
-        "| incremental ASA ms (median / p95 / max) | updates done as region / equal to full | faster path per "
-        "update: incremental / full | decode + faster ASA < 16 ms (updates with display <= 200k faces) |\n"
+     << "| model | records | display faces at end | decode ms (median / p95 / max) | full ASA ms "
+        "(median / p95 / max) "
+        "| incremental ASA ms (median / p95 / max) | updates done as region / equal to full | "
+        "faster path per "
+        "update: incremental / full | decode + faster ASA < 16 ms (updates with display <= 200k "
+        "faces) |\n"
      << "|---|---|---|---|---|---|---|---|---|\n";
   for (const Model& m : models) {
     const auto rows = replay(m.hcs, options);
@@ -321,32 +347,44 @@ int main(int argc, char** argv) {
         under += r.decode_ms + std::min(r.full_ms, r.incremental_ms) < 16.0;
       }
     }
-    std::printf("replay %s: %zu records, decode median %.2f ms, full median %.2f ms, incremental median %.2f ms, "
-                "%u region updates, %u equal\n",
-                m.name.c_str(), rows.size(), median(dec), median(full), median(inc), region, equal);
+    std::printf(
+        "replay %s: %zu records, decode median %.2f ms, full median %.2f ms, incremental median "
+        "%.2f ms, "
+        "%u region updates, %u equal\n",
+        m.name.c_str(), rows.size(), median(dec), median(full), median(inc), region, equal);
     auto trio = [&](const std::vector<double>& v) {
-      return fmt("%.2f", median(v)) + " / " + fmt("%.2f", percentile(v, 0.95)) + " / " + fmt("%.2f", max_of(v));
+      return fmt("%.2f", median(v)) + " / " + fmt("%.2f", percentile(v, 0.95)) + " / " +
+             fmt("%.2f", max_of(v));
     };
-    budget_notes.push_back(m.name + ": " + std::to_string(under) + " of " + std::to_string(eligible));
-    md << "| " << m.name << " | " << rows.size() << " | " << rows.back().display_faces << " | " << trio(dec)
-       << " | " << trio(full) << " | " << trio(inc) << " | " << region << " / " << equal << " of " << rows.size()
-       << " | " << inc_faster << " / " << rows.size() - inc_faster << " | " << under << " of " << eligible
-       << " |\n";
+    budget_notes.push_back(m.name + ": " + std::to_string(under) + " of " +
+                           std::to_string(eligible));
+    md << "| " << m.name << " | " << rows.size() << " | " << rows.back().display_faces << " | "
+       << trio(dec) << " | " << trio(full) << " | " << trio(inc) << " | " << region << " / "
+       << equal << " of " << rows.size() << " | " << inc_faster << " / " << rows.size() - inc_faster
+       << " | " << under << " of " << eligible << " |\n";
   }
-  md << "\n**Targets.** First displayed mesh within 20 ms of connecting, unthrottled (median of the runs): ";
-  for (size_t i = 0; i < first_display_notes.size(); ++i) md << (i ? "; " : "") << first_display_notes[i];
-  md << ". Decode + ASA under 16 ms per update for display meshes up to 200k triangles (replay, with the "
+  md << "\n**Targets.** First displayed mesh within 20 ms of connecting, unthrottled (median of "
+        "the runs): ";
+  for (size_t i = 0; i < first_display_notes.size(); ++i)
+    md << (i ? "; " : "") << first_display_notes[i];
+  md << ". Decode + ASA under 16 ms per update for display meshes up to 200k triangles (replay, "
+        "with the "
         "faster ASA path per update): ";
   for (size_t i = 0; i < budget_notes.size(); ++i) md << (i ? "; " : "") << budget_notes[i];
-  md << " updates. On loopback the stream itself is not the limit: unthrottled, the end time is the decoder "
-        "and ASA sharing two busy cores, and ASA coalesces most records (the `coalesced` column), so the "
-        "display jumps in a few large steps; at 100 KB/s nearly every record is shown, and the region path "
-        "serves the updates that change little of the mesh. Throttled first-display times include the time "
+  md << " updates. On loopback the stream itself is not the limit: unthrottled, the end time is "
+        "the decoder "
+        "and ASA sharing two busy cores, and ASA coalesces most records (the `coalesced` column), "
+        "so the "
+        "display jumps in a few large steps; at 100 KB/s nearly every record is shown, and the "
+        "region path "
+        "serves the updates that change little of the mesh. Throttled first-display times include "
+        "the time "
         "to receive the container prefix and the base mesh at that rate.\n";
   md << "\nModels: ";
   for (size_t i = 0; i < models.size(); ++i) {
-    md << (i ? "; " : "") << models[i].name << " = " << models[i].origin << ", " << models[i].vertices
-       << " vertices, " << models[i].faces << " faces, " << models[i].bytes << " bytes";
+    md << (i ? "; " : "") << models[i].name << " = " << models[i].origin << ", "
+       << models[i].vertices << " vertices, " << models[i].faces << " faces, " << models[i].bytes
+       << " bytes";
   }
   md << ".\n";
   fs::create_directories(report_dir);

@@ -12,21 +12,20 @@
 //
 //   codec_bench --report-dir DIR [--meshes a.off,b.ply] [--quick]
 //               [--mesh-dir DIR] [--samples N]
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "bench/real_mesh_list.h"
 #include "bench/codec/measurements.h"
 #include "bench/codec/rate_distortion.h"
 #include "bench/codec/report.h"
 #include "bench/codec/svg_plot.h"
 #include "bench/codec/timing.h"
 #include "bench/peers/draco_peer.h"
+#include "bench/real_mesh_list.h"
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
@@ -125,7 +124,8 @@ std::vector<uint8_t> measure_ours(const Mesh& mesh, const Settings& s, MeshMeasu
     return {};
   }
   m.ours_records = static_cast<uint32_t>(index->records.size());
-  m.ours_base_bytes = index->records.empty() ? 0 : index->records[0].offset + index->records[0].size;
+  m.ours_base_bytes =
+      index->records.empty() ? 0 : index->records[0].offset + index->records[0].size;
   m.ours_vertices_at_ratio20 = vertices_at_ratio20(*index, m.ours_bytes_at_ratio20);
   for (size_t i = 1; i < index->records.size(); ++i)
     m.ours_largest_record = std::max<uint64_t>(m.ours_largest_record, index->records[i].size);
@@ -196,7 +196,8 @@ void measure_decode_speeds(const std::vector<uint8_t>& draco7, const std::vector
 }
 
 void measure_rate_distortion(const Mesh& mesh, const std::vector<uint8_t>& stream,
-                             const std::vector<uint8_t>& plain, const Settings& s, MeshMeasurements& m) {
+                             const std::vector<uint8_t>& plain, const Settings& s,
+                             MeshMeasurements& m) {
   DistanceOptions options;
   options.samples = s.samples;
   auto original = PreparedSurface::prepare(mesh, options);
@@ -221,7 +222,8 @@ void measure_rate_distortion(const Mesh& mesh, const std::vector<uint8_t>& strea
       m.ours_curve = *curve;
       for (size_t i = 1; i < m.ours_curve.size(); ++i) {
         const double before = m.ours_curve[i - 1].rms;
-        if (before > 0) m.ours_worst_rms_rise = std::max(m.ours_worst_rms_rise, m.ours_curve[i].rms / before - 1);
+        if (before > 0)
+          m.ours_worst_rms_rise = std::max(m.ours_worst_rms_rise, m.ours_curve[i].rms / before - 1);
       }
     }
   }
@@ -261,12 +263,14 @@ MeshMeasurements measure_mesh(const std::string& name, const Settings& s) {
   std::printf("%-16s V %7u  Draco L7 %6.2f bpv  L10 %6.2f bpv  decode %6.2f Mv/s\n", name.c_str(),
               m.vertices, m.bpv(m.draco7_bytes), m.bpv(m.draco10_bytes), m.draco_decode_vps / 1e6);
   if (m.ours_error.empty()) {
-    std::printf("%-16s ours %6.2f bpv (%.2f x L7, issue I %.2f bpv)  encode %6.3f Mv/s  decode %6.2f Mv/s  "
-                "%u records (%u plane), largest %.2f %%, ratio 20: %.1f %% of vertices, model %s\n",
-                name.c_str(), m.bpv(m.ours_bytes), double(m.ours_bytes) / m.draco7_bytes, m.bpv(m.plain_bytes),
-                m.ours_encode_vps / 1e6, m.ours_decode_vps / 1e6, m.ours_records, m.ours_plane_records,
-                100.0 * m.ours_largest_record / m.ours_bytes, 100.0 * m.ours_vertices_at_ratio20 / m.vertices,
-                m.ours_model_matches ? "matches" : "DIFFERS");
+    std::printf(
+        "%-16s ours %6.2f bpv (%.2f x L7, issue I %.2f bpv)  encode %6.3f Mv/s  decode %6.2f Mv/s  "
+        "%u records (%u plane), largest %.2f %%, ratio 20: %.1f %% of vertices, model %s\n",
+        name.c_str(), m.bpv(m.ours_bytes), double(m.ours_bytes) / m.draco7_bytes,
+        m.bpv(m.plain_bytes), m.ours_encode_vps / 1e6, m.ours_decode_vps / 1e6, m.ours_records,
+        m.ours_plane_records, 100.0 * m.ours_largest_record / m.ours_bytes,
+        100.0 * m.ours_vertices_at_ratio20 / m.vertices,
+        m.ours_model_matches ? "matches" : "DIFFERS");
   } else {
     std::printf("%-16s ours n/a: %s\n", name.c_str(), m.ours_error.c_str());
   }
@@ -279,8 +283,9 @@ MeshMeasurements measure_mesh(const std::string& name, const Settings& s) {
                 static_cast<unsigned long long>(c.chain.bytes), c.chain.rel_rms,
                 c.chain.rel_hausdorff);
     if (c.ours) {
-      std::printf("   ours %8llu B rms %.3g (x%.2f) H %.3g (x%.2f)", static_cast<unsigned long long>(c.ours->bytes),
-                  c.ours->rel_rms, c.ours->rms / c.chain.rms, c.ours->rel_hausdorff,
+      std::printf("   ours %8llu B rms %.3g (x%.2f) H %.3g (x%.2f)",
+                  static_cast<unsigned long long>(c.ours->bytes), c.ours->rel_rms,
+                  c.ours->rms / c.chain.rms, c.ours->rel_hausdorff,
                   c.ours->hausdorff / c.chain.hausdorff);
     }
     if (i < m.plain_at_chain.size() && m.plain_at_chain[i].ours) {
@@ -289,7 +294,8 @@ MeshMeasurements measure_mesh(const std::string& name, const Settings& s) {
     }
     std::printf("\n");
   }
-  if (!m.rd_error.empty()) std::printf("%-16s rate-distortion: %s\n", name.c_str(), m.rd_error.c_str());
+  if (!m.rd_error.empty())
+    std::printf("%-16s rate-distortion: %s\n", name.c_str(), m.rd_error.c_str());
   std::fflush(stdout);
   return m;
 }
@@ -306,20 +312,25 @@ int main(int argc, char** argv) {
   Settings settings;
   settings.mesh_dir = meshstream::testing::test_mesh_dir();
   app.add_option("--report-dir", report_dir, "where codec.md, codec_rd.csv, codec_rd.svg go");
-  app.add_option("--meshes", mesh_list, "comma-separated mesh file names (default: every real mesh)");
+  app.add_option("--meshes", mesh_list,
+                 "comma-separated mesh file names (default: every real mesh)");
   app.add_flag("--quick", quick, "three meshes, fewer runs and curve points");
   app.add_option("--mesh-dir", settings.mesh_dir, "folder of the test meshes");
   app.add_option("--samples", settings.samples, "area samples per direction for distances");
-  app.add_option("--base-shift", settings.encode.base_shift, "EncodeOptions::base_shift (-1 automatic)");
-  app.add_option("--base-vertices", settings.encode.target_base_vertices, "EncodeOptions::target_base_vertices");
-  app.add_option("--record-bytes", settings.encode.record_bytes, "EncodeOptions::record_bytes (0 automatic)");
+  app.add_option("--base-shift", settings.encode.base_shift,
+                 "EncodeOptions::base_shift (-1 automatic)");
+  app.add_option("--base-vertices", settings.encode.target_base_vertices,
+                 "EncodeOptions::target_base_vertices");
+  app.add_option("--record-bytes", settings.encode.record_bytes,
+                 "EncodeOptions::record_bytes (0 automatic)");
   bool no_peer = false;
   app.add_flag("--no-peer", no_peer, "skip issue I's ordering (faster)");
   CLI11_PARSE(app, argc, argv);
   settings.peer = !no_peer;
 
   if (settings.mesh_dir.empty() || !std::filesystem::is_directory(settings.mesh_dir)) {
-    std::fprintf(stderr, "codec_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or --mesh-dir)\n");
+    std::fprintf(stderr,
+                 "codec_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or --mesh-dir)\n");
     return 1;
   }
   if (quick) {

@@ -26,6 +26,7 @@
 // measured choice: for iterating; reports use the default). --csv writes the
 // per-mesh numbers; --baseline reads such a file and puts its medians and
 // per-mesh equal-bytes ratios beside this run's ("before / after").
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -36,12 +37,10 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "bench/real_mesh_list.h"
 #include "bench/codec/timing.h"
 #include "bench/peers/draco_peer.h"
 #include "bench/peers/meshopt_lod.h"
+#include "bench/real_mesh_list.h"
 #include "common/codec/container.h"
 #include "common/codec/decimate.h"
 #include "common/codec/decoder.h"
@@ -59,10 +58,10 @@ const char* const kLabels[3] = {"1/64", "1/16", "1/4"};
 
 struct Level {
   uint32_t meshopt_vertices = 0;
-  double meshopt_rms = 0;       // meshopt's mesh on our grid
-  uint64_t chain_bytes = 0;     // cumulative Draco bytes up to this level
-  double chain_rms = 0;         // the Draco-decoded level
-  uint32_t ours_vertices = 0;   // prefix with at most meshopt_vertices
+  double meshopt_rms = 0;      // meshopt's mesh on our grid
+  uint64_t chain_bytes = 0;    // cumulative Draco bytes up to this level
+  double chain_rms = 0;        // the Draco-decoded level
+  uint32_t ours_vertices = 0;  // prefix with at most meshopt_vertices
   double ours_rms = 0;
   uint64_t ours_bytes_at_chain = 0;  // prefix within chain_bytes
   uint32_t ours_vertices_at_chain = 0;
@@ -186,7 +185,8 @@ MeshRow measure_mesh(const std::string& name, const Settings& s) {
       id[v] = coarse.vertex_count();
       coarse.positions.push_back(grid->dequantize(q[v]));
     }
-    for (const Triangle& t : dec.base_faces) coarse.triangles.push_back({id[t[0]], id[t[1]], id[t[2]]});
+    for (const Triangle& t : dec.base_faces)
+      coarse.triangles.push_back({id[t[0]], id[t[1]], id[t[2]]});
     l.decimated_vertices = coarse.vertex_count();
     l.decimated_rms = measure->relative_rms(coarse);
   }
@@ -194,7 +194,8 @@ MeshRow measure_mesh(const std::string& name, const Settings& s) {
   {
     auto editable = EditableMesh::build(q, mesh.triangles);
     if (editable) {
-      row.decimate_seconds = cpu_seconds([&] { decimate_layers(std::move(*editable), DecimateOptions{}); });
+      row.decimate_seconds =
+          cpu_seconds([&] { decimate_layers(std::move(*editable), DecimateOptions{}); });
     }
   }
 
@@ -222,9 +223,10 @@ MeshRow measure_mesh(const std::string& name, const Settings& s) {
   uint64_t vertex_prefix[3], byte_prefix[3];
   for (int i = 0; i < 3; ++i) {
     vertex_prefix[i] = prefix_for_budget(
-        *index, DecodeBudget{DecodeBudget::Kind::kVertices, double(row.levels[i].meshopt_vertices)});
-    byte_prefix[i] =
-        prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, double(row.levels[i].chain_bytes)});
+        *index,
+        DecodeBudget{DecodeBudget::Kind::kVertices, double(row.levels[i].meshopt_vertices)});
+    byte_prefix[i] = prefix_for_budget(
+        *index, DecodeBudget{DecodeBudget::Kind::kBytes, double(row.levels[i].chain_bytes)});
     at[vertex_prefix[i]] = {};
     at[byte_prefix[i]] = {};
   }
@@ -232,16 +234,20 @@ MeshRow measure_mesh(const std::string& name, const Settings& s) {
   double curve_chain_rms[kCurveBudgets];
   double curve_budget[kCurveBudgets];
   {
-    const double lo = std::log(double(row.levels[0].chain_bytes)), hi = std::log(double(row.levels[2].chain_bytes));
+    const double lo = std::log(double(row.levels[0].chain_bytes)),
+                 hi = std::log(double(row.levels[2].chain_bytes));
     for (int j = 0; j < kCurveBudgets; ++j) {
       const double lb = lo + (hi - lo) * j / (kCurveBudgets - 1);
       // The chain's RMS at lb, log-log between its two neighbouring points.
       const int seg = std::log(double(row.levels[1].chain_bytes)) < lb ? 1 : 0;
-      const double b0 = std::log(double(row.levels[seg].chain_bytes)), b1 = std::log(double(row.levels[seg + 1].chain_bytes));
-      const double r0 = std::log(row.levels[seg].chain_rms), r1 = std::log(row.levels[seg + 1].chain_rms);
+      const double b0 = std::log(double(row.levels[seg].chain_bytes)),
+                   b1 = std::log(double(row.levels[seg + 1].chain_bytes));
+      const double r0 = std::log(row.levels[seg].chain_rms),
+                   r1 = std::log(row.levels[seg + 1].chain_rms);
       curve_chain_rms[j] = std::exp(b1 > b0 ? r0 + (r1 - r0) * (lb - b0) / (b1 - b0) : r0);
       curve_budget[j] = std::exp(lb);
-      curve_prefix[j] = prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, curve_budget[j]});
+      curve_prefix[j] =
+          prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, curve_budget[j]});
       at[curve_prefix[j]] = {};
     }
   }
@@ -297,20 +303,23 @@ int lost_points(const std::vector<MeshRow>& rows, int level) {
 // CSV: one line per mesh, name then the numbers the report needs.
 void write_csv(const std::string& path, const std::vector<MeshRow>& rows) {
   std::ofstream out(path);
-  out << "mesh,vertices,stream_bytes,base_bytes,base_vertices,layers,encode_s,curve_ratio,decimate_s";
+  out << "mesh,vertices,stream_bytes,base_bytes,base_vertices,layers,encode_s,curve_ratio,decimate_"
+         "s";
   for (int i = 0; i < 3; ++i)
-    out << ",mo_v" << i << ",mo_rms" << i << ",chain_bytes" << i << ",chain_rms" << i << ",ours_v" << i
-        << ",ours_rms" << i << ",ours_bytes_at_chain" << i << ",ours_v_at_chain" << i << ",ours_rms_at_chain" << i << ",dec_v" << i << ",dec_rms" << i;
+    out << ",mo_v" << i << ",mo_rms" << i << ",chain_bytes" << i << ",chain_rms" << i << ",ours_v"
+        << i << ",ours_rms" << i << ",ours_bytes_at_chain" << i << ",ours_v_at_chain" << i
+        << ",ours_rms_at_chain" << i << ",dec_v" << i << ",dec_rms" << i;
   out << "\n";
   for (const MeshRow& r : rows) {
     if (!r.error.empty()) continue;
-    out << r.name << ',' << r.vertices << ',' << r.stream_bytes << ',' << r.base_bytes << ',' << r.base_vertices
-        << ',' << r.layers << ',' << r.encode_seconds << ',' << r.curve_ratio << ',' << r.decimate_seconds;
+    out << r.name << ',' << r.vertices << ',' << r.stream_bytes << ',' << r.base_bytes << ','
+        << r.base_vertices << ',' << r.layers << ',' << r.encode_seconds << ',' << r.curve_ratio
+        << ',' << r.decimate_seconds;
     for (const Level& l : r.levels)
-      out << ',' << l.meshopt_vertices << ',' << l.meshopt_rms << ',' << l.chain_bytes << ',' << l.chain_rms << ','
-          << l.ours_vertices << ',' << l.ours_rms << ',' << l.ours_bytes_at_chain << ','
-          << l.ours_vertices_at_chain << ',' << l.ours_rms_at_chain << ',' << l.decimated_vertices << ','
-          << l.decimated_rms;
+      out << ',' << l.meshopt_vertices << ',' << l.meshopt_rms << ',' << l.chain_bytes << ','
+          << l.chain_rms << ',' << l.ours_vertices << ',' << l.ours_rms << ','
+          << l.ours_bytes_at_chain << ',' << l.ours_vertices_at_chain << ',' << l.ours_rms_at_chain
+          << ',' << l.decimated_vertices << ',' << l.decimated_rms;
     out << "\n";
   }
 }
@@ -363,17 +372,22 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-void write_markdown(const std::string& path, const std::vector<MeshRow>& rows, const std::vector<MeshRow>& before,
-                    const Settings& s) {
+void write_markdown(const std::string& path, const std::vector<MeshRow>& rows,
+                    const std::vector<MeshRow>& before, const Settings& s) {
   std::ofstream out(path);
   out << "## Decimation: coarse meshes per vertex and per byte\n\n";
   out << "`bench/decimation_bench` (one run, every real mesh, 12 bits, "
-      << (s.fast ? "plane_calibration = 1" : "default EncodeOptions") << "). Our decoded prefix against "
-      << "meshoptimizer's `meshopt_simplify` at 1/64, 1/16 and 1/4 of the indices (the codec bench's LOD "
-      << "chain). *Per vertex*: our prefix with at most meshopt's vertex count, (RMS x vertices) ours over "
-      << "meshopt's (both on the original's grid). *Equal bytes*: our prefix within the chain's cumulative "
+      << (s.fast ? "plane_calibration = 1" : "default EncodeOptions")
+      << "). Our decoded prefix against "
+      << "meshoptimizer's `meshopt_simplify` at 1/64, 1/16 and 1/4 of the indices (the codec "
+         "bench's LOD "
+      << "chain). *Per vertex*: our prefix with at most meshopt's vertex count, (RMS x vertices) "
+         "ours over "
+      << "meshopt's (both on the original's grid). *Equal bytes*: our prefix within the chain's "
+         "cumulative "
       << "Draco bytes, RMS ours over chain. RMS: symmetric, over the bounding-box diagonal, "
-      << "`RdMeasure::relative_rms` with " << s.samples << " area samples (common/codec/rd_measure.h).\n\n";
+      << "`RdMeasure::relative_rms` with " << s.samples
+      << " area samples (common/codec/rd_measure.h).\n\n";
   std::map<std::string, const MeshRow*> old;
   for (const MeshRow& r : before) old[r.name] = &r;
   out << "| mesh | V | bits/V | base V (bytes) | layers | encode s | decimate s |";
@@ -403,12 +417,18 @@ void write_markdown(const std::string& path, const std::vector<MeshRow>& rows, c
     if (b) out << " (" << fmt("%.2f", b->curve_ratio) << ")";
     out << " |\n";
   }
-  out << "\n" << (before.empty() ? "" : "In parentheses: the baseline run (before this decimation). ")
-      << "Ratios below 1: ours better. *lost*: our header, index and base alone exceed the chain's bytes "
-      << "(counted as worse than any ratio in the medians; the worst rows are over the points not lost). "
-      << "*curve*: geometric mean of ours / chain RMS at " << kCurveBudgets << " log-spaced byte budgets from the "
-      << "chain's 1/64 to its 1/4 point (chain interpolated log-log; budgets below our base skipped): less "
-      << "sensitive than one point to where a run of plane records falls. *decimate s*: decimate_layers "
+  out << "\n"
+      << (before.empty() ? "" : "In parentheses: the baseline run (before this decimation). ")
+      << "Ratios below 1: ours better. *lost*: our header, index and base alone exceed the chain's "
+         "bytes "
+      << "(counted as worse than any ratio in the medians; the worst rows are over the points not "
+         "lost). "
+      << "*curve*: geometric mean of ours / chain RMS at " << kCurveBudgets
+      << " log-spaced byte budgets from the "
+      << "chain's 1/64 to its 1/4 point (chain interpolated log-log; budgets below our base "
+         "skipped): less "
+      << "sensitive than one point to where a run of plane records falls. *decimate s*: "
+         "decimate_layers "
       << "alone (default options), thread CPU; *encode s*: the whole encode_hcs, one run.\n\n";
   out << "| summary | bits/V | encode s | decimate s |";
   for (const char* l : kLabels) out << " " << l << " per vertex | " << l << " equal bytes |";
@@ -417,42 +437,56 @@ void write_markdown(const std::string& path, const std::vector<MeshRow>& rows, c
   out << "\n";
   auto summary = [&](const std::string& label, const std::vector<MeshRow>& set) {
     if (set.empty()) return;
-    out << "| " << label << " median | " << fmt("%.2f", median_of(set, [](const MeshRow& r) { return r.bpv(); }))
-        << " | " << fmt("%.2f", median_of(set, [](const MeshRow& r) { return r.encode_seconds; })) << " | "
+    out << "| " << label << " median | "
+        << fmt("%.2f", median_of(set, [](const MeshRow& r) { return r.bpv(); })) << " | "
+        << fmt("%.2f", median_of(set, [](const MeshRow& r) { return r.encode_seconds; })) << " | "
         << fmt("%.3f", median_of(set, [](const MeshRow& r) { return r.decimate_seconds; })) << " |";
     for (int i = 0; i < 3; ++i) {
-      out << " " << fmt("%.2f", median_of(set, [i](const MeshRow& r) { return r.levels[i].per_vertex_ratio(); }))
-          << " | " << fmt("%.2f", median_of(set, [i](const MeshRow& r) { return r.levels[i].bytes_ratio(); }))
+      out << " "
+          << fmt("%.2f",
+                 median_of(set, [i](const MeshRow& r) { return r.levels[i].per_vertex_ratio(); }))
+          << " | "
+          << fmt("%.2f",
+                 median_of(set, [i](const MeshRow& r) { return r.levels[i].bytes_ratio(); }))
           << " |";
     }
-    out << " " << fmt("%.2f", median_of(set, [](const MeshRow& r) { return r.curve_ratio; })) << " |";
-    out << "\n| " << label << " worst | " << fmt("%.2f", worst_of(set, [](const MeshRow& r) { return r.bpv(); }))
-        << " | " << fmt("%.2f", worst_of(set, [](const MeshRow& r) { return r.encode_seconds; })) << " | "
+    out << " " << fmt("%.2f", median_of(set, [](const MeshRow& r) { return r.curve_ratio; }))
+        << " |";
+    out << "\n| " << label << " worst | "
+        << fmt("%.2f", worst_of(set, [](const MeshRow& r) { return r.bpv(); })) << " | "
+        << fmt("%.2f", worst_of(set, [](const MeshRow& r) { return r.encode_seconds; })) << " | "
         << fmt("%.3f", worst_of(set, [](const MeshRow& r) { return r.decimate_seconds; })) << " |";
     for (int i = 0; i < 3; ++i) {
-      out << " " << fmt("%.2f", worst_of(set, [i](const MeshRow& r) { return r.levels[i].per_vertex_ratio(); }))
-          << " | " << fmt("%.2f", worst_of(set, [i](const MeshRow& r) { return r.levels[i].bytes_ratio(); }))
+      out << " "
+          << fmt("%.2f",
+                 worst_of(set, [i](const MeshRow& r) { return r.levels[i].per_vertex_ratio(); }))
+          << " | "
+          << fmt("%.2f", worst_of(set, [i](const MeshRow& r) { return r.levels[i].bytes_ratio(); }))
           << " |";
     }
-    out << " " << fmt("%.2f", worst_of(set, [](const MeshRow& r) { return r.curve_ratio; })) << " |";
+    out << " " << fmt("%.2f", worst_of(set, [](const MeshRow& r) { return r.curve_ratio; }))
+        << " |";
     out << "\n| " << label << " lost points | | | |";
     for (int i = 0; i < 3; ++i) out << " | " << lost_points(set, i) << " |";
     out << " |\n";
   };
   summary("this run", rows);
   summary("baseline", before);
-  out << "\nAbsolute values (this run): meshopt V / RMS, ours V / RMS at that count, chain bytes / RMS, "
+  out << "\nAbsolute values (this run): meshopt V / RMS, ours V / RMS at that count, chain bytes / "
+         "RMS, "
          "ours V / RMS within those bytes.\n\n";
-  out << "| mesh | level | meshopt V | meshopt RMS | ours V | ours RMS | chain bytes | chain RMS | ours V "
+  out << "| mesh | level | meshopt V | meshopt RMS | ours V | ours RMS | chain bytes | chain RMS | "
+         "ours V "
          "(bytes) | ours RMS |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const MeshRow& r : rows) {
     if (!r.error.empty()) continue;
     for (int i = 0; i < 3; ++i) {
       const Level& l = r.levels[i];
       out << "| " << r.name << " | " << kLabels[i] << " | " << l.meshopt_vertices << " | "
-          << fmt("%.3g", l.meshopt_rms) << " | " << l.ours_vertices << " | " << fmt("%.3g", l.ours_rms) << " | "
-          << l.chain_bytes << " | " << fmt("%.3g", l.chain_rms) << " | " << l.ours_vertices_at_chain << " ("
-          << l.ours_bytes_at_chain << ") | " << fmt("%.3g", l.ours_rms_at_chain) << " |\n";
+          << fmt("%.3g", l.meshopt_rms) << " | " << l.ours_vertices << " | "
+          << fmt("%.3g", l.ours_rms) << " | " << l.chain_bytes << " | " << fmt("%.3g", l.chain_rms)
+          << " | " << l.ours_vertices_at_chain << " (" << l.ours_bytes_at_chain << ") | "
+          << fmt("%.3g", l.ours_rms_at_chain) << " |\n";
     }
   }
 }
@@ -467,7 +501,8 @@ int main(int argc, char** argv) {
   Settings s;
   s.mesh_dir = meshstream::testing::test_mesh_dir();
   app.add_option("--report-dir", report_dir, "where decimation.md goes");
-  app.add_option("--meshes", mesh_list, "comma-separated mesh file names (default: every real mesh)");
+  app.add_option("--meshes", mesh_list,
+                 "comma-separated mesh file names (default: every real mesh)");
   app.add_option("--mesh-dir", s.mesh_dir, "folder of the test meshes");
   app.add_option("--samples", s.samples, "area samples on the original (RdMeasure)");
   app.add_flag("--fast", s.fast, "plane_calibration = 1 (skip the encoder's measured choice)");
@@ -475,7 +510,9 @@ int main(int argc, char** argv) {
   app.add_option("--baseline", baseline, "a --csv file of an earlier run, shown beside this one");
   CLI11_PARSE(app, argc, argv);
   if (s.mesh_dir.empty() || !std::filesystem::is_directory(s.mesh_dir)) {
-    std::fprintf(stderr, "decimation_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or --mesh-dir)\n");
+    std::fprintf(
+        stderr,
+        "decimation_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or --mesh-dir)\n");
     return 1;
   }
   const std::vector<std::string> names = mesh_list.empty() ? kRealMeshes : split_commas(mesh_list);
@@ -487,11 +524,12 @@ int main(int argc, char** argv) {
       std::printf("%-16s failed: %s\n", name.c_str(), r.error.c_str());
       continue;
     }
-    std::printf("%-16s V %6u %5.2f bpv base %4u V %5llu B layers %3u encode %5.2f s |", name.c_str(), r.vertices,
-                r.bpv(), r.base_vertices, (unsigned long long)r.base_bytes, r.layers, r.encode_seconds);
+    std::printf("%-16s V %6u %5.2f bpv base %4u V %5llu B layers %3u encode %5.2f s |",
+                name.c_str(), r.vertices, r.bpv(), r.base_vertices,
+                (unsigned long long)r.base_bytes, r.layers, r.encode_seconds);
     for (const Level& l : r.levels)
-      std::printf(" dec %.2f perV %.2f bytes %.2f%s |", l.decimated_ratio(), l.per_vertex_ratio(), l.bytes_ratio(),
-                  l.lost() ? "*" : "");
+      std::printf(" dec %.2f perV %.2f bytes %.2f%s |", l.decimated_ratio(), l.per_vertex_ratio(),
+                  l.bytes_ratio(), l.lost() ? "*" : "");
     std::printf(" curve %.2f dec %.3f s\n", r.curve_ratio, r.decimate_seconds);
     std::fflush(stdout);
   }
@@ -509,8 +547,8 @@ int main(int argc, char** argv) {
               median_of(rows, [](const MeshRow& r) { return r.levels[0].decimated_ratio(); }),
               median_of(rows, [](const MeshRow& r) { return r.levels[1].decimated_ratio(); }),
               median_of(rows, [](const MeshRow& r) { return r.levels[2].decimated_ratio(); }));
-  std::printf("median per vertex %.3f %.3f %.3f  equal bytes %.3f %.3f %.3f  bpv %.3f\n", med(0, false),
-              med(1, false), med(2, false), med(0, true), med(1, true), med(2, true),
+  std::printf("median per vertex %.3f %.3f %.3f  equal bytes %.3f %.3f %.3f  bpv %.3f\n",
+              med(0, false), med(1, false), med(2, false), med(0, true), med(1, true), med(2, true),
               median_of(rows, [](const MeshRow& r) { return r.bpv(); }));
   std::printf("wrote %s/decimation.md\n", report_dir.c_str());
   return 0;

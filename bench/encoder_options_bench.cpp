@@ -10,6 +10,7 @@
 //
 // `build/bench/encoder_options_bench --report-dir bench/report` writes
 // encoder_options.md; `--variants a,b` and `--meshes x,y` narrow a run.
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,11 +22,9 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "bench/real_mesh_list.h"
 #include "bench/peers/draco_peer.h"
 #include "bench/peers/meshopt_lod.h"
+#include "bench/real_mesh_list.h"
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
@@ -56,21 +55,35 @@ std::vector<Variant> all_variants() {
   };
   add("default", "the encoder's defaults", [](EncodeOptions&) {});
   add("base-shift-0", "exact base (12-bit)", [](EncodeOptions& o) { o.base_shift = 0; });
-  add("base-shift-4", "8-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 4; });
-  add("base-shift-3", "9-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 3; });
-  add("base-shift-5", "7-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 5; });
-  add("base-shift-6", "6-bit base, low bits in plane records", [](EncodeOptions& o) { o.base_shift = 6; });
-  add("base-150", "decimate to about 150 base vertices", [](EncodeOptions& o) { o.target_base_vertices = 150; });
-  add("base-600", "decimate to about 600 base vertices", [](EncodeOptions& o) { o.target_base_vertices = 600; });
+  add("base-shift-4", "8-bit base, low bits in plane records",
+      [](EncodeOptions& o) { o.base_shift = 4; });
+  add("base-shift-3", "9-bit base, low bits in plane records",
+      [](EncodeOptions& o) { o.base_shift = 3; });
+  add("base-shift-5", "7-bit base, low bits in plane records",
+      [](EncodeOptions& o) { o.base_shift = 5; });
+  add("base-shift-6", "6-bit base, low bits in plane records",
+      [](EncodeOptions& o) { o.base_shift = 6; });
+  add("base-150", "decimate to about 150 base vertices",
+      [](EncodeOptions& o) { o.target_base_vertices = 150; });
+  add("base-600", "decimate to about 600 base vertices",
+      [](EncodeOptions& o) { o.target_base_vertices = 600; });
   add("insertion-shift-2", "inserted vertices 2 bits coarser, sharpened by plane records",
       [](EncodeOptions& o) { o.insertion_shift = 2; });
-  add("calibration-1", "displacement estimate, plane balance 1 (no measured choice)", [](EncodeOptions& o) { o.plane_calibration = 1; });
-  add("calibration-3", "displacement estimate, plane balance 3 (no measured choice)", [](EncodeOptions& o) { o.plane_calibration = 3; });
-  add("surface-1", "surface-distance estimate, plane balance 1 (no measured choice)", [](EncodeOptions& o) { o.distortion_estimate = 2; o.plane_calibration = 1; });
-  add("displacement-auto", "displacement estimate, balance 1 or 3 by measurement (the encoder before the surface estimate)", [](EncodeOptions& o) {
-    o.distortion_estimate = 1;
-  });
-  add("issue-1-order", "no bit planes: every position exact at insertion", [](EncodeOptions& o) { o.embedded = false; });
+  add("calibration-1", "displacement estimate, plane balance 1 (no measured choice)",
+      [](EncodeOptions& o) { o.plane_calibration = 1; });
+  add("calibration-3", "displacement estimate, plane balance 3 (no measured choice)",
+      [](EncodeOptions& o) { o.plane_calibration = 3; });
+  add("surface-1", "surface-distance estimate, plane balance 1 (no measured choice)",
+      [](EncodeOptions& o) {
+        o.distortion_estimate = 2;
+        o.plane_calibration = 1;
+      });
+  add("displacement-auto",
+      "displacement estimate, balance 1 or 3 by measurement (the encoder before the surface "
+      "estimate)",
+      [](EncodeOptions& o) { o.distortion_estimate = 1; });
+  add("issue-1-order", "no bit planes: every position exact at insertion",
+      [](EncodeOptions& o) { o.embedded = false; });
   return v;
 }
 
@@ -79,7 +92,7 @@ struct Cell {
   std::string error;
   double bits_per_vertex = 0;
   double encode_seconds = 0;
-  double ratio[kPoints] = {};    // our RMS / chain RMS at the chain's bytes; +inf when over budget
+  double ratio[kPoints] = {};  // our RMS / chain RMS at the chain's bytes; +inf when over budget
   uint32_t vertices[kPoints] = {};
 };
 
@@ -121,8 +134,8 @@ Result<Mesh> decode_within(std::span<const uint8_t> stream, uint64_t budget, boo
   return decoder.mesh();
 }
 
-MeshRow measure(const std::string& dir, const std::string& name, const std::vector<Variant>& variants,
-                uint32_t samples) {
+MeshRow measure(const std::string& dir, const std::string& name,
+                const std::vector<Variant>& variants, uint32_t samples) {
   MeshRow row;
   row.name = name;
   auto imported = import_mesh(dir + "/" + name);
@@ -162,7 +175,8 @@ MeshRow measure(const std::string& dir, const std::string& name, const std::vect
     o.threads = 1;  // the encode time column compares the work of each variant
     const auto start = std::chrono::steady_clock::now();
     auto stream = encode_hcs(mesh, o);
-    c.encode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    c.encode_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!stream) {
       c.error = stream.error().message;
       row.cells.push_back(c);
@@ -182,8 +196,8 @@ MeshRow measure(const std::string& dir, const std::string& name, const std::vect
       c.ratio[i] = over ? std::numeric_limits<double>::infinity()
                         : surface->relative_rms(*shown) / row.chain_rms[i];
     }
-    std::printf("%-16s %-18s %6.2f bpv  %.2f s  RMS/chain", name.c_str(), v.name.c_str(), c.bits_per_vertex,
-                c.encode_seconds);
+    std::printf("%-16s %-18s %6.2f bpv  %.2f s  RMS/chain", name.c_str(), v.name.c_str(),
+                c.bits_per_vertex, c.encode_seconds);
     for (size_t i = 0; i < kPoints; ++i) std::printf("  %s", fmt("%.3f", c.ratio[i]).c_str());
     std::printf("%s\n", c.ok ? "" : (" error: " + c.error).c_str());
     std::fflush(stdout);
@@ -199,16 +213,20 @@ void write_report(const std::filesystem::path& file, const std::vector<MeshRow>&
      << "Written by `bench/encoder_options_bench` (`--report-dir bench/report`). Every real mesh, "
         "cleaned by `import_mesh`, 12-bit positions. The chain is the codec bench's: "
         "`meshopt_simplify` to 1/64, 1/16 and 1/4 of the indices, Draco level 7, bytes cumulative. "
-        "Each variant's stream is cut at the largest record boundary within the chain's bytes; both "
+        "Each variant's stream is cut at the largest record boundary within the chain's bytes; "
+        "both "
         "meshes are measured with `RdMeasure::relative_rms` ("
      << samples
      << " area samples on the original, fixed quadrature points on the shown mesh: symmetric "
         "RMS over the bounding-box diagonal). Ratios below 1: closer than the chain at equal bytes "
         "(issue 5's target: at most 0.5). *lost*: header, index and base alone exceed the chain's "
-        "bytes (counted as infinitely far in the medians). *score*: the geometric mean of the three "
+        "bytes (counted as infinitely far in the medians). *score*: the geometric mean of the "
+        "three "
         "ratios (lost points count as 10), medians over meshes.\n\n";
-  md << "| variant | what | median RMS/chain 1/64 | 1/16 | 1/4 | median score | points < 1 | points <= 0.5 | "
-        "median bits/vertex | median encode s |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  md << "| variant | what | median RMS/chain 1/64 | 1/16 | 1/4 | median score | points < 1 | "
+        "points <= 0.5 | "
+        "median bits/vertex | median encode s "
+        "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (size_t v = 0; v < variants.size(); ++v) {
     std::vector<double> per_point[kPoints], score, bpv, secs;
     int below = 0, half = 0;
@@ -228,10 +246,12 @@ void write_report(const std::filesystem::path& file, const std::vector<MeshRow>&
     }
     md << "| " << variants[v].name << " | " << variants[v].what;
     for (size_t i = 0; i < kPoints; ++i) md << " | " << fmt("%.2f", median(per_point[i]));
-    md << " | " << fmt("%.3f", median(score)) << " | " << below << " of " << kPoints * score.size() << " | "
-       << half << " | " << fmt("%.2f", median(bpv)) << " | " << fmt("%.2f", median(secs)) << " |\n";
+    md << " | " << fmt("%.3f", median(score)) << " | " << below << " of " << kPoints * score.size()
+       << " | " << half << " | " << fmt("%.2f", median(bpv)) << " | " << fmt("%.2f", median(secs))
+       << " |\n";
   }
-  md << "\nPer mesh (RMS ours/chain at 1/64, 1/16, 1/4; bits per vertex of the whole stream):\n\n| mesh | chain RMS";
+  md << "\nPer mesh (RMS ours/chain at 1/64, 1/16, 1/4; bits per vertex of the whole stream):\n\n| "
+        "mesh | chain RMS";
   for (const Variant& v : variants) md << " | " << v.name;
   md << " |\n|---|---";
   for (size_t v = 0; v < variants.size(); ++v) md << "|---";
@@ -249,8 +269,8 @@ void write_report(const std::filesystem::path& file, const std::vector<MeshRow>&
         md << " | error: " << c.error;
         continue;
       }
-      md << " | " << fmt("%.2f", c.ratio[0]) << " / " << fmt("%.2f", c.ratio[1]) << " / " << fmt("%.2f", c.ratio[2])
-         << " (" << fmt("%.1f", c.bits_per_vertex) << ")";
+      md << " | " << fmt("%.2f", c.ratio[0]) << " / " << fmt("%.2f", c.ratio[1]) << " / "
+         << fmt("%.2f", c.ratio[2]) << " (" << fmt("%.1f", c.bits_per_vertex) << ")";
     }
     md << " |\n";
   }
@@ -267,13 +287,16 @@ int main(int argc, char** argv) {
   std::string mesh_dir = meshstream::testing::test_mesh_dir();
   uint32_t samples = 20000;
   app.add_option("--report-dir", report_dir, "where encoder_options.md goes");
-  app.add_option("--meshes", mesh_list, "comma-separated mesh file names (default: every real mesh)");
+  app.add_option("--meshes", mesh_list,
+                 "comma-separated mesh file names (default: every real mesh)");
   app.add_option("--variants", variant_list, "comma-separated variant names (default: all)");
   app.add_option("--mesh-dir", mesh_dir, "folder of the test meshes");
   app.add_option("--samples", samples, "area samples on the original");
   CLI11_PARSE(app, argc, argv);
   if (mesh_dir.empty() || !std::filesystem::is_directory(mesh_dir)) {
-    std::fprintf(stderr, "encoder_options_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or --mesh-dir)\n");
+    std::fprintf(stderr,
+                 "encoder_options_bench: test meshes not found (set MESHSTREAM_TEST_MESHES or "
+                 "--mesh-dir)\n");
     return 1;
   }
   std::vector<Variant> variants = all_variants();
@@ -284,7 +307,8 @@ int main(int argc, char** argv) {
       if (std::find(wanted.begin(), wanted.end(), v.name) != wanted.end()) kept.push_back(v);
     }
     if (kept.size() != wanted.size()) {
-      std::fprintf(stderr, "encoder_options_bench: unknown variant in '%s'\n", variant_list.c_str());
+      std::fprintf(stderr, "encoder_options_bench: unknown variant in '%s'\n",
+                   variant_list.c_str());
       return 2;
     }
     variants = kept;
@@ -293,7 +317,8 @@ int main(int argc, char** argv) {
   std::vector<MeshRow> rows;
   for (const std::string& name : names) {
     rows.push_back(measure(mesh_dir, name, variants, samples));
-    if (!rows.back().error.empty()) std::printf("%-16s failed: %s\n", name.c_str(), rows.back().error.c_str());
+    if (!rows.back().error.empty())
+      std::printf("%-16s failed: %s\n", name.c_str(), rows.back().error.c_str());
   }
   std::filesystem::create_directories(report_dir);
   write_report(std::filesystem::path(report_dir) / "encoder_options.md", rows, variants, samples);

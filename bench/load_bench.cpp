@@ -21,19 +21,18 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cstring>
+#include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <numeric>
-#include <thread>
-#include <atomic>
 #include <sstream>
+#include <thread>
 #include <unordered_map>
-
-#include <CLI/CLI.hpp>
 
 #include "common/codec/container.h"
 #include "common/codec/crc32.h"
@@ -48,9 +47,9 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace asio = meshstream::net::asio;
-using meshstream::net::tcp;
 using asio::awaitable;
 using asio::use_awaitable;
+using meshstream::net::tcp;
 using Clock = std::chrono::steady_clock;
 namespace v1 = meshstream::v1;
 
@@ -85,7 +84,8 @@ constexpr const char* LOAD_BENCH_EXPLANATION =
     "first-chunk path: accepting (all "
     "clients connect before the requests; listen backlog SOMAXCONN 4096, one accept in flight, "
     "connections dealt round-robin to the workers; see connect+hello), the catalog (a hash "
-    "lookup; each model's bytes are mapped or loaded once and shared) and encoding the header frame (2.8 us for the "
+    "lookup; each model's bytes are mapped or loaded once and shared) and encoding the header "
+    "frame (2.8 us for the "
     "274-record index, measured). Taking every queued connection per turn of the accept loop "
     "instead of one was tried and did not move connect+hello p99 (6 interleaved runs each), so "
     "the accept loop stays as it is. Tried: chunk size 16-128 KiB (`--max-chunk-bytes`) does not "
@@ -126,10 +126,10 @@ struct Scenario {
   std::vector<ClientTimes> times;
   double seconds = 0;  // first request to last end
   uint64_t bytes = 0;
-  long rss_idle_kib = 0;      // server RssAnon, no connection
-  long rss_connected_kib = 0; // server RssAnon, all connected, before streaming
-  long hwm_kib = 0;           // server VmHWM after the run
-  double server_cpu_ms = 0;   // CPU time used while streaming (go to last end)
+  long rss_idle_kib = 0;       // server RssAnon, no connection
+  long rss_connected_kib = 0;  // server RssAnon, all connected, before streaming
+  long hwm_kib = 0;            // server VmHWM after the run
+  double server_cpu_ms = 0;    // CPU time used while streaming (go to last end)
   double client_cpu_ms = 0;
   size_t errors = 0;
 };
@@ -206,14 +206,16 @@ awaitable<void> run_client(Shared& shared, asio::steady_timer& go, ClientTimes& 
 
     v1::ClientMessage request;
     request.mutable_stream()->set_model(shared.model);
-    if (shared.budget_bytes) request.mutable_stream()->mutable_budget()->set_bytes(shared.budget_bytes);
+    if (shared.budget_bytes)
+      request.mutable_stream()->mutable_budget()->set_bytes(shared.budget_bytes);
     const auto request_bytes = meshstream::proto::encode_frame(request);
     const auto requested = Clock::now();
     t.requested_unix_ms = realtime_ms();
     co_await asio::async_write(socket, asio::buffer(request_bytes), use_awaitable);
     bool same = true;
     while (true) {
-      if (!co_await read_message(socket, reader, buffer, m)) throw std::runtime_error("connection lost");
+      if (!co_await read_message(socket, reader, buffer, m))
+        throw std::runtime_error("connection lost");
       if (m.has_error()) throw std::runtime_error("error frame: " + m.error().message());
       if (m.has_chunk()) {
         if (t.first_chunk_ms < 0) {
@@ -231,9 +233,8 @@ awaitable<void> run_client(Shared& shared, asio::steady_timer& go, ClientTimes& 
         break;
       }
     }
-    const bool complete = shared.budget_bytes
-                              ? t.bytes > 0 && t.bytes <= shared.budget_bytes
-                              : t.bytes == shared.expected.size();
+    const bool complete = shared.budget_bytes ? t.bytes > 0 && t.bytes <= shared.budget_bytes
+                                              : t.bytes == shared.expected.size();
     if (!same || !complete) {
       throw std::runtime_error("stream differs from the model's bytes");
     }
@@ -318,9 +319,9 @@ void unpin() {
 // One way of running the server and the load generator.
 struct Variant {
   std::string label;
-  int hold_ms = -1;            // server --first-chunk-hold-ms; -1 = its default
+  int hold_ms = -1;             // server --first-chunk-hold-ms; -1 = its default
   unsigned client_threads = 2;  // load generator threads
-  bool pin = false;            // server (one thread) on core 0, clients on core 1
+  bool pin = false;             // server (one thread) on core 0, clients on core 1
   unsigned server_threads = 0;  // 0 = the server's default (one per core)
   uint64_t budget_bytes = 0;    // each request's byte budget; 0 = the whole stream
 };
@@ -357,13 +358,15 @@ Scenario run_scenario(const Variant& variant, const std::vector<std::string>& ba
   s.times.resize(clients);
   meshstream::nettest::ServerProcess server;
   if (variant.pin) pin_to_core(0);  // the server inherits core 0
-  const bool started =
-      server.start(variant_args(base_args, variant),
-                   work_dir + "/server_" + std::to_string(clients) + ".log", std::chrono::seconds(300));
+  const bool started = server.start(variant_args(base_args, variant),
+                                    work_dir + "/server_" + std::to_string(clients) + ".log",
+                                    std::chrono::seconds(300));
   if (variant.pin) pin_to_core(1);  // the clients run on core 1
   struct Unpin {
     bool on;
-    ~Unpin() { if (on) unpin(); }
+    ~Unpin() {
+      if (on) unpin();
+    }
   } unpin_after{variant.pin};
   if (!started) {
     std::cerr << "load_bench: server did not start:\n" << server.log() << "\n";
@@ -471,8 +474,8 @@ double load_average_1min() {
 struct Row {
   std::string label;
   size_t clients = 0;
-  std::vector<double> mbps, first50, first99, read99, wrote50, wrote99, lag50, lag99, end50,
-      end99, hello50, hello99, growth, server_cpu, client_cpu, load;
+  std::vector<double> mbps, first50, first99, read99, wrote50, wrote99, lag50, lag99, end50, end99,
+      hello50, hello99, growth, server_cpu, client_cpu, load;
   double peak_mib = 0;
   size_t errors = 0;
 
@@ -483,10 +486,10 @@ struct Row {
       read.push_back(t.server_read_ms);
       wrote.push_back(t.server_wrote_ms);
       // The load generator's own delay: first chunk parsed here - written there.
-      lag.push_back(t.server_wrote_ms >= 0 && t.first_chunk_unix_ms >= 0
-                        ? std::max(0.0, t.first_chunk_unix_ms - t.requested_unix_ms -
-                                            t.server_wrote_ms)
-                        : -1);
+      lag.push_back(
+          t.server_wrote_ms >= 0 && t.first_chunk_unix_ms >= 0
+              ? std::max(0.0, t.first_chunk_unix_ms - t.requested_unix_ms - t.server_wrote_ms)
+              : -1);
       end.push_back(t.end_ms);
       hello.push_back(t.connect_hello_ms);
     }
@@ -508,15 +511,16 @@ struct Row {
     load.push_back(load_before);
     peak_mib = std::max(peak_mib, double(r.hwm_kib) / 1024.0);
     errors += r.errors;
-    std::fprintf(stderr,
-                 "load_bench: [%s] %zu clients (load %.2f): %.1f MB/s, first chunk p50 %.2f p99 "
-                 "%.2f ms (server read request p99 %.2f, wrote it p50 %.2f p99 %.2f; generator "
-                 "lag p50 %.2f p99 %.2f), end p50 %.2f p99 %.2f ms, connect+hello p50 %.2f p99 %.2f "
-                 "ms, CPU server %.0f clients %.0f in %.0f ms, errors %zu\n",
-                 label.c_str(), clients, load_before, mbps.back(), first50.back(), first99.back(),
-                 read99.back(), wrote50.back(), wrote99.back(), lag50.back(), lag99.back(),
-                 end50.back(), end99.back(), hello50.back(), hello99.back(), r.server_cpu_ms, r.client_cpu_ms, r.seconds * 1e3,
-                 r.errors);
+    std::fprintf(
+        stderr,
+        "load_bench: [%s] %zu clients (load %.2f): %.1f MB/s, first chunk p50 %.2f p99 "
+        "%.2f ms (server read request p99 %.2f, wrote it p50 %.2f p99 %.2f; generator "
+        "lag p50 %.2f p99 %.2f), end p50 %.2f p99 %.2f ms, connect+hello p50 %.2f p99 %.2f "
+        "ms, CPU server %.0f clients %.0f in %.0f ms, errors %zu\n",
+        label.c_str(), clients, load_before, mbps.back(), first50.back(), first99.back(),
+        read99.back(), wrote50.back(), wrote99.back(), lag50.back(), lag99.back(), end50.back(),
+        end99.back(), hello50.back(), hello99.back(), r.server_cpu_ms, r.client_cpu_ms,
+        r.seconds * 1e3, r.errors);
   }
 };
 
@@ -572,9 +576,16 @@ int main(int argc, char** argv) {
   } remove_work{work};
   // Debug level: each session logs when it read its request and wrote its
   // first chunk (joined with the clients' own times by port).
-  std::vector<std::string> args{"--cache", (work / "cache").string(), "--max-connections", "5000",
-                                "--log-level", "debug", "--handshake-timeout-ms", "60000",
-                                "--stall-timeout-ms", "60000"};
+  std::vector<std::string> args{"--cache",
+                                (work / "cache").string(),
+                                "--max-connections",
+                                "5000",
+                                "--log-level",
+                                "debug",
+                                "--handshake-timeout-ms",
+                                "60000",
+                                "--stall-timeout-ms",
+                                "60000"};
   if (max_chunk) args.insert(args.end(), {"--max-chunk-bytes", std::to_string(max_chunk)});
   std::string model, model_text;
   std::vector<uint8_t> model_bytes;
@@ -600,8 +611,9 @@ int main(int argc, char** argv) {
                                     meshstream::server::make_synthetic_hcs(o));
     args.insert(args.end(), {"--models", (work / "models").string()});
     model = "synthetic";
-    model_text = "synthetic .hcs (valid container, random payloads; encoder not built), 100k "
-                 "vertices, 120 records";
+    model_text =
+        "synthetic .hcs (valid container, random payloads; encoder not built), 100k "
+        "vertices, 120 records";
   }
 
   // A first start encodes the model into the cache (timed apart from the
@@ -665,19 +677,21 @@ int main(int argc, char** argv) {
     compared[i].clients = compare_clients;
   }
   for (unsigned rep = 0; rep < compare_repeat; ++rep) {
-    for (size_t i = 0; i < variants.size(); ++i) run_into(compared[i], variants[i], compare_clients);
+    for (size_t i = 0; i < variants.size(); ++i)
+      run_into(compared[i], variants[i], compare_clients);
   }
 
   std::string md;
   char line[1024];
   md += "## Server under load (load_bench)\n\n";
-  md += "N clients on loopback each open a connection and say Hello; once all are connected "
-        "they request the same model at once and read it to the end. Every stream is checked "
-        "byte-exact against the model's bytes (offsets contiguous, memcmp of every chunk). "
-        "Server: `meshstream-server` with its defaults (one io thread per core, first chunks "
-        "before bulk with a 50 ms bound), a fresh process per run. Load generator: the clients "
-        "are Asio coroutines in the bench process, spread over 2 threads (one io_context each), "
-        "on the same 2 cores as the server (and whatever else runs on this shared machine).\n\n";
+  md +=
+      "N clients on loopback each open a connection and say Hello; once all are connected "
+      "they request the same model at once and read it to the end. Every stream is checked "
+      "byte-exact against the model's bytes (offsets contiguous, memcmp of every chunk). "
+      "Server: `meshstream-server` with its defaults (one io thread per core, first chunks "
+      "before bulk with a 50 ms bound), a fresh process per run. Load generator: the clients "
+      "are Asio coroutines in the bench process, spread over 2 threads (one io_context each), "
+      "on the same 2 cores as the server (and whatever else runs on this shared machine).\n\n";
   std::snprintf(line, sizeof line,
                 "Model: %s; %zu bytes per stream. Each row is the median over %u runs (comparison: "
                 "%u interleaved runs per variant). Open files limit: %llu. 1-minute load average "
@@ -685,9 +699,10 @@ int main(int argc, char** argv) {
                 model_text.c_str(), model_bytes.size(), repeat, compare_repeat,
                 static_cast<unsigned long long>(limit.rlim_cur), load_min, load_max);
   md += line;
-  md += "| clients | aggregate MB/s | first chunk p50 / p99 ms | server wrote it p50 / p99 ms | "
-        "generator lag p99 ms | end p50 / p99 ms | connect+hello p50 / p99 ms | server peak RSS "
-        "MiB | RSS growth per open connection KiB | errors |\n";
+  md +=
+      "| clients | aggregate MB/s | first chunk p50 / p99 ms | server wrote it p50 / p99 ms | "
+      "generator lag p99 ms | end p50 / p99 ms | connect+hello p50 / p99 ms | server peak RSS "
+      "MiB | RSS growth per open connection KiB | errors |\n";
   md += "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   size_t errors = 0;
   for (const Row& r : rows) {
@@ -701,25 +716,27 @@ int main(int argc, char** argv) {
                   median(r.growth), r.errors);
     md += line;
   }
-  md += "\nTimes to first chunk and to the end count from each client's stream request; all N "
-        "requests leave in the same instant, so p99 includes queueing behind the other N-1 "
-        "streams. *Server wrote it*: from the client's request to the moment the server handed "
-        "that stream's first chunk to the kernel (each session logs, at debug level, the wall "
-        "clock when it read its request and wrote its first chunk; the bench joins those lines "
-        "with its clients by port). *Generator lag*: from that moment to the moment this load "
-        "generator parsed the chunk, i.e. the time the chunk waited in the client's socket "
-        "because the generator's thread was busy with the other clients' data. RSS growth per "
-        "connection = (server anonymous RSS with all N sessions open - with none) / N. Issue 6 "
-        "targets: 1000 clients with 0 errors, p99 first chunk < 50 ms, < 64 KiB per "
-        "connection.\n\n";
+  md +=
+      "\nTimes to first chunk and to the end count from each client's stream request; all N "
+      "requests leave in the same instant, so p99 includes queueing behind the other N-1 "
+      "streams. *Server wrote it*: from the client's request to the moment the server handed "
+      "that stream's first chunk to the kernel (each session logs, at debug level, the wall "
+      "clock when it read its request and wrote its first chunk; the bench joins those lines "
+      "with its clients by port). *Generator lag*: from that moment to the moment this load "
+      "generator parsed the chunk, i.e. the time the chunk waited in the client's socket "
+      "because the generator's thread was busy with the other clients' data. RSS growth per "
+      "connection = (server anonymous RSS with all N sessions open - with none) / N. Issue 6 "
+      "targets: 1000 clients with 0 errors, p99 first chunk < 50 ms, < 64 KiB per "
+      "connection.\n\n";
   if (!compared.empty()) {
     std::snprintf(line, sizeof line,
                   "### Where the first-chunk time goes at %zu clients (variants side by side)\n\n",
                   compare_clients);
     md += line;
-    md += "| variant | aggregate MB/s | first chunk p50 / p99 ms | p99 of single runs, min - max "
-          "ms | server read request p99 ms | server wrote first chunk p50 / p99 ms | generator "
-          "lag p50 / p99 ms | end p99 ms | CPU ms while streaming: server / generator | errors |\n";
+    md +=
+        "| variant | aggregate MB/s | first chunk p50 / p99 ms | p99 of single runs, min - max "
+        "ms | server read request p99 ms | server wrote first chunk p50 / p99 ms | generator "
+        "lag p50 / p99 ms | end p99 ms | CPU ms while streaming: server / generator | errors |\n";
     md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const Row& r : compared) {
       errors += r.errors;

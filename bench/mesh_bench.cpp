@@ -6,6 +6,8 @@
 //   mesh_bench [--report-dir DIR] [--runs N] [--meshes DIR]
 // Writes DIR/mesh.md (default bench/report/mesh.md) and prints one line per
 // mesh.
+#include <draco/io/mesh_io.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -15,8 +17,6 @@
 #include <fstream>
 #include <string>
 #include <vector>
-
-#include <draco/io/mesh_io.h>
 
 #ifdef MESHSTREAM_HAVE_OPENMESH
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
@@ -38,7 +38,9 @@ double median_ms(int runs, Fn&& fn) {
   for (int r = 0; r < std::max(1, runs); ++r) {
     const auto start = std::chrono::steady_clock::now();
     fn();
-    times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    times.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
   }
   std::sort(times.begin(), times.end());
   const size_t n = times.size();
@@ -113,9 +115,12 @@ int main(int argc, char** argv) {
   int runs = 7;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--report-dir" && i + 1 < argc) report_dir = argv[++i];
-    else if (arg == "--runs" && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (arg == "--meshes" && i + 1 < argc) mesh_dir = argv[++i];
+    if (arg == "--report-dir" && i + 1 < argc)
+      report_dir = argv[++i];
+    else if (arg == "--runs" && i + 1 < argc)
+      runs = std::max(1, std::atoi(argv[++i]));
+    else if (arg == "--meshes" && i + 1 < argc)
+      mesh_dir = argv[++i];
     else if (arg == "--help" || arg == "-h") {
       std::printf("usage: mesh_bench [--report-dir DIR] [--runs N] [--meshes DIR]\n");
       return 0;
@@ -131,7 +136,9 @@ int main(int argc, char** argv) {
                            "mask.off",        "dragon_res3.ply", "fandisk.off", "casting.off"};
   std::vector<Row> rows;
   if (mesh_dir.empty()) {
-    std::fprintf(stderr, "mesh_bench: real meshes not found (set MESHSTREAM_TEST_MESHES); procedural only\n");
+    std::fprintf(
+        stderr,
+        "mesh_bench: real meshes not found (set MESHSTREAM_TEST_MESHES); procedural only\n");
   }
   for (const char* name : kMeshes) {
     if (mesh_dir.empty()) break;
@@ -173,10 +180,11 @@ int main(int argc, char** argv) {
     row.adjacency_ms = median(adjacency);
     row.openmesh_ms = peer_adjacency.empty() ? -1 : median(peer_adjacency);
     row.stats_ms = median(stats);
-    std::printf("%-16s %7u faces  parse %7.1f ms  import %7.1f ms  draco %7s ms  adjacency %6.2f ms  "
-                "openmesh %7s ms  stats %6.1f ms\n",
-                name, row.faces, row.parse_ms, row.import_ms, cell(row.draco_ms).c_str(), row.adjacency_ms,
-                cell(row.openmesh_ms).c_str(), row.stats_ms);
+    std::printf(
+        "%-16s %7u faces  parse %7.1f ms  import %7.1f ms  draco %7s ms  adjacency %6.2f ms  "
+        "openmesh %7s ms  stats %6.1f ms\n",
+        name, row.faces, row.parse_ms, row.import_ms, cell(row.draco_ms).c_str(), row.adjacency_ms,
+        cell(row.openmesh_ms).c_str(), row.stats_ms);
     std::fflush(stdout);
     rows.push_back(row);
   }
@@ -198,8 +206,9 @@ int main(int argc, char** argv) {
     s.openmesh_ms = median_ms(std::min(runs, 3), [&] { (void)build_openmesh(mesh); });
 #endif
     s.stats_ms = median_ms(std::min(runs, 3), [&] { (void)compute_stats(mesh); });
-    std::printf("demo %8u faces  generate %7.1f ms  adjacency %7.2f ms  openmesh %7s ms  stats %6.1f ms\n",
-                s.faces, s.generate_ms, s.adjacency_ms, cell(s.openmesh_ms).c_str(), s.stats_ms);
+    std::printf(
+        "demo %8u faces  generate %7.1f ms  adjacency %7.2f ms  openmesh %7s ms  stats %6.1f ms\n",
+        s.faces, s.generate_ms, s.adjacency_ms, cell(s.openmesh_ms).c_str(), s.stats_ms);
     scaling.push_back(s);
   }
 
@@ -210,20 +219,23 @@ int main(int argc, char** argv) {
       << "`bench/mesh_bench` — median of " << runs
       << " interleaved rounds per figure (each round times every step once, so load bursts on "
          "the shared 2-core machine hit ours and the peers alike). *Import* = parse + "
-         "clean (weld, degenerate/duplicate/unreferenced removal, non-manifold repair); *parse* = our "
-         "reader alone (OFF, PLY, OBJ and ASCII STL our own, binary STL through Draco's io); *Draco* = "
+         "clean (weld, degenerate/duplicate/unreferenced removal, non-manifold repair); *parse* = "
+         "our "
+         "reader alone (OFF, PLY, OBJ and ASCII STL our own, binary STL through Draco's io); "
+         "*Draco* = "
          "`draco::ReadMeshFromFile` on the same file (no cleaning; no OFF support). *Adjacency* = "
          "`Adjacency::build` (corner table) on the imported mesh; *OpenMesh* = building OpenMesh's "
          "half-edge `TriMesh` from the same arrays. Ratios > 1 mean ours is faster.\n\n";
   if (!rows.empty()) {
-    const Row& big = *std::max_element(rows.begin(), rows.end(),
-                                       [](const Row& a, const Row& b) { return a.faces < b.faces; });
-    out << "**Largest real mesh, " << big.name << "** (" << big.faces << " triangles after import): import "
-        << cell(big.import_ms) << " ms (parse " << cell(big.parse_ms) << " ms), Adjacency::build "
-        << cell(big.adjacency_ms) << " ms";
+    const Row& big = *std::max_element(
+        rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.faces < b.faces; });
+    out << "**Largest real mesh, " << big.name << "** (" << big.faces
+        << " triangles after import): import " << cell(big.import_ms) << " ms (parse "
+        << cell(big.parse_ms) << " ms), Adjacency::build " << cell(big.adjacency_ms) << " ms";
     if (big.openmesh_ms >= 0) out << " (OpenMesh " << cell(big.openmesh_ms) << " ms)";
     out << ".\n\n";
-    out << "| mesh | MB | vertices | triangles | parse ms | import ms | Draco read ms | Draco / parse | "
+    out << "| mesh | MB | vertices | triangles | parse ms | import ms | Draco read ms | Draco / "
+           "parse | "
            "adjacency ms | OpenMesh ms | OpenMesh / adjacency | stats ms |\n"
         << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const Row& r : rows) {
@@ -231,10 +243,11 @@ int main(int argc, char** argv) {
       const std::string name = highlight ? "**" + r.name + "**" : r.name;
       char mb[16];
       std::snprintf(mb, sizeof mb, "%.1f", r.file_mb);
-      out << "| " << name << " | " << mb << " | " << r.vertices << " | " << r.faces << " | " << cell(r.parse_ms)
-          << " | " << cell(r.import_ms) << " | " << cell(r.draco_ms) << " | " << ratio(r.parse_ms, r.draco_ms)
-          << " | " << cell(r.adjacency_ms) << " | " << cell(r.openmesh_ms) << " | "
-          << ratio(r.adjacency_ms, r.openmesh_ms) << " | " << cell(r.stats_ms) << " |\n";
+      out << "| " << name << " | " << mb << " | " << r.vertices << " | " << r.faces << " | "
+          << cell(r.parse_ms) << " | " << cell(r.import_ms) << " | " << cell(r.draco_ms) << " | "
+          << ratio(r.parse_ms, r.draco_ms) << " | " << cell(r.adjacency_ms) << " | "
+          << cell(r.openmesh_ms) << " | " << ratio(r.adjacency_ms, r.openmesh_ms) << " | "
+          << cell(r.stats_ms) << " |\n";
     }
     out << "\n";
     out << "What import changed where it had to (components and boundary loops as drawn → as "
@@ -243,16 +256,18 @@ int main(int argc, char** argv) {
            "repair cuts it loose and import drops it as a *flap*; pieces the repair cuts off "
            "otherwise stay, as components of their own:\n\n"
         << "| mesh | welded | degenerate | duplicates | unreferenced | NM edges / vertices | split "
-           "vertices | detached faces | flipped faces | flaps dropped | components | boundary loops |\n"
+           "vertices | detached faces | flipped faces | flaps dropped | components | boundary "
+           "loops |\n"
         << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const Row& r : rows) {
       const CleanReport& c = r.report;
       if (!c.changed()) continue;
       out << "| " << r.name << " | " << c.welded_vertices << " | " << c.degenerate_faces << " | "
-          << c.duplicate_faces << " | " << c.unreferenced_vertices << " | " << c.nonmanifold_edges << " / "
-          << c.nonmanifold_vertices << " | " << c.split_vertices << " | " << c.detached_faces << " | "
-          << c.flipped_faces << " | " << c.double_sided_flaps << " | " << r.before.components << " → " << r.after.components << " | "
-          << r.before.boundary_loops << " → " << r.after.boundary_loops << " |\n";
+          << c.duplicate_faces << " | " << c.unreferenced_vertices << " | " << c.nonmanifold_edges
+          << " / " << c.nonmanifold_vertices << " | " << c.split_vertices << " | "
+          << c.detached_faces << " | " << c.flipped_faces << " | " << c.double_sided_flaps << " | "
+          << r.before.components << " → " << r.after.components << " | " << r.before.boundary_loops
+          << " → " << r.after.boundary_loops << " |\n";
     }
     out << "\n";
   }
@@ -262,8 +277,8 @@ int main(int argc, char** argv) {
   for (const Scale& s : scaling) {
     char per_face[32];
     std::snprintf(per_face, sizeof per_face, "%.1f", 1e6 * s.adjacency_ms / s.faces);
-    out << "| " << s.faces << " | " << cell(s.generate_ms) << " | " << cell(s.adjacency_ms) << " | " << per_face
-        << " | " << cell(s.openmesh_ms) << " | " << cell(s.stats_ms) << " |\n";
+    out << "| " << s.faces << " | " << cell(s.generate_ms) << " | " << cell(s.adjacency_ms) << " | "
+        << per_face << " | " << cell(s.openmesh_ms) << " | " << cell(s.stats_ms) << " |\n";
   }
   out << "\n";
   std::printf("wrote %s\n", out_path.c_str());

@@ -9,8 +9,8 @@
 namespace meshstream::bench {
 
 inline const std::vector<std::string> kRealMeshes = {
-    "bun_zipper.ply", "bunny.off",       "bunny.stl",       "armadillo.obj", "fandisk.off",
-    "crank.off",      "casting.off",     "mask.off",        "hemisphere.off", "skull.obj",
+    "bun_zipper.ply",  "bunny.off",       "bunny.stl",      "armadillo.obj",  "fandisk.off",
+    "crank.off",       "casting.off",     "mask.off",       "hemisphere.off", "skull.obj",
     "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"};
 
 // "a,b,,c" -> {"a", "b", "c"}.

@@ -32,14 +32,16 @@ namespace {
 using namespace meshstream;
 
 // The 13 real models of ../shared/meshes/MANIFEST.md.
-const char* const kMeshes[] = {"bun_zipper.ply", "bunny.off",    "bunny.stl",      "armadillo.obj", "fandisk.off",
-                               "crank.off",      "casting.off",  "mask.off",       "hemisphere.off", "skull.obj",
-                               "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"};
+const char* const kMeshes[] = {"bun_zipper.ply", "bunny.off", "bunny.stl",       "armadillo.obj",
+                               "fandisk.off",    "crank.off", "casting.off",     "mask.off",
+                               "hemisphere.off", "skull.obj", "maneki-neko.off", "dragon_res2.ply",
+                               "dragon_res3.ply"};
 
 std::string mesh_dir() {
   if (const char* env = std::getenv("MESHSTREAM_TEST_MESHES"); env && *env) return env;
   // Beside the repository, found from this file's path (no CMake definition needed).
-  return (std::filesystem::path(__FILE__).parent_path().parent_path() / ".." / "shared" / "meshes").string();
+  return (std::filesystem::path(__FILE__).parent_path().parent_path() / ".." / "shared" / "meshes")
+      .string();
 }
 
 double median(std::vector<double> v) {
@@ -55,7 +57,9 @@ struct Row {
   double decode_ms = 0;
 };
 
-double structure_total(const StructureBits& b) { return b.count + b.valence + b.rank + b.open_edge; }
+double structure_total(const StructureBits& b) {
+  return b.count + b.valence + b.rank + b.open_edge;
+}
 
 void add(StructureBits& total, const StructureBits& b) {
   total.count += b.count;
@@ -70,8 +74,8 @@ void add(StructureBits& total, const StructureBits& b) {
 std::string bits_cells(const StructureBits& b) {
   const double m = std::max<uint64_t>(1, b.insertions);
   char line[256];
-  std::snprintf(line, sizeof line, "%.3f | %.3f | %.3f | %.3f | %.3f | %.2f", b.count / m, b.valence / m, b.rank / m,
-                b.open_edge / m, structure_total(b) / m, b.residual / m);
+  std::snprintf(line, sizeof line, "%.3f | %.3f | %.3f | %.3f | %.3f | %.2f", b.count / m,
+                b.valence / m, b.rank / m, b.open_edge / m, structure_total(b) / m, b.residual / m);
   return line;
 }
 
@@ -92,7 +96,9 @@ int main(int argc, char** argv) {
     } else if (a == "--only" && i + 1 < argc) {
       only = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: %s [--report-dir DIR] [--fixed] [--decode-runs N] [--only NAME]\n", argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s [--report-dir DIR] [--fixed] [--decode-runs N] [--only NAME]\n",
+                   argv[0]);
       return 2;
     }
   }
@@ -120,7 +126,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s: %s\n", name, stream.error().message.c_str());
         return 1;
       }
-      rows[f].push_back(Row{name, imported->mesh.vertex_count(), stream->size(), report.structure_bits, 0});
+      rows[f].push_back(
+          Row{name, imported->mesh.vertex_count(), stream->size(), report.structure_bits, 0});
       streams[f] = std::move(*stream);
     }
     std::vector<double> ms[2];
@@ -141,10 +148,12 @@ int main(int argc, char** argv) {
       row.decode_ms = median(ms[f]);
       const StructureBits& b = row.bits;
       const double n = std::max<uint64_t>(1, b.insertions);
-      std::printf("f%d %-16s v=%6u bytes=%8zu  per inserted vertex: count %.3f valence %.3f rank %.3f open %.3f "
-                  "residual %.3f | steps/ins %.2f decode %.2f ms\n",
-                  f == 0 ? 2 : 3, name, row.vertices, row.bytes, b.count / n, b.valence / n, b.rank / n,
-                  b.open_edge / n, b.residual / n, double(b.walk_steps) / n, row.decode_ms);
+      std::printf(
+          "f%d %-16s v=%6u bytes=%8zu  per inserted vertex: count %.3f valence %.3f rank %.3f open "
+          "%.3f "
+          "residual %.3f | steps/ins %.2f decode %.2f ms\n",
+          f == 0 ? 2 : 3, name, row.vertices, row.bytes, b.count / n, b.valence / n, b.rank / n,
+          b.open_edge / n, b.residual / n, double(b.walk_steps) / n, row.decode_ms);
     }
     std::fflush(stdout);
   }
@@ -159,28 +168,40 @@ int main(int argc, char** argv) {
   for (int f = 0; f < 2; ++f) {
     const StructureBits& t = total[f];
     const double n = std::max<uint64_t>(1, t.insertions);
-    std::printf("ALL f%d: count %.3f valence %.3f rank %.3f open %.3f residual %.3f structure %.3f bits/inserted vertex\n",
-                f == 0 ? 2 : 3, t.count / n, t.valence / n, t.rank / n, t.open_edge / n, t.residual / n,
-                structure_total(t) / n);
+    std::printf(
+        "ALL f%d: count %.3f valence %.3f rank %.3f open %.3f residual %.3f structure %.3f "
+        "bits/inserted vertex\n",
+        f == 0 ? 2 : 3, t.count / n, t.valence / n, t.rank / n, t.open_edge / n, t.residual / n,
+        structure_total(t) / n);
   }
-  std::printf("format 3 / format 2: stream size median %.4f (min %.4f, max %.4f), decode time median %.3f\n",
-              median(size_ratio), size_ratio.empty() ? 0 : *std::min_element(size_ratio.begin(), size_ratio.end()),
-              size_ratio.empty() ? 0 : *std::max_element(size_ratio.begin(), size_ratio.end()), median(time_ratio));
+  std::printf(
+      "format 3 / format 2: stream size median %.4f (min %.4f, max %.4f), decode time median "
+      "%.3f\n",
+      median(size_ratio),
+      size_ratio.empty() ? 0 : *std::min_element(size_ratio.begin(), size_ratio.end()),
+      size_ratio.empty() ? 0 : *std::max_element(size_ratio.begin(), size_ratio.end()),
+      median(time_ratio));
   if (report_dir.empty() || fixed || !only.empty()) return 0;
   std::filesystem::create_directories(report_dir);
   std::ofstream out(report_dir + "/structure_bits.md");
   out << "## Structure bits (refinement records, per symbol class)\n\n"
-      << "`bench/structure_bits_bench`, default encoder options, every real mesh: ideal coded bits (-log2 p "
-         "of every range-coded bit) of each symbol class of the refinement records per inserted vertex, for "
-         "refinement format 2 (the peer: the same records through format 2's models) and format 3 (written "
-         "by default: models that learn fast at first, valence also by the apex's free faces, start rank by "
+      << "`bench/structure_bits_bench`, default encoder options, every real mesh: ideal coded bits "
+         "(-log2 p "
+         "of every range-coded bit) of each symbol class of the refinement records per inserted "
+         "vertex, for "
+         "refinement format 2 (the peer: the same records through format 2's models) and format 3 "
+         "(written "
+         "by default: models that learn fast at first, valence also by the apex's free faces, "
+         "start rank by "
          "the number of candidate runs and the best score's lead). Decode: median of "
       << decode_runs << " whole-stream decodes, the two formats alternating.\n\n"
-      << "| symbols, bits per inserted vertex (pooled) | count | valence | rank | open edge | structure | residual |\n"
+      << "| symbols, bits per inserted vertex (pooled) | count | valence | rank | open edge | "
+         "structure | residual |\n"
       << "|---|---|---|---|---|---|---|\n"
       << "| format 2 | " << bits_cells(total[0]) << " |\n"
       << "| format 3 | " << bits_cells(total[1]) << " |\n\n"
-      << "| mesh | vertices | format 2 bytes | format 3 bytes | ratio | format 3 count / valence / rank / residual "
+      << "| mesh | vertices | format 2 bytes | format 3 bytes | ratio | format 3 count / valence / "
+         "rank / residual "
          "bits | decode ms f2 | decode ms f3 |\n"
       << "|---|---|---|---|---|---|---|---|\n";
   char line[512];
@@ -188,14 +209,16 @@ int main(int argc, char** argv) {
     const Row& a2 = rows[0][i];
     const Row& a3 = rows[1][i];
     const double m = std::max<uint64_t>(1, a3.bits.insertions);
-    std::snprintf(line, sizeof line, "| %s | %u | %zu | %zu | %.4f | %.2f / %.2f / %.2f / %.2f | %.1f | %.1f |\n",
-                  a2.name.c_str(), a2.vertices, a2.bytes, a3.bytes, double(a3.bytes) / double(a2.bytes),
-                  a3.bits.count / m, a3.bits.valence / m, a3.bits.rank / m, a3.bits.residual / m, a2.decode_ms,
-                  a3.decode_ms);
+    std::snprintf(line, sizeof line,
+                  "| %s | %u | %zu | %zu | %.4f | %.2f / %.2f / %.2f / %.2f | %.1f | %.1f |\n",
+                  a2.name.c_str(), a2.vertices, a2.bytes, a3.bytes,
+                  double(a3.bytes) / double(a2.bytes), a3.bits.count / m, a3.bits.valence / m,
+                  a3.bits.rank / m, a3.bits.residual / m, a2.decode_ms, a3.decode_ms);
     out << line;
   }
   std::snprintf(line, sizeof line,
-                "\nFormat 3 / format 2: stream size median %.4f (min %.4f, max %.4f); decode time median %.3f.\n",
+                "\nFormat 3 / format 2: stream size median %.4f (min %.4f, max %.4f); decode time "
+                "median %.3f.\n",
                 median(size_ratio), *std::min_element(size_ratio.begin(), size_ratio.end()),
                 *std::max_element(size_ratio.begin(), size_ratio.end()), median(time_ratio));
   out << line;

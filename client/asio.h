@@ -2,9 +2,10 @@
 // <utility> before the Asio headers ("exchange is not a member of std").
 #pragma once
 
-#include <utility>
-
+// clang-format off: <utility> must stay first (see above).
 #include <boost/asio.hpp>
+#include <utility>
+// clang-format on
 
 namespace meshstream::client {
 namespace asio = boost::asio;

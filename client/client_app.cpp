@@ -7,9 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <thread>
-
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "client/decoded_stream.h"
 #include "client/display_pipeline.h"
@@ -42,7 +41,8 @@ int run_list(const ClientOptions& o) {
     std::cout << nlohmann::json{{"event", "models"}, {"models", list}}.dump() << std::endl;
     return 0;
   }
-  std::printf("%-24s %10s %10s %12s %8s  %s\n", "model", "vertices", "faces", "bytes", "records", "source");
+  std::printf("%-24s %10s %10s %12s %8s  %s\n", "model", "vertices", "faces", "bytes", "records",
+              "source");
   for (const auto& m : *models) {
     std::printf("%-24s %10u %10u %12llu %8u  %s\n", m.name().c_str(), m.vertices(), m.faces(),
                 static_cast<unsigned long long>(m.stream_bytes()), m.records(), m.source().c_str());
@@ -87,7 +87,9 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
   LatestFrameMailbox mailbox;
 
   const auto t0 = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  };
   std::mutex file_mutex;
   std::optional<Error> file_error;  // first failure writing a file
   auto keep_error = [&](const Status& s) {
@@ -113,8 +115,10 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
       ++display_updates;
       coalesced += frame.coalesced_updates;
       log.refinement(frame, info, elapsed(), client.rate_bytes_per_s());
-      if (!o.out_dir.empty()) keep_error(write_mesh(*frame.display, record_file(o.out_dir, frame.records_decoded - 1)));
-      if (o.snapshot_at && !snapshot_done && frame.records_decoded == *o.snapshot_at + 1 && hooks.snapshot) {
+      if (!o.out_dir.empty())
+        keep_error(write_mesh(*frame.display, record_file(o.out_dir, frame.records_decoded - 1)));
+      if (o.snapshot_at && !snapshot_done && frame.records_decoded == *o.snapshot_at + 1 &&
+          hooks.snapshot) {
         keep_error(hooks.snapshot(*frame.display, frame.face_kind.get(), o, o.snapshot_png));
         snapshot_done = true;
       }
@@ -122,8 +126,10 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
     if (frame.final && !final_frame) {
       final_frame = frame;
       if (!o.out_dir.empty()) {
-        keep_error(write_mesh(*frame.display, (std::filesystem::path(o.out_dir) / "final.ply").string()));
-        keep_error(write_mesh(*frame.decoded, (std::filesystem::path(o.out_dir) / "final.decoded.ply").string()));
+        keep_error(
+            write_mesh(*frame.display, (std::filesystem::path(o.out_dir) / "final.ply").string()));
+        keep_error(write_mesh(*frame.decoded,
+                              (std::filesystem::path(o.out_dir) / "final.decoded.ply").string()));
       }
       if (!o.snapshot_png.empty() && !o.snapshot_at && hooks.snapshot) {
         keep_error(hooks.snapshot(*frame.display, frame.face_kind.get(), o, o.snapshot_png));
@@ -176,7 +182,8 @@ int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
     return 1;
   }
   if (o.snapshot_at && !snapshot_done) {
-    log.error("--snapshot-at " + std::to_string(*o.snapshot_at) + ": the stream ended before that record");
+    log.error("--snapshot-at " + std::to_string(*o.snapshot_at) +
+              ": the stream ended before that record");
     return 1;
   }
   DoneSummary s;

@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   const ClientOptions& options = std::get<ClientOptions>(parsed);
 
   ViewerHooks hooks;
-  hooks.run_view = [](const ClientOptions& o, LatestFrameMailbox& frames, StreamControls& controls) {
+  hooks.run_view = [](const ClientOptions& o, LatestFrameMailbox& frames,
+                      StreamControls& controls) {
     ViewerOptions v;
     v.width = o.width;
     v.height = o.height;

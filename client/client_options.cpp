@@ -1,15 +1,15 @@
 #include "client/client_options.h"
 
-#include <iostream>
-
 #include <CLI/CLI.hpp>
+#include <iostream>
 
 namespace meshstream::client {
 
 ParsedClientOptions parse_client_options(int argc, char** argv) {
   ClientOptions o;
-  CLI::App app{"meshstream-client: stream a model from a meshstream server, decode every refinement "
-               "as it arrives and post-process it with ASA"};
+  CLI::App app{
+      "meshstream-client: stream a model from a meshstream server, decode every refinement "
+      "as it arrives and post-process it with ASA"};
   std::string address, rule = "zorin", path = "auto";
   std::optional<uint64_t> bytes;
   std::optional<uint32_t> vertices;
@@ -18,7 +18,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("address", address, "server address HOST:PORT")->required();
   app.add_option("model", o.model, "model name to stream (see --list)");
   app.add_flag("--list", o.list, "list the server's models and exit");
-  app.add_option("--out", o.out_dir, "write NNNN.ply per display update (NNNN = record index) and final.ply");
+  app.add_option("--out", o.out_dir,
+                 "write NNNN.ply per display update (NNNN = record index) and final.ply");
   app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
@@ -28,7 +29,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("--rule", rule, "Butterfly rule: zorin or projection")
       ->check(CLI::IsMember({"zorin", "projection"}))
       ->capture_default_str();
-  app.add_option("--crease", o.asa.crease_degrees, "edges bending more than DEG degrees stay sharp (0 = off)")
+  app.add_option("--crease", o.asa.crease_degrees,
+                 "edges bending more than DEG degrees stay sharp (0 = off)")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   bool no_asa = false;
@@ -36,29 +38,40 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
       ->check(CLI::IsMember({"auto", "full", "incremental"}))
       ->capture_default_str();
-  auto* b = app.add_option("--bytes", bytes, "stop at the last record boundary within N stream bytes");
-  auto* v = app.add_option("--vertices", vertices, "stop after the last record with at most N vertices");
-  auto* p = app.add_option("--percent", percent,
-                           "stop after the last record with at most P percent of the full mesh's vertices "
-                           "(0 < P <= 100; as `meshstream decode --percent`)")
+  auto* b =
+      app.add_option("--bytes", bytes, "stop at the last record boundary within N stream bytes");
+  auto* v =
+      app.add_option("--vertices", vertices, "stop after the last record with at most N vertices");
+  auto* p = app.add_option(
+                   "--percent", percent,
+                   "stop after the last record with at most P percent of the full mesh's vertices "
+                   "(0 < P <= 100; as `meshstream decode --percent`)")
                 ->check(CLI::Range(0.0, 100.0));
   auto* pb = app.add_option("--percent-bytes", percent_bytes,
-                            "stop at the last record boundary within P percent of the stream's bytes (0 < P <= 100)")
+                            "stop at the last record boundary within P percent of the stream's "
+                            "bytes (0 < P <= 100)")
                  ->check(CLI::Range(0.0, 100.0));
   b->excludes(v)->excludes(p)->excludes(pb);
   v->excludes(p)->excludes(pb);
   p->excludes(pb);
   app.add_flag("--json", o.json, "print one JSON event per line on stdout");
   app.add_flag("--view", o.view, "open a window that shows the model as it refines");
-  app.add_option("--snapshot", o.snapshot_png, "render the final (or --snapshot-at) display mesh to a PNG");
-  app.add_option("--width", o.width, "snapshot/window width")->check(CLI::Range(16, 16384))->capture_default_str();
-  app.add_option("--height", o.height, "snapshot/window height")->check(CLI::Range(16, 16384))->capture_default_str();
-  app.add_option("--snapshot-at", o.snapshot_at, "snapshot the display mesh after record N (0 = base mesh)");
+  app.add_option("--snapshot", o.snapshot_png,
+                 "render the final (or --snapshot-at) display mesh to a PNG");
+  app.add_option("--width", o.width, "snapshot/window width")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
+  app.add_option("--height", o.height, "snapshot/window height")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
+  app.add_option("--snapshot-at", o.snapshot_at,
+                 "snapshot the display mesh after record N (0 = base mesh)");
   app.add_option("--exit-after", o.exit_after_frames, "close the window after N frames (tests)");
   app.add_option("--exit-after-records", o.exit_after_records,
                  "close the window once a frame with N decoded records is drawn (tests)");
   app.add_option("--max-chunk-bytes", o.max_chunk_bytes, "largest chunk to ask the server for");
-  app.add_option("--reconnect-attempts", reconnect_attempts, "consecutive reconnects before giving up")
+  app.add_option("--reconnect-attempts", reconnect_attempts,
+                 "consecutive reconnects before giving up")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   app.add_flag("--quiet", o.quiet, "no progress line");
@@ -85,10 +98,13 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   // !(x > 0) also refuses NaN, which CLI11's range check lets through.
   if (percent && !(*percent > 0)) return usage("--percent must be in (0, 100]");
   if (percent_bytes && !(*percent_bytes > 0)) return usage("--percent-bytes must be in (0, 100]");
-  if (o.snapshot_at && o.snapshot_png.empty()) return usage("--snapshot-at needs --snapshot FILE.png");
+  if (o.snapshot_at && o.snapshot_png.empty())
+    return usage("--snapshot-at needs --snapshot FILE.png");
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
   o.asa_enabled = !no_asa;
-  o.asa_path = path == "full" ? AsaPath::kFull : path == "incremental" ? AsaPath::kIncremental : AsaPath::kAuto;
+  o.asa_path = path == "full"          ? AsaPath::kFull
+               : path == "incremental" ? AsaPath::kIncremental
+                                       : AsaPath::kAuto;
   if (bytes) o.budget = {Budget::Kind::kBytes, static_cast<double>(*bytes)};
   if (vertices) o.budget = {Budget::Kind::kVertices, static_cast<double>(*vertices)};
   if (percent) o.budget = {Budget::Kind::kPercentVertices, *percent};

@@ -20,11 +20,11 @@ namespace meshstream::client {
 struct ClientOptions {
   std::string host;
   uint16_t port = 0;
-  std::string model;          // empty with --list
+  std::string model;  // empty with --list
   bool list = false;
-  std::string out_dir;        // --out: NNNN.ply per display update, final.ply
-  bool asa_enabled = true;    // --no-asa turns it off
-  AsaOptions asa;             // levels, flatness, rule, crease
+  std::string out_dir;                // --out: NNNN.ply per display update, final.ply
+  bool asa_enabled = true;            // --no-asa turns it off
+  AsaOptions asa;                     // levels, flatness, rule, crease
   AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)
   Budget budget;
   bool json = false;
@@ -37,7 +37,7 @@ struct ClientOptions {
   uint32_t exit_after_records = 0;
   uint32_t max_chunk_bytes = 0;
   ReconnectPolicy reconnect;
-  bool quiet = false;         // no progress line
+  bool quiet = false;  // no progress line
 };
 
 // Options to run with, or the exit code to return now (0 after --help, 2

@@ -43,12 +43,14 @@ Result<std::unique_ptr<Connection>> Connection::open(const std::string& host, ui
   if (ec) return make_error(ErrorCode::kIo, "cannot resolve " + where + ": " + ec.message());
   bool done = false;
   boost::system::error_code result = asio::error::timed_out;
-  asio::async_connect(c->socket_, endpoints, [&](const boost::system::error_code& e, const tcp::endpoint&) {
-    result = e;
-    done = true;
-  });
+  asio::async_connect(c->socket_, endpoints,
+                      [&](const boost::system::error_code& e, const tcp::endpoint&) {
+                        result = e;
+                        done = true;
+                      });
   if (!c->run_until(done, Clock::now() + timeout, nullptr)) result = asio::error::timed_out;
-  if (result) return make_error(ErrorCode::kIo, "cannot connect to " + where + ": " + result.message());
+  if (result)
+    return make_error(ErrorCode::kIo, "cannot connect to " + where + ": " + result.message());
   c->socket_.set_option(tcp::no_delay(true), ec);
   return c;
 }
@@ -62,7 +64,8 @@ Status Connection::send(const v1::ClientMessage& message, Millis timeout) {
     done = true;
   });
   if (!run_until(done, Clock::now() + timeout, nullptr)) result = asio::error::timed_out;
-  if (result) return make_error(ErrorCode::kIo, "sending to " + peer_ + " failed: " + result.message());
+  if (result)
+    return make_error(ErrorCode::kIo, "sending to " + peer_ + " failed: " + result.message());
   return {};
 }
 
@@ -70,17 +73,19 @@ Result<v1::ServerMessage> Connection::receive(Millis timeout, const std::atomic<
   while (true) {
     auto next = reader_.next();
     if (!next) {
-      return make_error(next.error().code, "server " + peer_ + " sent a bad frame: " + next.error().message);
+      return make_error(next.error().code,
+                        "server " + peer_ + " sent a bad frame: " + next.error().message);
     }
     if (*next) return std::move(**next);
     bool done = false;
     size_t got = 0;
     boost::system::error_code result = asio::error::timed_out;
-    socket_.async_read_some(asio::buffer(buffer_), [&](const boost::system::error_code& e, size_t n) {
-      result = e;
-      got = n;
-      done = true;
-    });
+    socket_.async_read_some(asio::buffer(buffer_),
+                            [&](const boost::system::error_code& e, size_t n) {
+                              result = e;
+                              got = n;
+                              done = true;
+                            });
     if (!run_until(done, Clock::now() + timeout, cancel)) {
       result = (cancel && cancel->load()) ? asio::error::operation_aborted : asio::error::timed_out;
     }
@@ -104,7 +109,8 @@ Result<HostPort> parse_host_port(const std::string& text) {
     return make_error(ErrorCode::kInvalidArgument, "'" + text + "' is not HOST:PORT (" + why + ")");
   };
   const size_t colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size()) return bad("missing host or port");
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
+    return bad("missing host or port");
   HostPort hp;
   hp.host = text.substr(0, colon);
   if (hp.host.size() >= 2 && hp.host.front() == '[' && hp.host.back() == ']') {

@@ -24,7 +24,8 @@ class Connection {
  public:
   // Resolves `host` and connects to `port`; kIo with the address and the
   // reason when it cannot within `timeout`.
-  static Result<std::unique_ptr<Connection>> open(const std::string& host, uint16_t port, Millis timeout);
+  static Result<std::unique_ptr<Connection>> open(const std::string& host, uint16_t port,
+                                                  Millis timeout);
 
   ~Connection();
   Connection(const Connection&) = delete;

@@ -19,12 +19,14 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
     // A plane record's delta sets full_rebuild for consumers that predate
     // moved_vertices; with no vertex added and no face touched it is a
     // position update of exactly the moved vertices (decoder.h).
-    const bool moves_only = !d.moved_vertices.empty() && d.added_vertices.empty() && d.touched_faces.empty();
+    const bool moves_only =
+        !d.moved_vertices.empty() && d.added_vertices.empty() && d.touched_faces.empty();
     if (d.full_rebuild && !moves_only) {
       pending_.clear();
       pending_.full = true;
     } else if (!pending_.full) {
-      pending_.vertices.insert(pending_.vertices.end(), d.added_vertices.begin(), d.added_vertices.end());
+      pending_.vertices.insert(pending_.vertices.end(), d.added_vertices.begin(),
+                               d.added_vertices.end());
       pending_.faces.insert(pending_.faces.end(), d.touched_faces.begin(), d.touched_faces.end());
       pending_.moved.insert(pending_.moved.end(), d.moved_vertices.begin(), d.moved_vertices.end());
     }
@@ -101,7 +103,8 @@ void DecodedStream::set_barrier(std::optional<uint32_t> record) {
   barrier_ = record;
 }
 
-bool DecodedStream::wait(uint64_t seen_pokes, bool outcome_seen, std::chrono::milliseconds max_wait) {
+bool DecodedStream::wait(uint64_t seen_pokes, bool outcome_seen,
+                         std::chrono::milliseconds max_wait) {
   std::unique_lock lock(mutex_);
   changed_.wait_for(lock, max_wait, [&] {
     return stopped_ || pending_updates_ > 0 || (outcome_.has_value() && !outcome_seen) ||
@@ -134,7 +137,8 @@ TakenUpdate DecodedStream::take(Mesh& mirror, MeshChanges& changes) {
       changes.clear();
       changes.full = true;
     } else if (!changes.full) {
-      changes.vertices.insert(changes.vertices.end(), pending_.vertices.begin(), pending_.vertices.end());
+      changes.vertices.insert(changes.vertices.end(), pending_.vertices.begin(),
+                              pending_.vertices.end());
       changes.faces.insert(changes.faces.end(), pending_.faces.begin(), pending_.faces.end());
       changes.moved.insert(changes.moved.end(), pending_.moved.begin(), pending_.moved.end());
     }

@@ -23,9 +23,9 @@ namespace meshstream::client {
 
 // What changed in the decoded mesh since the pipeline last took it.
 struct MeshChanges {
-  bool full = false;                  // everything (the base mesh arrived)
-  std::vector<uint32_t> vertices;     // added vertices (may repeat)
-  std::vector<uint32_t> faces;        // faces created or rewritten (may repeat)
+  bool full = false;               // everything (the base mesh arrived)
+  std::vector<uint32_t> vertices;  // added vertices (may repeat)
+  std::vector<uint32_t> faces;     // faces created or rewritten (may repeat)
   // Existing vertices that only moved (plane records, RecordDelta::
   // moved_vertices; may repeat): their positions changed, no face changed
   // its corners, so the faces around them changed shape only.
@@ -41,7 +41,7 @@ struct MeshChanges {
 // How the stream ended (set once by the network side).
 struct StreamOutcome {
   bool ok = true;
-  std::string reason;   // "complete", "budget" (ok) ...
+  std::string reason;               // "complete", "budget" (ok) ...
   Error error{ErrorCode::kIo, ""};  // when !ok
 };
 
@@ -93,9 +93,9 @@ class DecodedStream {
   std::optional<StreamOutcome> outcome() const;
 
   // ---- either side
-  void poke();                  // wake the pipeline (options changed)
+  void poke();  // wake the pipeline (options changed)
   uint64_t pokes() const;
-  void stop();                  // wake and release everyone for good
+  void stop();  // wake and release everyone for good
   bool stopped() const;
 
  private:

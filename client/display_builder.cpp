@@ -10,11 +10,13 @@ namespace meshstream::client {
 using Clock = std::chrono::steady_clock;
 
 namespace {
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
 
 bool same_options(const AsaOptions& a, const AsaOptions& b) {
-  return a.levels == b.levels && a.flatness == b.flatness && a.uniform == b.uniform && a.rule == b.rule &&
-         a.tension == b.tension && a.crease_degrees == b.crease_degrees;
+  return a.levels == b.levels && a.flatness == b.flatness && a.uniform == b.uniform &&
+         a.rule == b.rule && a.tension == b.tension && a.crease_degrees == b.crease_degrees;
 }
 }  // namespace
 
@@ -86,7 +88,8 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   if (plain_full) {
     s.incremental.reset();
     AsaResult result;
-    if (auto st = subdivide_into(mesh, options, s.workspace, result); !st) return tl::unexpected(st.error());
+    if (auto st = subdivide_into(mesh, options, s.workspace, result); !st)
+      return tl::unexpected(st.error());
     report.asa_ms = ms_since(start);
     if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
     DisplayMesh out;

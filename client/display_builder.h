@@ -21,8 +21,8 @@ enum class AsaPath { kAuto, kFull, kIncremental };
 
 struct BuildReport {
   double asa_ms = 0;
-  bool incremental = false;      // which path produced this display mesh
-  uint32_t region_faces = 0;     // decoded faces recomputed (incremental path)
+  bool incremental = false;   // which path produced this display mesh
+  uint32_t region_faces = 0;  // decoded faces recomputed (incremental path)
 };
 
 struct DisplayMesh {
@@ -43,9 +43,9 @@ class DisplayBuilder {
   // input by `changes` (ignored when `options_changed` or on the first
   // call). `decoded_shared` is returned as is when ASA is off. Errors: those
   // of subdivide() (a mesh ASA cannot work on).
-  Result<DisplayMesh> build(const std::shared_ptr<const Mesh>& decoded_shared, const MeshChanges& changes,
-                            bool asa_enabled, const AsaOptions& options, bool options_changed,
-                            BuildReport& report);
+  Result<DisplayMesh> build(const std::shared_ptr<const Mesh>& decoded_shared,
+                            const MeshChanges& changes, bool asa_enabled, const AsaOptions& options,
+                            bool options_changed, BuildReport& report);
 
  private:
   struct State;

@@ -17,13 +17,13 @@
 namespace meshstream::client {
 
 struct DisplayFrame {
-  uint64_t sequence = 0;          // increases by one per published frame
-  uint32_t records_decoded = 0;   // records applied to `decoded`
+  uint64_t sequence = 0;         // increases by one per published frame
+  uint32_t records_decoded = 0;  // records applied to `decoded`
   uint32_t records_total = 0;
-  uint64_t bytes_received = 0;    // stream bytes so far
+  uint64_t bytes_received = 0;  // stream bytes so far
   uint64_t bytes_total = 0;
-  std::shared_ptr<const Mesh> decoded;         // the decoder's mesh at this record
-  std::shared_ptr<const Mesh> display;         // after ASA (== decoded when ASA is off)
+  std::shared_ptr<const Mesh> decoded;                     // the decoder's mesh at this record
+  std::shared_ptr<const Mesh> display;                     // after ASA (== decoded when ASA is off)
   std::shared_ptr<const std::vector<FaceKind>> face_kind;  // per display face; may be null
   double decode_ms = 0;
   double asa_ms = 0;
@@ -84,7 +84,7 @@ class StreamControls {
   virtual void set_asa(bool asa_enabled, const AsaOptions& options) = 0;
   virtual AsaOptions asa_options() const = 0;
   virtual bool asa_enabled() const = 0;
-  virtual void pause() = 0;   // stop reading from the network (the server paces down)
+  virtual void pause() = 0;  // stop reading from the network (the server paces down)
   virtual void resume() = 0;
   virtual bool paused() const = 0;
   virtual double current_rate_bytes_per_s() const = 0;

@@ -6,16 +6,22 @@ namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
 
-DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamClient* client, LatestFrameMailbox& mailbox,
-                                 PipelineSettings settings, FrameObserver observer)
-    : decoded_(decoded), client_(client), mailbox_(mailbox), observer_(std::move(observer)),
+DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamClient* client,
+                                 LatestFrameMailbox& mailbox, PipelineSettings settings,
+                                 FrameObserver observer)
+    : decoded_(decoded),
+      client_(client),
+      mailbox_(mailbox),
+      observer_(std::move(observer)),
       settings_(std::move(settings)) {
   builder_.set_path(settings_.path);
 }
 
 DisplayPipeline::~DisplayPipeline() { stop(); }
 
-void DisplayPipeline::start() { thread_ = std::thread([this] { loop(); }); }
+void DisplayPipeline::start() {
+  thread_ = std::thread([this] { loop(); });
+}
 
 void DisplayPipeline::stop() {
   decoded_.stop();
@@ -30,7 +36,8 @@ Status DisplayPipeline::wait_finished() {
   return {};
 }
 
-void DisplayPipeline::set_totals(uint64_t bytes_total, uint32_t records_total, uint32_t end_record) {
+void DisplayPipeline::set_totals(uint64_t bytes_total, uint32_t records_total,
+                                 uint32_t end_record) {
   std::lock_guard lock(mutex_);
   bytes_total_ = bytes_total;
   records_total_ = records_total;
@@ -55,7 +62,9 @@ void DisplayPipeline::publish(DisplayFrame frame, const FrameInfo& info) {
 
 void DisplayPipeline::loop() {
   const auto started = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double, std::milli>(Clock::now() - started).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double, std::milli>(Clock::now() - started).count();
+  };
   Mesh mirror;
   MeshChanges changes;
   uint64_t seen_pokes = 0;
@@ -109,8 +118,9 @@ void DisplayPipeline::loop() {
       frame.coalesced_updates = u.updates > 0 ? u.updates - 1 : 0;
       // Final once the last record the server will send is in (the end
       // frame itself may still be on its way), or the stream ended well.
-      frame.final = (end_record > 0 && u.records_decoded >= end_record) ||
-                    (u.ended && decoded_.outcome() && decoded_.outcome()->ok && !decoded_.has_pending());
+      frame.final =
+          (end_record > 0 && u.records_decoded >= end_record) ||
+          (u.ended && decoded_.outcome() && decoded_.outcome()->ok && !decoded_.has_pending());
       info.new_records = true;
       frame.decoded = std::make_shared<const Mesh>(mirror);
     } else {
@@ -170,6 +180,8 @@ void DisplayPipeline::resume() {
   if (client_) client_->resume();
 }
 bool DisplayPipeline::paused() const { return client_ && client_->paused(); }
-double DisplayPipeline::current_rate_bytes_per_s() const { return client_ ? client_->rate_bytes_per_s() : 0; }
+double DisplayPipeline::current_rate_bytes_per_s() const {
+  return client_ ? client_->rate_bytes_per_s() : 0;
+}
 
 }  // namespace meshstream::client

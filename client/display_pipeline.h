@@ -25,7 +25,7 @@ struct FrameInfo {
   bool new_records = false;  // it shows records the previous frame did not
   bool rerun = false;        // ASA options changed
   BuildReport build;
-  double elapsed_ms = 0;     // since the pipeline started
+  double elapsed_ms = 0;  // since the pipeline started
 };
 
 using FrameObserver = std::function<void(const DisplayFrame&, const FrameInfo&)>;

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <iostream>
-
 #include <nlohmann/json.hpp>
 
 namespace meshstream::client {
@@ -13,9 +12,12 @@ double round3(double x) { return std::round(x * 1000.0) / 1000.0; }
 
 std::string human_bytes(double b) {
   char buf[32];
-  if (b >= 1e6) std::snprintf(buf, sizeof buf, "%.2f MB", b / 1e6);
-  else if (b >= 1e3) std::snprintf(buf, sizeof buf, "%.1f KB", b / 1e3);
-  else std::snprintf(buf, sizeof buf, "%.0f B", b);
+  if (b >= 1e6)
+    std::snprintf(buf, sizeof buf, "%.2f MB", b / 1e6);
+  else if (b >= 1e3)
+    std::snprintf(buf, sizeof buf, "%.1f KB", b / 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f B", b);
   return buf;
 }
 
@@ -53,7 +55,8 @@ void EventLog::header(const StreamFacts& f, double elapsed_ms) {
   line(j.dump());
 }
 
-void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double elapsed_ms, double rate) {
+void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double elapsed_ms,
+                          double rate) {
   std::lock_guard lock(mutex_);
   if (json_) {
     nlohmann::json j{{"event", "refinement"},
@@ -73,11 +76,13 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
     return;
   }
   if (!progress_) return;
-  const double pct = fr.bytes_total ? 100.0 * double(fr.bytes_received) / double(fr.bytes_total) : 0;
+  const double pct =
+      fr.bytes_total ? 100.0 * double(fr.bytes_received) / double(fr.bytes_total) : 0;
   std::fprintf(stderr, "\r\033[K%s / %s (%.0f%%)  records %u/%u  vertices %u (display %u)  %s/s",
-               human_bytes(double(fr.bytes_received)).c_str(), human_bytes(double(fr.bytes_total)).c_str(),
-               pct, fr.records_decoded, fr.records_total, fr.decoded->vertex_count(),
-               fr.display->vertex_count(), human_bytes(rate).c_str());
+               human_bytes(double(fr.bytes_received)).c_str(),
+               human_bytes(double(fr.bytes_total)).c_str(), pct, fr.records_decoded,
+               fr.records_total, fr.decoded->vertex_count(), fr.display->vertex_count(),
+               human_bytes(rate).c_str());
   std::fflush(stderr);
   progress_shown_ = true;
 }
@@ -85,7 +90,8 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
 void EventLog::reconnecting(const Error& error, int attempt) {
   std::lock_guard lock(mutex_);
   clear_progress();
-  std::fprintf(stderr, "meshstream-client: %s; reconnecting (attempt %d)\n", error.message.c_str(), attempt);
+  std::fprintf(stderr, "meshstream-client: %s; reconnecting (attempt %d)\n", error.message.c_str(),
+               attempt);
   std::fflush(stderr);
 }
 
@@ -112,12 +118,14 @@ void EventLog::done(const DoneSummary& s) {
   }
   clear_progress();
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "%s: %u/%u records, %s of %s (%s), %u vertices, %u faces; display %u vertices, %u faces; "
-                "%.1f ms, %u display updates (%u updates coalesced), %d reconnects",
-                s.model.c_str(), s.records, s.records_total, human_bytes(double(s.bytes)).c_str(),
-                human_bytes(double(s.bytes_total)).c_str(), s.reason.c_str(), s.vertices, s.faces,
-                s.display_vertices, s.display_faces, s.elapsed_ms, s.display_updates, s.coalesced, s.reconnects);
+  std::snprintf(
+      buf, sizeof buf,
+      "%s: %u/%u records, %s of %s (%s), %u vertices, %u faces; display %u vertices, %u faces; "
+      "%.1f ms, %u display updates (%u updates coalesced), %d reconnects",
+      s.model.c_str(), s.records, s.records_total, human_bytes(double(s.bytes)).c_str(),
+      human_bytes(double(s.bytes_total)).c_str(), s.reason.c_str(), s.vertices, s.faces,
+      s.display_vertices, s.display_faces, s.elapsed_ms, s.display_updates, s.coalesced,
+      s.reconnects);
   line(buf);
 }
 

@@ -11,7 +11,8 @@ void RateMeter::add(uint64_t bytes) {
   std::lock_guard lock(mutex_);
   const auto now = Clock::now();
   samples_.emplace_back(now, bytes);
-  while (!samples_.empty() && now - samples_.front().first > std::chrono::seconds(1)) samples_.pop_front();
+  while (!samples_.empty() && now - samples_.front().first > std::chrono::seconds(1))
+    samples_.pop_front();
 }
 
 double RateMeter::bytes_per_s() const {
@@ -47,11 +48,20 @@ bool transient(v1::Error::Code code) {
 v1::Budget to_proto(const Budget& b) {
   v1::Budget out;
   switch (b.kind) {
-    case Budget::Kind::kAll: break;
-    case Budget::Kind::kBytes: out.set_bytes(static_cast<uint64_t>(b.value)); break;
-    case Budget::Kind::kVertices: out.set_vertices(static_cast<uint32_t>(b.value)); break;
-    case Budget::Kind::kPercentVertices: out.set_percent_vertices(b.value); break;
-    case Budget::Kind::kPercentBytes: out.set_percent(b.value); break;
+    case Budget::Kind::kAll:
+      break;
+    case Budget::Kind::kBytes:
+      out.set_bytes(static_cast<uint64_t>(b.value));
+      break;
+    case Budget::Kind::kVertices:
+      out.set_vertices(static_cast<uint32_t>(b.value));
+      break;
+    case Budget::Kind::kPercentVertices:
+      out.set_percent_vertices(b.value);
+      break;
+    case Budget::Kind::kPercentBytes:
+      out.set_percent(b.value);
+      break;
   }
   return out;
 }
@@ -67,21 +77,25 @@ Status handshake(Connection& connection, Millis timeout) {
   if (!reply) return tl::unexpected(reply.error());
   if (reply->has_error()) {
     // kUnsupported marks an answer that retrying will not change.
-    const ErrorCode code = transient(reply->error().code()) ? ErrorCode::kIo : ErrorCode::kUnsupported;
+    const ErrorCode code =
+        transient(reply->error().code()) ? ErrorCode::kIo : ErrorCode::kUnsupported;
     return make_error(code, server_error_text(reply->error()));
   }
   if (!reply->has_hello()) {
-    return make_error(ErrorCode::kParse, "server " + connection.peer() + " did not answer Hello with ServerHello");
+    return make_error(ErrorCode::kParse,
+                      "server " + connection.peer() + " did not answer Hello with ServerHello");
   }
   if (reply->hello().protocol_version() != proto::kProtocolVersion) {
-    return make_error(ErrorCode::kUnsupported, "server speaks protocol version " +
-                                                   std::to_string(reply->hello().protocol_version()) +
-                                                   ", this client " + std::to_string(proto::kProtocolVersion));
+    return make_error(ErrorCode::kUnsupported,
+                      "server speaks protocol version " +
+                          std::to_string(reply->hello().protocol_version()) + ", this client " +
+                          std::to_string(proto::kProtocolVersion));
   }
   return {};
 }
 
-Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port, Millis timeout) {
+Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port,
+                                               Millis timeout) {
   auto connection = Connection::open(host, port, timeout);
   if (!connection) return tl::unexpected(connection.error());
   if (auto s = handshake(**connection, timeout); !s) return tl::unexpected(s.error());
@@ -117,9 +131,9 @@ bool StreamClient::wait_while_paused() {
   return !stop_.load();
 }
 
-StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
-                                            const std::function<void(const StreamFacts&)>& on_header,
-                                            bool& progressed, Error& error) {
+StreamClient::Attempt StreamClient::attempt(
+    DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header,
+    bool& progressed, Error& error) {
   const ReconnectPolicy& policy = target_.reconnect;
   auto connection = Connection::open(target_.host, target_.port, policy.connect_timeout);
   if (!connection) {
@@ -168,9 +182,10 @@ StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
         error = facts.error();
         return Attempt::kFatal;
       }
-      if (facts_ && (facts->total_bytes != facts_->total_bytes || facts->records_total != facts_->records_total)) {
-        error = Error{ErrorCode::kCorrupt, "model '" + target_.model +
-                                               "' changed on the server between connections"};
+      if (facts_ && (facts->total_bytes != facts_->total_bytes ||
+                     facts->records_total != facts_->records_total)) {
+        error = Error{ErrorCode::kCorrupt,
+                      "model '" + target_.model + "' changed on the server between connections"};
         return Attempt::kFatal;
       }
       if (!facts_) {
@@ -188,8 +203,9 @@ StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
     if (message->has_chunk()) {
       const v1::Chunk& chunk = message->chunk();
       if (!have_header || chunk.offset() != expected) {
-        error = Error{ErrorCode::kParse, "server sent a chunk at offset " + std::to_string(chunk.offset()) +
-                                             ", expected " + std::to_string(expected)};
+        error = Error{ErrorCode::kParse, "server sent a chunk at offset " +
+                                             std::to_string(chunk.offset()) + ", expected " +
+                                             std::to_string(expected)};
         return Attempt::kRetry;
       }
       const std::string& data = chunk.data();
@@ -225,9 +241,9 @@ StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
             error = Error{ErrorCode::kCorrupt,
                           "model '" + target_.model + "': the server's header announces " +
                               std::to_string(facts_->records_total) + " records and " +
-                              std::to_string(facts_->total_bytes) + " bytes, the stream's own index " +
-                              std::to_string(summary->second) + " records and " +
-                              std::to_string(summary->first) + " bytes"};
+                              std::to_string(facts_->total_bytes) +
+                              " bytes, the stream's own index " + std::to_string(summary->second) +
+                              " records and " + std::to_string(summary->first) + " bytes"};
             return Attempt::kFatal;
           }
         }
@@ -253,7 +269,8 @@ StreamClient::Attempt StreamClient::attempt(DecodedStream& decoded,
   return Attempt::kDone;
 }
 
-void StreamClient::run(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header) {
+void StreamClient::run(DecodedStream& decoded,
+                       const std::function<void(const StreamFacts&)>& on_header) {
   const ReconnectPolicy& policy = target_.reconnect;
   int failures = 0;
   while (!stop_) {
@@ -267,14 +284,16 @@ void StreamClient::run(DecodedStream& decoded, const std::function<void(const St
     }
     if (progressed) failures = 0;
     if (++failures > policy.max_attempts) {
-      error.message = "giving up after " + std::to_string(policy.max_attempts) + " attempts: " + error.message;
+      error.message =
+          "giving up after " + std::to_string(policy.max_attempts) + " attempts: " + error.message;
       decoded.finish(StreamOutcome{false, "error", error});
       return;
     }
     ++reconnects_;
     if (on_retry_) on_retry_(error, failures);
     // Bounded exponential back-off, interruptible by stop().
-    const auto delay = std::min<Millis>(policy.max_delay, policy.first_delay * (1 << std::min(failures - 1, 16)));
+    const auto delay =
+        std::min<Millis>(policy.max_delay, policy.first_delay * (1 << std::min(failures - 1, 16)));
     std::unique_lock lock(pause_mutex_);
     pause_changed_.wait_for(lock, delay, [&] { return stop_.load(); });
   }

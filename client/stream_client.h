@@ -36,9 +36,9 @@ struct Budget {
 struct ReconnectPolicy {
   Millis first_delay{50};
   Millis max_delay{2000};
-  int max_attempts = 8;          // consecutive failures without progress
+  int max_attempts = 8;  // consecutive failures without progress
   Millis connect_timeout{5000};
-  Millis read_timeout{15000};    // silence that counts as a lost connection
+  Millis read_timeout{15000};  // silence that counts as a lost connection
 };
 
 struct StreamTarget {
@@ -99,7 +99,8 @@ class StreamClient {
 };
 
 // Hello + ListModels on one connection: the catalog, or the error.
-Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port, Millis timeout);
+Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port,
+                                               Millis timeout);
 
 // Hello/ServerHello exchange on an open connection.
 Status handshake(Connection& connection, Millis timeout);

@@ -35,35 +35,40 @@ void read_arrays(const v1::RecordIndex& r, uint64_t payload_offset, StreamFacts&
 }
 
 Status read_coded(const v1::RecordIndex& r, const v1::StreamHeader& h, StreamFacts& f) {
-  const std::string what = "model '" + h.model().substr(0, 128) + "': the server's compact record index";
-  auto corrupt = [&](const std::string& problem) { return make_error(ErrorCode::kCorrupt, what + " " + problem); };
+  const std::string what =
+      "model '" + h.model().substr(0, 128) + "': the server's compact record index";
+  auto corrupt = [&](const std::string& problem) {
+    return make_error(ErrorCode::kCorrupt, what + " " + problem);
+  };
   if (r.sizes_size() || r.vertices_size() || r.faces_size() || r.crc32_size()) {
     return corrupt("comes with the record arrays too (a header carries one form)");
   }
-  if (r.count() == 0) return corrupt("has " + std::to_string(r.coded().size()) + " coded bytes but no record count");
+  if (r.count() == 0)
+    return corrupt("has " + std::to_string(r.coded().size()) + " coded bytes but no record count");
   if (r.count() > kMaxRecords) {
-    return corrupt("announces " + std::to_string(r.count()) + " records, more than a stream may hold (" +
-                   std::to_string(kMaxRecords) + ")");
+    return corrupt("announces " + std::to_string(r.count()) +
+                   " records, more than a stream may hold (" + std::to_string(kMaxRecords) + ")");
   }
   const auto* bytes = reinterpret_cast<const uint8_t*>(r.coded().data());
-  auto entries = decode_record_index(std::span<const uint8_t>(bytes, r.coded().size()), r.count(), h.payload_offset());
+  auto entries = decode_record_index(std::span<const uint8_t>(bytes, r.coded().size()), r.count(),
+                                     h.payload_offset());
   if (!entries) {
     return make_error(ErrorCode::kParse, what + " does not decode to " + std::to_string(r.count()) +
                                              " records: " + entries.error().message);
   }
   const RecordEntry& last = entries->back();
   if (last.offset + last.size != h.total_bytes()) {
-    return corrupt("ends at byte " + std::to_string(last.offset + last.size) + " but the header's total_bytes is " +
-                   std::to_string(h.total_bytes()));
+    return corrupt("ends at byte " + std::to_string(last.offset + last.size) +
+                   " but the header's total_bytes is " + std::to_string(h.total_bytes()));
   }
   if (h.end_record() > r.count()) {
-    return corrupt("holds " + std::to_string(r.count()) + " records but the header's end_record is " +
-                   std::to_string(h.end_record()));
+    return corrupt("holds " + std::to_string(r.count()) +
+                   " records but the header's end_record is " + std::to_string(h.end_record()));
   }
   if (last.vertices != h.vertices() || last.faces != h.faces()) {
-    return corrupt("ends with " + std::to_string(last.vertices) + " vertices and " + std::to_string(last.faces) +
-                   " faces but the header says " + std::to_string(h.vertices()) + " and " +
-                   std::to_string(h.faces()));
+    return corrupt("ends with " + std::to_string(last.vertices) + " vertices and " +
+                   std::to_string(last.faces) + " faces but the header says " +
+                   std::to_string(h.vertices()) + " and " + std::to_string(h.faces()));
   }
   f.records_total = r.count();
   f.record_end.reserve(entries->size());

@@ -30,8 +30,8 @@ struct StreamFacts {
   uint32_t base_vertices = 0;
   uint32_t base_faces = 0;
   uint32_t quant_bits = 0;
-  std::vector<uint64_t> record_end;        // stream offset after record i
-  std::vector<uint32_t> record_vertices;   // cumulative, per record
+  std::vector<uint64_t> record_end;       // stream offset after record i
+  std::vector<uint32_t> record_vertices;  // cumulative, per record
   std::vector<uint32_t> record_faces;
 };
 

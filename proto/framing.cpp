@@ -50,10 +50,10 @@ uint8_t* put_varint(uint8_t* p, uint64_t value) {
 }
 
 // Wire tags: (field number << 3) | wire type; 0 = varint, 2 = length-delimited.
-constexpr uint8_t kTagServerChunk = (4 << 3) | 2;    // ServerMessage.chunk
-constexpr uint8_t kTagChunkOffset = (1 << 3) | 0;    // Chunk.offset
-constexpr uint8_t kTagChunkRecords = (2 << 3) | 0;   // Chunk.records_complete
-constexpr uint8_t kTagChunkData = (3 << 3) | 2;      // Chunk.data
+constexpr uint8_t kTagServerChunk = (4 << 3) | 2;   // ServerMessage.chunk
+constexpr uint8_t kTagChunkOffset = (1 << 3) | 0;   // Chunk.offset
+constexpr uint8_t kTagChunkRecords = (2 << 3) | 0;  // Chunk.records_complete
+constexpr uint8_t kTagChunkData = (3 << 3) | 2;     // Chunk.data
 
 }  // namespace
 

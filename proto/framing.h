@@ -14,14 +14,14 @@
 //   }
 #pragma once
 
+#include <google/protobuf/message_lite.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <google/protobuf/message_lite.h>
 
 #include "common/base/result.h"
 #include "proto/meshstream.pb.h"

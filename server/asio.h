@@ -3,14 +3,15 @@
 // ("exchange is not a member of std"); include only this header.
 #pragma once
 
-#include <utility>
-
+// clang-format off: <utility> must stay first (see above).
 #include <boost/asio.hpp>
 #include <boost/asio/awaitable.hpp>
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/use_awaitable.hpp>
+#include <utility>
+// clang-format on
 
 namespace meshstream::net {
 namespace asio = boost::asio;

@@ -20,7 +20,8 @@ CompactIndex make_compact_index(const StreamIndex& index) {
   for (uint32_t i = 0; i < count; ++i) {
     const RecordEntry& a = index.records[i];
     const RecordEntry& b = (*decoded)[i];
-    if (a.offset != b.offset || a.size != b.size || a.vertices != b.vertices || a.faces != b.faces) {
+    if (a.offset != b.offset || a.size != b.size || a.vertices != b.vertices ||
+        a.faces != b.faces) {
       out.refused = "the coded index decodes to a different record " + std::to_string(i);
       return out;
     }

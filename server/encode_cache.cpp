@@ -26,16 +26,16 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir) 
   const auto start = std::chrono::steady_clock::now();
   auto finish = [&](Result<CatalogModel> model) {
     out.model = std::move(model);
-    out.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
   };
 #if MESHSTREAM_HAVE_MESH_ENCODER
   const EncodeOptions options;
   const fs::path cached =
-      cache_dir.empty() ? fs::path()
-                        : fs::path(cache_dir) / (job.key + "-q" + std::to_string(options.quant_bits) +
-                                                 "-e" + std::to_string(kEncoderVersion) + ".hcs");
+      cache_dir.empty()
+          ? fs::path()
+          : fs::path(cache_dir) / (job.key + "-q" + std::to_string(options.quant_bits) + "-e" +
+                                   std::to_string(kEncoderVersion) + ".hcs");
   if (!cache_dir.empty() && fs::exists(cached)) {
     if (auto bytes = map_file(cached.string())) {
       if (auto model = make_model(job.name, job.source, job.origin, std::move(*bytes))) {

@@ -53,7 +53,8 @@ Result<std::shared_ptr<const StreamBytes>> map_file(const std::string& path) {
   void* data = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
   const int err = errno;
   ::close(fd);  // the mapping keeps the file alive
-  if (data == MAP_FAILED) return make_error(ErrorCode::kIo, path + ": cannot map: " + std::strerror(err));
+  if (data == MAP_FAILED)
+    return make_error(ErrorCode::kIo, path + ": cannot map: " + std::strerror(err));
   return std::shared_ptr<const StreamBytes>(
       std::make_shared<MappedFile>(data, static_cast<size_t>(st.st_size)));
 }

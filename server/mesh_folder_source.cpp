@@ -68,7 +68,8 @@ class MeshFolderSource final : public CatalogSource {
     std::vector<EncodeJob> jobs;
     auto is_taken = [&](const std::string& name) {
       return catalog.contains(name) ||
-             std::any_of(jobs.begin(), jobs.end(), [&](const EncodeJob& j) { return j.name == name; });
+             std::any_of(jobs.begin(), jobs.end(),
+                         [&](const EncodeJob& j) { return j.name == name; });
     };
     for (const fs::path& path : files) {
       std::string name = path.stem().string();

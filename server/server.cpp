@@ -1,8 +1,8 @@
 #include "server/server.h"
 
-#include <thread>
-
 #include <spdlog/spdlog.h>
+
+#include <thread>
 
 #include "proto/framing.h"
 
@@ -67,7 +67,8 @@ Status Server::listen() {
   boost::system::error_code ec;
   const auto address = asio::ip::make_address(options_.listen_host, ec);
   if (ec) {
-    return make_error(ErrorCode::kIo, "--listen: '" + options_.listen_host + "' is not an IP address");
+    return make_error(ErrorCode::kIo,
+                      "--listen: '" + options_.listen_host + "' is not an IP address");
   }
   const net::tcp::endpoint endpoint(address, options_.listen_port);
   auto acceptor = std::make_unique<net::tcp::acceptor>(workers_[0]->io);
@@ -77,7 +78,8 @@ Status Server::listen() {
   if (!ec) acceptor->listen(asio::socket_base::max_listen_connections, ec);
   if (ec) {
     return make_error(ErrorCode::kIo, "cannot listen on " + options_.listen_host + ":" +
-                                          std::to_string(options_.listen_port) + ": " + ec.message());
+                                          std::to_string(options_.listen_port) + ": " +
+                                          ec.message());
   }
   acceptor_ = std::move(acceptor);
   // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
@@ -122,11 +124,14 @@ awaitable<void> Server::accept_loop() {
     // The session runs on its worker's thread; hand it over there.
     asio::post(worker.io, [this, &worker, reject, socket = std::move(socket)]() mutable {
       if (stopping_) {  // the socket closes
-        if (reject) --rejecting_; else --active_sessions_;
+        if (reject)
+          --rejecting_;
+        else
+          --active_sessions_;
         return;
       }
-      auto session = std::make_shared<Session>(std::move(socket), shared_, worker.registry, reject,
-                                               !reject);
+      auto session =
+          std::make_shared<Session>(std::move(socket), shared_, worker.registry, reject, !reject);
       session->start();
     });
   }
@@ -138,8 +143,7 @@ void Server::stop() {
 }
 
 void Server::begin_shutdown() {
-  spdlog::info("shutting down: no new connections, closing {} sessions",
-               active_sessions_.load());
+  spdlog::info("shutting down: no new connections, closing {} sessions", active_sessions_.load());
   boost::system::error_code ec;
   if (acceptor_) acceptor_->close(ec);
   if (signals_) signals_->cancel(ec);

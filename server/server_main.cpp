@@ -1,10 +1,10 @@
 // meshstream-server: parse options -> load the catalog -> listen -> serve
 // until SIGINT/SIGTERM -> exit 0.
-#include <cstdio>
-#include <iostream>
-
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <iostream>
 
 #include "server/catalog.h"
 #include "server/server.h"
@@ -47,9 +47,10 @@ int main(int argc, char** argv) {
                  model->index.header.vertex_count, model->index.total_bytes(),
                  model->index.records.size());
     if (model->compact.coded.empty()) {
-      spdlog::warn("{}: its record index cannot be coded compactly ({}); its headers carry the "
-                   "arrays",
-                   model->name, model->compact.refused);
+      spdlog::warn(
+          "{}: its record index cannot be coded compactly ({}); its headers carry the "
+          "arrays",
+          model->name, model->compact.refused);
     }
   }
 

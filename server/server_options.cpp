@@ -1,9 +1,8 @@
 #include "server/server_options.h"
 
+#include <CLI/CLI.hpp>
 #include <cstdlib>
 #include <iostream>
-
-#include <CLI/CLI.hpp>
 
 namespace meshstream::server {
 namespace {
@@ -25,7 +24,8 @@ bool split_listen(const std::string& text, std::string& host, uint16_t& port) {
   host = text.substr(0, colon);
   if (host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
   const std::string digits = text.substr(colon + 1);
-  if (digits.size() > 5 || digits.find_first_not_of("0123456789") != std::string::npos) return false;
+  if (digits.size() > 5 || digits.find_first_not_of("0123456789") != std::string::npos)
+    return false;
   const unsigned long value = std::stoul(digits);
   if (value > 65535) return false;
   port = static_cast<uint16_t>(value);

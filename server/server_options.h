@@ -12,9 +12,9 @@
 namespace meshstream::server {
 
 struct ServerOptions {
-  std::string models_dir;           // --models DIR (may be empty with --demo)
+  std::string models_dir;  // --models DIR (may be empty with --demo)
   std::string listen_host = "127.0.0.1";
-  uint16_t listen_port = 7878;      // 0 = any free port (printed on stdout)
+  uint16_t listen_port = 7878;  // 0 = any free port (printed on stdout)
   bool demo = false;
   std::string cache_dir;            // default: $XDG_CACHE_HOME/meshstream or ~/.cache/meshstream
   uint32_t max_connections = 1024;  // extra clients get Error{BUSY}
@@ -24,7 +24,7 @@ struct ServerOptions {
   std::chrono::milliseconds idle_timeout{60000};
   std::chrono::milliseconds stall_timeout{30000};
   uint32_t max_frame_bytes = proto::kDefaultMaxClientFrameBytes;  // client frames
-  uint32_t max_chunk_bytes = 64 * 1024;  // default Chunk.data size
+  uint32_t max_chunk_bytes = 64 * 1024;                           // default Chunk.data size
   // Longest time bulk chunks wait for a burst of new streams' first chunks
   // (FirstChunkGate); zero = no hold (bulk only steps back once per chunk).
   std::chrono::milliseconds first_chunk_hold{50};

@@ -1,8 +1,8 @@
 #include "server/session.h"
 
-#include <algorithm>
-
 #include <spdlog/spdlog.h>
+
+#include <algorithm>
 
 namespace meshstream::server {
 namespace {
@@ -75,10 +75,10 @@ Session::~Session() {
   }
   std::string first_chunk;
   if (first_chunk_written_) {
-    first_chunk = fmt::format(", first chunk {:.2f} ms after its request",
-                              std::chrono::duration<double, std::milli>(*first_chunk_written_ -
-                                                                        *first_request_read_)
-                                  .count());
+    first_chunk = fmt::format(
+        ", first chunk {:.2f} ms after its request",
+        std::chrono::duration<double, std::milli>(*first_chunk_written_ - *first_request_read_)
+            .count());
   }
   spdlog::info("session {}: models [{}], {} streams, {} bytes, {:.3f} s{}, ended: {}", peer_,
                models_, streams_, bytes_total_, seconds, first_chunk,
@@ -90,9 +90,10 @@ Session::~Session() {
       const auto at = std::chrono::system_clock::now() - (Clock::now() - t);
       return std::chrono::duration_cast<std::chrono::microseconds>(at.time_since_epoch()).count();
     };
-    spdlog::debug("session {}: first stream timing: request read at {} us, first chunk written "
-                  "at {} us (unix)",
-                  peer_, wall(*first_request_read_), wall(*first_chunk_written_));
+    spdlog::debug(
+        "session {}: first stream timing: request read at {} us, first chunk written "
+        "at {} us (unix)",
+        peer_, wall(*first_request_read_), wall(*first_chunk_written_));
   }
 }
 
@@ -214,8 +215,8 @@ void Session::handle(const v1::ClientMessage& message) {
     const uint32_t version = message.hello().protocol_version();
     if (version != proto::kProtocolVersion) {
       fail(v1::Error::VERSION_MISMATCH,
-           "protocol version " + std::to_string(version) + " is not supported; this server speaks " +
-               std::to_string(proto::kProtocolVersion),
+           "protocol version " + std::to_string(version) +
+               " is not supported; this server speaks " + std::to_string(proto::kProtocolVersion),
            "wrong protocol version " + std::to_string(version));
       return;
     }
@@ -253,11 +254,20 @@ void Session::handle_stream(const v1::StreamRequest& request) {
   if (request.has_budget()) {
     const v1::Budget& b = request.budget();
     switch (b.limit_case()) {
-      case v1::Budget::kBytes: budget = ByteBudget{b.bytes()}; break;
-      case v1::Budget::kVertices: budget = VertexBudget{b.vertices()}; break;
-      case v1::Budget::kPercent: budget = PercentBudget{b.percent()}; break;
-      case v1::Budget::kPercentVertices: budget = PercentVerticesBudget{b.percent_vertices()}; break;
-      default: break;
+      case v1::Budget::kBytes:
+        budget = ByteBudget{b.bytes()};
+        break;
+      case v1::Budget::kVertices:
+        budget = VertexBudget{b.vertices()};
+        break;
+      case v1::Budget::kPercent:
+        budget = PercentBudget{b.percent()};
+        break;
+      case v1::Budget::kPercentVertices:
+        budget = PercentVerticesBudget{b.percent_vertices()};
+        break;
+      default:
+        break;
     }
   }
   auto plan = plan_stream(model->index, request.resume_offset(), budget);
@@ -265,13 +275,13 @@ void Session::handle_stream(const v1::StreamRequest& request) {
     send_error(v1::Error::INVALID_REQUEST, plan.error().message, false);
     return;
   }
-  size_t chunk = request.max_chunk_bytes() ? request.max_chunk_bytes()
-                                           : shared_.options->max_chunk_bytes;
+  size_t chunk =
+      request.max_chunk_bytes() ? request.max_chunk_bytes() : shared_.options->max_chunk_bytes;
   chunk = std::clamp(chunk, kMinChunkBytes, kMaxChunkBytes);
   if (shared_.options->rate_bytes_per_s > 0) {
     // About 20 chunks a second, so paced arrival is visibly progressive.
-    chunk = std::min<size_t>(chunk, std::max<uint64_t>(kMinChunkBytes,
-                                                       shared_.options->rate_bytes_per_s / 20));
+    chunk = std::min<size_t>(
+        chunk, std::max<uint64_t>(kMinChunkBytes, shared_.options->rate_bytes_per_s / 20));
   }
   ++starting_;
   shared_.first_chunks->stream_starting(Clock::now());
@@ -367,7 +377,8 @@ std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& p
 
 awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
   while (!closed_) {
-    if (!pending_header_.empty() && (!queue_.empty() || !stream_ || stream_->position >= stream_->plan.end)) {
+    if (!pending_header_.empty() &&
+        (!queue_.empty() || !stream_ || stream_->position >= stream_->plan.end)) {
       // Something else must follow the header: send it on its own.
       const std::vector<uint8_t> header = std::move(pending_header_);
       pending_header_.clear();
@@ -394,17 +405,18 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
       } else if (auto* start = std::get_if<StartStream>(&item)) {
         if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
         const CatalogModel& model = *start->model;
-        stream_.emplace(ActiveStream{
-            &model, model.bytes, start->plan, start->chunk_bytes, start->plan.start, 0,
-            records_complete_at(model.index, start->plan.start),
-            TokenBucket(double(shared_.options->rate_bytes_per_s), double(start->chunk_bytes),
-                        Clock::now()),
-            0, false, start->requested});
+        stream_.emplace(ActiveStream{&model, model.bytes, start->plan, start->chunk_bytes,
+                                     start->plan.start, 0,
+                                     records_complete_at(model.index, start->plan.start),
+                                     TokenBucket(double(shared_.options->rate_bytes_per_s),
+                                                 double(start->chunk_bytes), Clock::now()),
+                                     0, false, start->requested});
         ++streams_;
         if (models_.find(model.name) == std::string::npos) {
           models_ += models_.empty() ? model.name : "," + model.name;
         }
-        pending_header_ = header_frame(model, start->plan, start->chunk_bytes, start->compact_index);
+        pending_header_ =
+            header_frame(model, start->plan, start->chunk_bytes, start->compact_index);
       } else {  // CancelStream
         if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
       }
@@ -413,7 +425,8 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
     if (stream_) {
       ActiveStream& s = *stream_;
       if (s.position >= s.plan.end) {
-        if (!co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET)) break;
+        if (!co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET))
+          break;
         continue;
       }
       const size_t limit =
@@ -514,8 +527,8 @@ awaitable<void> Session::watchdog(std::shared_ptr<Session> self) {
              "handshake timeout");
       } else if (hello_done_ && !stream_ && queue_.empty() && !write_in_flight_ &&
                  now - last_activity_ >= o.idle_timeout) {
-        fail(v1::Error::TIMEOUT,
-             "idle for " + std::to_string(o.idle_timeout.count()) + " ms", "idle timeout");
+        fail(v1::Error::TIMEOUT, "idle for " + std::to_string(o.idle_timeout.count()) + " ms",
+             "idle timeout");
       }
     }
     auto next = now + check;

@@ -34,9 +34,9 @@ struct ServerShared {
   const Catalog* catalog = nullptr;
   std::shared_ptr<const std::vector<uint8_t>> model_list_frame;  // ModelList, pre-encoded
   std::shared_ptr<const std::vector<uint8_t>> hello_frame;       // ServerHello, pre-encoded
-  std::atomic<int64_t>* active_sessions = nullptr;     // counted toward --max-connections
-  std::atomic<int64_t>* rejecting_sessions = nullptr;  // busy sessions still closing
-  FirstChunkGate* first_chunks = nullptr;              // bulk waits for new streams' first chunks
+  std::atomic<int64_t>* active_sessions = nullptr;               // counted toward --max-connections
+  std::atomic<int64_t>* rejecting_sessions = nullptr;            // busy sessions still closing
+  FirstChunkGate* first_chunks = nullptr;  // bulk waits for new streams' first chunks
 };
 
 // The sessions of one worker thread, touched only from that thread.

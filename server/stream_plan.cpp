@@ -1,8 +1,8 @@
 #include "server/stream_plan.h"
 
 #include <algorithm>
-#include <cmath>
 #include <charconv>
+#include <cmath>
 #include <string>
 
 #include "common/codec/decoder.h"
@@ -109,7 +109,8 @@ ChunkCut next_chunk(const StreamIndex& index, const StreamPlan& plan, uint64_t p
   // of 1.8 KB, header included).
   uint64_t end = unit_end;
   const uint64_t base_end = index.records.empty() ? 0 : record_end(index.records[0]);
-  while (end != base_end && next < index.records.size() && record_end(index.records[next]) <= limit) {
+  while (end != base_end && next < index.records.size() &&
+         record_end(index.records[next]) <= limit) {
     end = record_end(index.records[next]);
     ++next;
   }

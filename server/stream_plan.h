@@ -16,16 +16,25 @@
 
 namespace meshstream::server {
 
-struct ByteBudget { uint64_t bytes; };
-struct VertexBudget { uint32_t vertices; };
+struct ByteBudget {
+  uint64_t bytes;
+};
+struct VertexBudget {
+  uint32_t vertices;
+};
 // Percent of the stream's bytes (wire Budget.percent).
-struct PercentBudget { double percent; };
+struct PercentBudget {
+  double percent;
+};
 // Percent of the full mesh's vertices (wire Budget.percent_vertices): the
 // rule of `meshstream decode --percent`, i.e. prefix_for_budget's
 // kPercentVertices (common/codec/decoder.h).
-struct PercentVerticesBudget { double percent; };
+struct PercentVerticesBudget {
+  double percent;
+};
 // monostate = whole stream.
-using Budget = std::variant<std::monostate, ByteBudget, VertexBudget, PercentBudget, PercentVerticesBudget>;
+using Budget =
+    std::variant<std::monostate, ByteBudget, VertexBudget, PercentBudget, PercentVerticesBudget>;
 
 struct StreamPlan {
   uint64_t start = 0;         // first byte sent (0 or a record's offset)

@@ -24,9 +24,10 @@ std::vector<uint8_t> make_synthetic_hcs(const SyntheticStreamOptions& o) {
   records[0].size = std::max<uint32_t>(1, o.base_bytes);
   records[0].vertices = std::min(o.base_vertices, o.vertices);
   for (uint32_t i = 1; i < n; ++i) {
-    records[i].size = std::max<uint32_t>(1, uint32_t(double(o.payload_bytes) * weights[i - 1] / sum));
-    records[i].vertices = records[0].vertices +
-        uint32_t(uint64_t(o.vertices - records[0].vertices) * i / (n - 1));
+    records[i].size =
+        std::max<uint32_t>(1, uint32_t(double(o.payload_bytes) * weights[i - 1] / sum));
+    records[i].vertices =
+        records[0].vertices + uint32_t(uint64_t(o.vertices - records[0].vertices) * i / (n - 1));
   }
   for (RecordEntry& r : records) r.faces = r.vertices * 2;
 

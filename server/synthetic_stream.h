@@ -11,10 +11,10 @@
 namespace meshstream::server {
 
 struct SyntheticStreamOptions {
-  uint32_t vertices = 100000;      // of the full "mesh"
-  uint32_t base_vertices = 300;    // after record 0
-  uint32_t records = 200;          // base mesh included
-  uint32_t base_bytes = 8000;      // size of record 0
+  uint32_t vertices = 100000;        // of the full "mesh"
+  uint32_t base_vertices = 300;      // after record 0
+  uint32_t records = 200;            // base mesh included
+  uint32_t base_bytes = 8000;        // size of record 0
   uint64_t payload_bytes = 1 << 20;  // all records after the base, about
   uint64_t seed = 1;
 };

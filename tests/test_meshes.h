@@ -16,7 +16,8 @@ inline std::string test_mesh_dir() {
     if (std::filesystem::is_directory(env)) return env;
   }
 #ifdef MESHSTREAM_SOURCE_DIR
-  std::filesystem::path shared = std::filesystem::path(MESHSTREAM_SOURCE_DIR) / ".." / "shared" / "meshes";
+  std::filesystem::path shared =
+      std::filesystem::path(MESHSTREAM_SOURCE_DIR) / ".." / "shared" / "meshes";
   if (std::filesystem::is_directory(shared)) return std::filesystem::canonical(shared).string();
 #endif
   return {};
@@ -26,9 +27,9 @@ inline std::string test_mesh(const std::string& name) { return test_mesh_dir() +
 
 }  // namespace meshstream::testing
 
-#define MESHSTREAM_REQUIRE_TEST_MESHES()                                              \
-  do {                                                                                \
-    if (::meshstream::testing::test_mesh_dir().empty())                               \
+#define MESHSTREAM_REQUIRE_TEST_MESHES()                                               \
+  do {                                                                                 \
+    if (::meshstream::testing::test_mesh_dir().empty())                                \
       GTEST_SKIP() << "real test meshes not found (set MESHSTREAM_TEST_MESHES or put " \
-                      "../shared/meshes beside the repository)";                      \
+                      "../shared/meshes beside the repository)";                       \
   } while (0)

@@ -3,9 +3,8 @@
 // and relative to A's bounding-box diagonal.
 #include <cstdio>
 #include <iostream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "common/mesh/import.h"
 #include "common/metrics/distance.h"
@@ -69,14 +68,18 @@ int run_compare(const CompareArgs& args) {
     std::cout << out.dump() << "\n";
     return 0;
   }
-  std::printf("A: %s (%u vertices, %u faces)\n", args.a.c_str(), a->vertex_count(), a->face_count());
-  std::printf("B: %s (%u vertices, %u faces)\n", args.b.c_str(), b->vertex_count(), b->face_count());
+  std::printf("A: %s (%u vertices, %u faces)\n", args.a.c_str(), a->vertex_count(),
+              a->face_count());
+  std::printf("B: %s (%u vertices, %u faces)\n", args.b.c_str(), b->vertex_count(),
+              b->face_count());
   std::printf("A's bounding-box diagonal: %.9g\n", d->diagonal);
   std::printf("Hausdorff: %.9g (%s of the diagonal)\n", d->hausdorff,
               percent(d->relative_hausdorff()).c_str());
   std::printf("RMS:       %.9g (%s of the diagonal)\n", d->rms, percent(d->relative_rms()).c_str());
-  std::printf("A to B:    max %.9g  mean %.9g  rms %.9g\n", d->a_to_b.max, d->a_to_b.mean, d->a_to_b.rms);
-  std::printf("B to A:    max %.9g  mean %.9g  rms %.9g\n", d->b_to_a.max, d->b_to_a.mean, d->b_to_a.rms);
+  std::printf("A to B:    max %.9g  mean %.9g  rms %.9g\n", d->a_to_b.max, d->a_to_b.mean,
+              d->a_to_b.rms);
+  std::printf("B to A:    max %.9g  mean %.9g  rms %.9g\n", d->b_to_a.max, d->b_to_a.mean,
+              d->b_to_a.rms);
   std::printf("(%u area samples per direction plus every vertex and edge midpoint, seed %llu)\n",
               args.samples, static_cast<unsigned long long>(args.seed));
   return 0;

@@ -22,7 +22,8 @@ struct DecodeArgs {
 Result<std::vector<uint8_t>> read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return make_error(ErrorCode::kIo, path + ": cannot open");
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
   if (in.bad()) return make_error(ErrorCode::kIo, path + ": read error");
   return bytes;
 }
@@ -41,13 +42,15 @@ int run_decode(const DecodeArgs& args) {
   if (prefix < index->total_bytes() && budget.kind == DecodeBudget::Kind::kAll) {
     return report_failure(Error{ErrorCode::kTruncated, args.input + ": stream is cut short (" +
                                                            std::to_string(bytes->size()) + " of " +
-                                                           std::to_string(index->total_bytes()) + " bytes)"});
+                                                           std::to_string(index->total_bytes()) +
+                                                           " bytes)"});
   }
   IncrementalDecoder decoder;
   auto fed = decoder.feed(std::span<const uint8_t>(bytes->data(), prefix));
   if (!fed) return report_failure(std::move(fed.error()).with_context(args.input));
   if (decoder.records_decoded() == 0) {
-    return report_failure(Error{ErrorCode::kTruncated, args.input + ": the base mesh is incomplete"});
+    return report_failure(
+        Error{ErrorCode::kTruncated, args.input + ": the base mesh is incomplete"});
   }
   if (auto s = write_mesh(decoder.mesh(), args.output); !s) return report_failure(s.error());
   std::printf("%s: decoded %u of %zu records (%llu of %llu bytes): %u vertices, %u faces -> %s\n",
@@ -61,15 +64,18 @@ int run_decode(const DecodeArgs& args) {
 }  // namespace
 
 void add_decode_command(CLI::App& app, int& exit_code) {
-  auto* cmd = app.add_subcommand("decode", "Decode an .hcs stream (or the prefix a budget selects)");
+  auto* cmd =
+      app.add_subcommand("decode", "Decode an .hcs stream (or the prefix a budget selects)");
   auto args = std::make_shared<DecodeArgs>();
   cmd->add_option("input", args->input, ".hcs stream")->required();
   cmd->add_option("-o,--output", args->output, "mesh to write (.ply or .obj)")->required();
-  auto* b = cmd->add_option("--bytes", args->bytes, "decode at most this many bytes")->check(CLI::NonNegativeNumber);
+  auto* b = cmd->add_option("--bytes", args->bytes, "decode at most this many bytes")
+                ->check(CLI::NonNegativeNumber);
   auto* v = cmd->add_option("--vertices", args->vertices, "decode at most this many vertices")
                 ->check(CLI::NonNegativeNumber);
-  auto* p = cmd->add_option("--percent", args->percent, "decode at most this percentage of the vertices")
-                ->check(CLI::Range(0.0, 100.0));
+  auto* p =
+      cmd->add_option("--percent", args->percent, "decode at most this percentage of the vertices")
+          ->check(CLI::Range(0.0, 100.0));
   auto* r = cmd->add_option("--ratio", args->ratio, "decode 1/CR of the stream (CR >= 1)")
                 ->check(CLI::Range(1.0, 1e12));
   b->excludes(v)->excludes(p)->excludes(r);

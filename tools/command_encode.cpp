@@ -35,17 +35,19 @@ int run_encode(const EncodeArgs& args) {
   auto bytes = encode_hcs(imported->mesh, options);
   if (!bytes) return report_failure(std::move(bytes.error()).with_context(args.input));
   std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()));
+  out.write(reinterpret_cast<const char*>(bytes->data()),
+            static_cast<std::streamsize>(bytes->size()));
   out.close();
   if (!out) return report_failure(Error{ErrorCode::kIo, args.output + ": cannot write the stream"});
   auto index = read_stream_index(*bytes);
   if (!index) return report_failure(std::move(index.error()).with_context(args.output));
   const uint32_t v = imported->mesh.vertex_count();
-  std::printf("%s: %u vertices, %u faces -> %s: %zu bytes (%.2f bits/vertex), base %u vertices, "
-              "%u layers, %zu records\n",
-              args.input.c_str(), v, imported->mesh.face_count(), args.output.c_str(), bytes->size(),
-              v ? 8.0 * double(bytes->size()) / v : 0.0, index->header.base_vertex_count,
-              index->header.layer_count, index->records.size());
+  std::printf(
+      "%s: %u vertices, %u faces -> %s: %zu bytes (%.2f bits/vertex), base %u vertices, "
+      "%u layers, %zu records\n",
+      args.input.c_str(), v, imported->mesh.face_count(), args.output.c_str(), bytes->size(),
+      v ? 8.0 * double(bytes->size()) / v : 0.0, index->header.base_vertex_count,
+      index->header.layer_count, index->records.size());
   return 0;
 }
 
@@ -59,12 +61,14 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--quant-bits", args->quant_bits, "position quantization bits (8..20)")
       ->check(CLI::Range(8, 20))
       ->capture_default_str();
-  cmd->add_option("--base-vertices", args->base_vertices, "stop decimating at about this many vertices")
+  cmd->add_option("--base-vertices", args->base_vertices,
+                  "stop decimating at about this many vertices")
       ->check(CLI::Range(4u, 1u << 30))
       ->capture_default_str();
-  cmd->add_option("--record-bytes", args->record_bytes,
-                  "close a refinement record at about this size (0: automatic, at least min(n/50, 200) "
-                  "records, none above 2 % of the stream)")
+  cmd->add_option(
+         "--record-bytes", args->record_bytes,
+         "close a refinement record at about this size (0: automatic, at least min(n/50, 200) "
+         "records, none above 2 % of the stream)")
       ->check(CLI::Range(0u, 1u << 26))
       ->capture_default_str();
   cmd->add_option("--base-shift", args->base_shift,

@@ -57,8 +57,8 @@ void add_generate_command(CLI::App& app, int& exit_code) {
       exit_code = report_failure(mesh.error());
       return;
     }
-    const bool ply = args->output.size() >= 4 &&
-                     args->output.compare(args->output.size() - 4, 4, ".ply") == 0;
+    const bool ply =
+        args->output.size() >= 4 && args->output.compare(args->output.size() - 4, 4, ".ply") == 0;
     Status written = ply && args->ascii ? write_ply(*mesh, args->output, PlyEncoding::kAscii)
                                         : write_mesh(*mesh, args->output);
     if (!written) {

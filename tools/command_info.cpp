@@ -10,8 +10,7 @@ void add_info_command(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("info", "Facts about a mesh file or an .hcs stream");
   auto path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
-  cmd->add_option("input", *path, "mesh file (PLY, OBJ, STL, OFF, DRC) or .hcs stream")
-      ->required();
+  cmd->add_option("input", *path, "mesh file (PLY, OBJ, STL, OFF, DRC) or .hcs stream")->required();
   cmd->add_flag("--json", *json, "print one JSON object instead of text");
   cmd->callback([path, json, &exit_code] {
     char magic[4] = {};

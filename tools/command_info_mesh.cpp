@@ -4,9 +4,8 @@
 // the result.
 #include <cstdio>
 #include <iostream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "common/mesh/import.h"
 #include "common/mesh/topology.h"
@@ -31,8 +30,10 @@ nlohmann::json stats_json(const MeshStats& s) {
                       {"nonmanifold_vertices", s.nonmanifold_vertices},
                       {"orientation_conflicts", s.orientation_conflicts},
                       {"duplicate_faces", s.duplicate_faces},
-                      {"bbox", {{"min", vec_json(s.bbox.min)}, {"max", vec_json(s.bbox.max)},
-                                {"diagonal", s.bbox.diagonal()}}}};
+                      {"bbox",
+                       {{"min", vec_json(s.bbox.min)},
+                        {"max", vec_json(s.bbox.max)},
+                        {"diagonal", s.bbox.diagonal()}}}};
   j["genus"] = s.genus_valid ? nlohmann::json(s.genus) : nlohmann::json(nullptr);
   return j;
 }
@@ -85,7 +86,8 @@ void print_stats(const MeshStats& s) {
                 s.nonmanifold_vertices);
   }
   std::printf("\n");
-  if (s.orientation_conflicts) std::printf("  orientation     %u conflicting edges\n", s.orientation_conflicts);
+  if (s.orientation_conflicts)
+    std::printf("  orientation     %u conflicting edges\n", s.orientation_conflicts);
   if (s.duplicate_faces) std::printf("  duplicates      %u faces\n", s.duplicate_faces);
 }
 
@@ -117,8 +119,8 @@ int run_info_mesh(const std::string& path, bool json) {
     return 0;
   }
   std::printf("%s\n", path.c_str());
-  std::printf("file: %u vertices, %u triangles (after fan-triangulating polygons)\n", r.vertices_in_file,
-              r.faces_in_file);
+  std::printf("file: %u vertices, %u triangles (after fan-triangulating polygons)\n",
+              r.vertices_in_file, r.faces_in_file);
   std::printf("as drawn (bit-identical positions welded, degenerate faces dropped):\n");
   print_stats(file_stats);
   std::printf("import changed:%s\n", r.changed() ? "" : " nothing");
@@ -137,8 +139,8 @@ int run_info_mesh(const std::string& path, bool json) {
   std::printf("mesh (what encode and subdivide work on):\n");
   print_stats(stats);
   const BoundingBox& box = stats.bbox;
-  std::printf("  bounding box    (%.9g, %.9g, %.9g) - (%.9g, %.9g, %.9g), diagonal %.9g\n", box.min.x,
-              box.min.y, box.min.z, box.max.x, box.max.y, box.max.z, box.diagonal());
+  std::printf("  bounding box    (%.9g, %.9g, %.9g) - (%.9g, %.9g, %.9g), diagonal %.9g\n",
+              box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z, box.diagonal());
   std::printf("  attributes      %s\n", attributes_of(imported->mesh).c_str());
   return 0;
 }

@@ -25,7 +25,8 @@ int run_subdivide(SubdivideArgs& args) {
   auto imported = import_mesh(args.input);
   if (!imported) return report_failure(imported.error());
   const Mesh& mesh = imported->mesh;
-  args.options.rule = args.rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
+  args.options.rule =
+      args.rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
 
   const auto start = std::chrono::steady_clock::now();
   AsaWorkspace workspace;
@@ -39,16 +40,17 @@ int run_subdivide(SubdivideArgs& args) {
   }
   std::map<FaceKind, uint32_t> kinds;
   for (FaceKind k : result->face_kind) ++kinds[k];
-  std::printf("%s: %u vertices, %u faces -> %s: %u vertices, %u faces (%s, %d level%s, %.1f ms)\n",
-              args.input.c_str(), mesh.vertex_count(), mesh.face_count(), args.output.c_str(),
-              result->mesh.vertex_count(), result->mesh.face_count(),
-              args.options.uniform ? "uniform" : ("ASA t=" + std::to_string(args.options.flatness)).c_str(),
-              args.options.levels, args.options.levels == 1 ? "" : "s", ms);
+  std::printf(
+      "%s: %u vertices, %u faces -> %s: %u vertices, %u faces (%s, %d level%s, %.1f ms)\n",
+      args.input.c_str(), mesh.vertex_count(), mesh.face_count(), args.output.c_str(),
+      result->mesh.vertex_count(), result->mesh.face_count(),
+      args.options.uniform ? "uniform" : ("ASA t=" + std::to_string(args.options.flatness)).c_str(),
+      args.options.levels, args.options.levels == 1 ? "" : "s", ms);
   if (!args.options.uniform) {
     const AsaStats& stats = workspace.last_stats();
     for (size_t level = 0; level < stats.targets.size(); ++level) {
-      std::printf("  level %zu: %u flatness targets, %u new vertices\n", level + 1, stats.targets[level],
-                  stats.split_edges[level]);
+      std::printf("  level %zu: %u flatness targets, %u new vertices\n", level + 1,
+                  stats.targets[level], stats.split_edges[level]);
     }
     std::printf("  last level: %u faces split 1-to-4, %u bisected, %u untouched\n",
                 kinds[FaceKind::kTarget], kinds[FaceKind::kBisected], kinds[FaceKind::kUntouched]);
@@ -66,14 +68,17 @@ void add_subdivide_command(CLI::App& app, int& exit_code) {
       "or everywhere with --uniform. Old vertices never move.");
   cmd->add_option("IN", args->input, "input mesh (OBJ, PLY, STL, OFF, DRC)")->required();
   cmd->add_option("-o,--output", args->output, "output mesh (.ply or .obj)")->required();
-  cmd->add_option("--levels", args->options.levels, "subdivision levels (flatness re-evaluated each)")
+  cmd->add_option("--levels", args->options.levels,
+                  "subdivision levels (flatness re-evaluated each)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
-  cmd->add_option("--flatness", args->options.flatness,
-                  "t: triangles whose normals differ by more than acos(t) are refined (0.7-0.9 works well)")
+  cmd->add_option(
+         "--flatness", args->options.flatness,
+         "t: triangles whose normals differ by more than acos(t) are refined (0.7-0.9 works well)")
       ->check(CLI::Range(-1.0f, 1.0f))
       ->capture_default_str();
-  cmd->add_flag("--uniform", args->options.uniform, "split every triangle (classic modified Butterfly)");
+  cmd->add_flag("--uniform", args->options.uniform,
+                "split every triangle (classic modified Butterfly)");
   cmd->add_option("--rule", args->rule,
                   "zorin: weights on 3-D points; projection: only the normal offset (thesis)")
       ->check(CLI::IsMember({"zorin", "projection"}))

@@ -3,9 +3,8 @@
 // process exit code in `exit_code` (0 ok, 1 bad data or failure).
 #pragma once
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "common/base/result.h"
 

@@ -22,10 +22,10 @@ struct RdPoint {
 
 // One step of the LOD chain and our stream at the same byte budget.
 struct ChainComparison {
-  std::string label;            // "1/64", ..., "full"
-  uint32_t target_faces = 0;    // what the simplifier was asked for
-  RdPoint chain;                // cumulative bytes of the chain up to this LOD
-  std::optional<RdPoint> ours;  // our largest prefix within chain.bytes
+  std::string label;              // "1/64", ..., "full"
+  uint32_t target_faces = 0;      // what the simplifier was asked for
+  RdPoint chain;                  // cumulative bytes of the chain up to this LOD
+  std::optional<RdPoint> ours;    // our largest prefix within chain.bytes
   bool ours_over_budget = false;  // our base mesh alone is larger than the budget
 };
 
@@ -45,7 +45,7 @@ struct MeshMeasurements {
   uint32_t ours_records = 0;
   uint64_t ours_base_bytes = 0;
   double ours_encode_vps = 0, ours_decode_vps = 0;
-  bool ours_counts_match = false;  // full decode has the input's vertex and face counts
+  bool ours_counts_match = false;         // full decode has the input's vertex and face counts
   uint32_t ours_vertices_at_ratio20 = 0;  // in the prefix of 1/20 of the stream (HCS's ratio 20)
   uint64_t ours_bytes_at_ratio20 = 0;
 

@@ -21,7 +21,8 @@
 namespace meshstream::bench {
 
 // Distance of what a client shows after `bytes` to the original.
-inline Result<RdPoint> rd_point(const PreparedSurface& original, const Mesh& shown, uint64_t bytes) {
+inline Result<RdPoint> rd_point(const PreparedSurface& original, const Mesh& shown,
+                                uint64_t bytes) {
   auto prepared = PreparedSurface::prepare(shown, original.options());
   if (!prepared) return tl::unexpected(prepared.error());
   const SurfaceDistance d = surface_distance(original, *prepared);
@@ -47,7 +48,8 @@ inline std::vector<uint64_t> choose_prefixes(const StreamIndex& index, int count
   if (ends.empty()) return chosen;
   const double first = static_cast<double>(ends.front()), last = static_cast<double>(ends.back());
   for (int i = 0; i < count; ++i) {
-    const double target = count > 1 ? first * std::pow(last / first, double(i) / (count - 1)) : last;
+    const double target =
+        count > 1 ? first * std::pow(last / first, double(i) / (count - 1)) : last;
     auto it = std::upper_bound(ends.begin(), ends.end(), static_cast<uint64_t>(target + 0.5));
     chosen.push_back(it == ends.begin() ? ends.front() : *(it - 1));
   }
@@ -74,16 +76,19 @@ inline Result<std::vector<RdPoint>> our_curve(std::span<const uint8_t> stream,
   for (uint64_t prefix : prefixes) {
     if (prefix > stream.size()) break;
     auto applied = decoder.feed(stream.subspan(fed, prefix - fed));
-    if (!applied) return tl::unexpected(std::move(applied.error()).with_context("stream prefix " + std::to_string(prefix)));
+    if (!applied)
+      return tl::unexpected(
+          std::move(applied.error()).with_context("stream prefix " + std::to_string(prefix)));
     fed = prefix;
     if (decoder.resume_offset() != prefix) {
-      return make_error(ErrorCode::kCorrupt, "decoder stopped at byte " +
-                                                 std::to_string(decoder.resume_offset()) +
-                                                 ", not at the record boundary " +
-                                                 std::to_string(prefix));
+      return make_error(ErrorCode::kCorrupt,
+                        "decoder stopped at byte " + std::to_string(decoder.resume_offset()) +
+                            ", not at the record boundary " + std::to_string(prefix));
     }
     auto point = rd_point(original, decoder.mesh(), prefix);
-    if (!point) return tl::unexpected(std::move(point.error()).with_context("prefix " + std::to_string(prefix)));
+    if (!point)
+      return tl::unexpected(
+          std::move(point.error()).with_context("prefix " + std::to_string(prefix)));
     curve.push_back(*point);
   }
   return curve;

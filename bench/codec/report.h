@@ -74,7 +74,8 @@ inline void write_markdown(const std::filesystem::path& path,
   md << "## Codec: the embedded .hcs stream against Draco, a meshoptimizer LOD chain and issue I's "
         "ordering (issues 3 and 5)\n\n"
      << "Written by `bench/codec_bench` (`build/bench/codec_bench --report-dir bench/report"
-     << (s.quick ? " --quick" : "") << "`), all in one run. Every real mesh of `../shared/meshes` that "
+     << (s.quick ? " --quick" : "")
+     << "`), all in one run. Every real mesh of `../shared/meshes` that "
      << "imports, cleaned by `import_mesh` (so Draco and ours code the very same mesh), "
      << "positions quantized to " << s.quant_bits << " bits by both. *Ours* is the default "
      << "`encode_hcs` stream (issue 5: successive-approximation bit planes, records ordered by "
@@ -91,7 +92,8 @@ inline void write_markdown(const std::filesystem::path& path,
 
   // Sizes.
   md << "### Size (bits per vertex, 12-bit positions)\n\n"
-     << "| mesh | vertices | Draco L7 | Draco L10 | ours | ours / L7 | ours / L10 | issue I order | "
+     << "| mesh | vertices | Draco L7 | Draco L10 | ours | ours / L7 | ours / L10 | issue I order "
+        "| "
         "ours / issue I order | issue-3 target (Draco L7 quoted) |\n"
      << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   std::vector<double> r7, r10, rplain, rdec, share20, share20_plain;
@@ -122,25 +124,35 @@ inline void write_markdown(const std::filesystem::path& path,
 
   // Stream structure.
   md << "\n### The embedded stream: granularity and parts\n\n"
-     << "Records beyond the base must number at least min(n/50, 200) and none may exceed 2 % of the "
-        "stream (issue 5). Plane records carry one bit plane of a batch's positions (context-adaptive "
-        "binary arithmetic coding, `embedded_geometry.h`: *context*); *plain* is the same bits through "
+     << "Records beyond the base must number at least min(n/50, 200) and none may exceed 2 % of "
+        "the "
+        "stream (issue 5). Plane records carry one bit plane of a batch's positions "
+        "(context-adaptive "
+        "binary arithmetic coding, `embedded_geometry.h`: *context*); *plain* is the same bits "
+        "through "
         "issue I's kind of coder (adaptive binary models by plane only, no axis, significance or "
-        "neighbour contexts), *raw* what they would take uncoded. *Model* = the decoder's mesh after every record hashes to what "
+        "neighbour contexts), *raw* what they would take uncoded. *Model* = the decoder's mesh "
+        "after every record hashes to what "
         "the encoder's model predicted (`EncodeReport`). *Worst RMS rise*: largest increase of RMS "
-        "between consecutive measured points of the curve below. *Estimate*: the distortion estimate of "
+        "between consecutive measured points of the curve below. *Estimate*: the distortion "
+        "estimate of "
         "the record ordering the encoder's measured choice kept (displacement or surface distance, "
         "`docs/hcs-format.md`).\n\n"
-     << "| mesh | records | plane records | required | largest record | base shift | estimate | structure bytes "
+     << "| mesh | records | plane records | required | largest record | base shift | estimate | "
+        "structure bytes "
         "| plane bytes (context / plain / raw) | model | worst RMS rise |\n"
      << "|---|---:|---:|---:|---:|---:|---|---:|---:|---|---:|\n";
   for (const MeshMeasurements& m : all) {
     if (!m.error.empty() || !m.ours_error.empty() || m.ours_bytes == 0) continue;
     md << "| " << m.name << " | " << m.ours_records << " | " << m.ours_plane_records << " | "
        << std::min<uint32_t>(m.vertices / 50, 200) + 1 << " | "
-       << fmt("%.2f %%", 100.0 * m.ours_largest_record / m.ours_bytes) << " | " << m.ours_base_shift << " | "
-       << (m.ours_distortion_estimate == 2 ? "surface" : m.ours_distortion_estimate == 1 ? "displacement" : "?")
-       << " | " << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / " << m.ours_plane_plain_bytes << " / " << m.ours_plane_raw_bytes << " | "
+       << fmt("%.2f %%", 100.0 * m.ours_largest_record / m.ours_bytes) << " | " << m.ours_base_shift
+       << " | "
+       << (m.ours_distortion_estimate == 2   ? "surface"
+           : m.ours_distortion_estimate == 1 ? "displacement"
+                                             : "?")
+       << " | " << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / "
+       << m.ours_plane_plain_bytes << " / " << m.ours_plane_raw_bytes << " | "
        << (m.ours_model_matches ? "matches" : "**differs**") << " | "
        << fmt("%.1f %%", 100 * m.ours_worst_rms_rise) << " |\n";
   }
@@ -153,16 +165,18 @@ inline void write_markdown(const std::filesystem::path& path,
   for (const MeshMeasurements& m : all) {
     if (!m.error.empty()) continue;
     const bool ours = m.ours_error.empty() && m.ours_bytes > 0;
-    md << "| " << m.name << " | " << (m.draco_decode_vps > 0 ? fmt("%.2f", m.draco_decode_vps / 1e6) : "n/a")
-       << " | " << (ours ? fmt("%.3f", m.ours_encode_vps / 1e6) : "n/a") << " | "
+    md << "| " << m.name << " | "
+       << (m.draco_decode_vps > 0 ? fmt("%.2f", m.draco_decode_vps / 1e6) : "n/a") << " | "
+       << (ours ? fmt("%.3f", m.ours_encode_vps / 1e6) : "n/a") << " | "
        << (ours ? fmt("%.2f", m.ours_decode_vps / 1e6) : "n/a") << " | "
        << (ours ? fmt_ratio(m.ours_decode_vps, m.draco_decode_vps) : "n/a") << " | "
        << (ours ? fmt("%.1f %%", 100.0 * m.ours_vertices_at_ratio20 / m.vertices) : "n/a") << " | "
-       << (m.plain_bytes ? fmt("%.1f %%", 100.0 * m.plain_vertices_at_ratio20 / m.vertices) : "n/a") << " | "
-       << (ours ? (m.ours_counts_match ? "yes" : "**no**") : "n/a") << " |\n";
+       << (m.plain_bytes ? fmt("%.1f %%", 100.0 * m.plain_vertices_at_ratio20 / m.vertices) : "n/a")
+       << " | " << (ours ? (m.ours_counts_match ? "yes" : "**no**") : "n/a") << " |\n";
     if (ours && m.draco_decode_vps > 0) rdec.push_back(m.ours_decode_vps / m.draco_decode_vps);
     if (ours && m.vertices > 0) share20.push_back(double(m.ours_vertices_at_ratio20) / m.vertices);
-    if (m.plain_bytes && m.vertices > 0) share20_plain.push_back(double(m.plain_vertices_at_ratio20) / m.vertices);
+    if (m.plain_bytes && m.vertices > 0)
+      share20_plain.push_back(double(m.plain_vertices_at_ratio20) / m.vertices);
   }
 
   // Rate-distortion at the chain points.
@@ -170,33 +184,44 @@ inline void write_markdown(const std::filesystem::path& path,
      << "The chain: `meshopt_simplify` to 1/64, 1/16, 1/4 of the indices (no error limit) "
         "and the full mesh, each Draco-coded (12 bits, level 7); a client downloads them in "
         "turn, so bytes are cumulative. Ours and issue I's order: the largest record boundary "
-        "within the same bytes, decoded by `IncrementalDecoder`. Distances: `surface_distance` to the "
+        "within the same bytes, decoded by `IncrementalDecoder`. Distances: `surface_distance` to "
+        "the "
         "cleaned original ("
      << s.samples
      << " area samples per direction plus every vertex and edge midpoint), relative RMS / "
-        "relative Hausdorff (over the original's bounding-box diagonal). Ratio < 1: closer than the "
-        "chain at equal bytes (issue 3 wants < 1, issue 5 wants <= 0.5). Where our header, index and "
-        "base alone exceed the chain's bytes (*base > budget*) we have no mesh within the budget: the "
-        "point is *lost*, counted as infinitely far in the medians (the table still shows the base's "
+        "relative Hausdorff (over the original's bounding-box diagonal). Ratio < 1: closer than "
+        "the "
+        "chain at equal bytes (issue 3 wants < 1, issue 5 wants <= 0.5). Where our header, index "
+        "and "
+        "base alone exceed the chain's bytes (*base > budget*) we have no mesh within the budget: "
+        "the "
+        "point is *lost*, counted as infinitely far in the medians (the table still shows the "
+        "base's "
         "bytes and distance).\n\n"
-     << "| mesh | chain point | bytes | chain RMS / H | ours bytes | ours vertices | ours RMS / H | RMS "
+     << "| mesh | chain point | bytes | chain RMS / H | ours bytes | ours vertices | ours RMS / H "
+        "| RMS "
         "ours/chain | H ours/chain | RMS issue I order/chain |\n"
      << "|---|---|---:|---|---:|---:|---|---:|---:|---:|\n";
   int wins = 0, halves = 0, compared = 0;
   for (const MeshMeasurements& m : all) {
     if (!m.error.empty()) continue;
-    if (!m.rd_error.empty()) md << "| " << m.name << " | rate-distortion failed: " << m.rd_error << " |||||||||\n";
+    if (!m.rd_error.empty())
+      md << "| " << m.name << " | rate-distortion failed: " << m.rd_error << " |||||||||\n";
     for (size_t i = 0; i < m.at_chain.size(); ++i) {
       const ChainComparison& c = m.at_chain[i];
-      md << "| " << m.name << " | " << c.label << " | " << c.chain.bytes << " | " << point_cell(c.chain) << " | ";
-      const RdPoint* plain =
-          i < m.plain_at_chain.size() && m.plain_at_chain[i].ours ? &*m.plain_at_chain[i].ours : nullptr;
+      md << "| " << m.name << " | " << c.label << " | " << c.chain.bytes << " | "
+         << point_cell(c.chain) << " | ";
+      const RdPoint* plain = i < m.plain_at_chain.size() && m.plain_at_chain[i].ours
+                                 ? &*m.plain_at_chain[i].ours
+                                 : nullptr;
       const std::string plain_cell = plain ? fmt_ratio(plain->rms, c.chain.rms) : "n/a";
       if (c.ours) {
-        md << c.ours->bytes << (c.ours_over_budget ? " (base > budget)" : "") << " | " << c.ours->vertices
-           << " | " << point_cell(*c.ours) << " | "
-           << (c.ours_over_budget ? std::string("lost") : fmt_ratio(c.ours->rms, c.chain.rms)) << " | "
-           << (c.ours_over_budget ? std::string("lost") : fmt_ratio(c.ours->hausdorff, c.chain.hausdorff))
+        md << c.ours->bytes << (c.ours_over_budget ? " (base > budget)" : "") << " | "
+           << c.ours->vertices << " | " << point_cell(*c.ours) << " | "
+           << (c.ours_over_budget ? std::string("lost") : fmt_ratio(c.ours->rms, c.chain.rms))
+           << " | "
+           << (c.ours_over_budget ? std::string("lost")
+                                  : fmt_ratio(c.ours->hausdorff, c.chain.hausdorff))
            << " | " << (c.ours_over_budget ? std::string("lost") : plain_cell) << " |\n";
         if (c.chain.rms > 0 && i < 4) {
           const double rr = c.ours->rms / c.chain.rms;
@@ -205,8 +230,9 @@ inline void write_markdown(const std::filesystem::path& path,
           // base's distance (which would flatter us on small meshes).
           const double lost = std::numeric_limits<double>::infinity();
           rms_ratio[i].push_back(c.ours_over_budget ? lost : rr);
-          h_ratio[i].push_back(c.ours_over_budget ? lost
-                               : c.chain.hausdorff > 0 ? c.ours->hausdorff / c.chain.hausdorff : 0);
+          h_ratio[i].push_back(c.ours_over_budget      ? lost
+                               : c.chain.hausdorff > 0 ? c.ours->hausdorff / c.chain.hausdorff
+                                                       : 0);
           if (plain) plain_ratio[i].push_back(c.ours_over_budget ? lost : plain->rms / c.chain.rms);
           if (i + 1 < m.at_chain.size()) {
             ++compared;
@@ -215,7 +241,8 @@ inline void write_markdown(const std::filesystem::path& path,
           }
         }
       } else {
-        md << "n/a | | ours: n/a" << (m.ours_error.empty() ? "" : " (" + m.ours_error + ")") << " | | | |\n";
+        md << "n/a | | ours: n/a" << (m.ours_error.empty() ? "" : " (" + m.ours_error + ")")
+           << " | | | |\n";
       }
     }
   }
@@ -237,12 +264,14 @@ inline void write_markdown(const std::filesystem::path& path,
     static const char* kLabels[4] = {"1/64", "1/16", "1/4", "full"};
     for (size_t i = 0; i < 4; ++i) {
       if (rms_ratio[i].empty()) continue;
-      md << "- at chain point " << kLabels[i] << ": RMS ours/chain **" << fmt("%.2f", median(rms_ratio[i]))
-         << "**, Hausdorff ours/chain " << fmt("%.2f", median(h_ratio[i])) << "; issue I's order RMS/chain "
-         << (plain_ratio[i].empty() ? std::string("n/a") : fmt("%.2f", median(plain_ratio[i]))) << "\n";
+      md << "- at chain point " << kLabels[i] << ": RMS ours/chain **"
+         << fmt("%.2f", median(rms_ratio[i])) << "**, Hausdorff ours/chain "
+         << fmt("%.2f", median(h_ratio[i])) << "; issue I's order RMS/chain "
+         << (plain_ratio[i].empty() ? std::string("n/a") : fmt("%.2f", median(plain_ratio[i])))
+         << "\n";
     }
-    md << "- chain points 1/64, 1/16, 1/4 where our RMS is lower at equal bytes: " << wins << " of " << compared
-       << "; at most half (issue 5's target): " << halves << " of " << compared << "\n";
+    md << "- chain points 1/64, 1/16, 1/4 where our RMS is lower at equal bytes: " << wins << " of "
+       << compared << "; at most half (issue 5's target): " << halves << " of " << compared << "\n";
   }
   md << "\nThe whole curves (" << s.curve_points
      << " log-spaced record boundaries per mesh and series, plus the chain budgets) are in "
@@ -257,13 +286,15 @@ inline void write_markdown(const std::filesystem::path& path,
   }
   bool notes = false;
   for (const MeshMeasurements& m : all) {
-    if (m.error.empty() && m.draco_error.empty() && m.ours_error.empty() && m.plain_error.empty()) continue;
+    if (m.error.empty() && m.draco_error.empty() && m.ours_error.empty() && m.plain_error.empty())
+      continue;
     if (!notes) md << "\nNotes:\n\n";
     notes = true;
     if (!m.error.empty()) md << "- " << m.name << ": import failed: " << m.error << "\n";
     if (!m.draco_error.empty()) md << "- " << m.name << ": Draco: " << m.draco_error << "\n";
     if (!m.ours_error.empty()) md << "- " << m.name << ": ours n/a: " << m.ours_error << "\n";
-    if (!m.plain_error.empty()) md << "- " << m.name << ": issue I order n/a: " << m.plain_error << "\n";
+    if (!m.plain_error.empty())
+      md << "- " << m.name << ": issue I order n/a: " << m.plain_error << "\n";
   }
 }
 

@@ -3,15 +3,15 @@
 // Header-only so each bench executable can include it.
 #pragma once
 
+#include <draco/compression/decode.h>
+#include <draco/compression/expert_encode.h>
+#include <draco/mesh/mesh.h>
+
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <draco/compression/decode.h>
-#include <draco/compression/expert_encode.h>
-#include <draco/mesh/mesh.h>
 
 #include "common/base/result.h"
 #include "common/mesh/mesh.h"
@@ -34,8 +34,8 @@ inline std::unique_ptr<draco::Mesh> to_draco_mesh(const Mesh& mesh) {
   out->SetNumFaces(mesh.face_count());
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     const Triangle& t = mesh.triangles[f];
-    out->SetFace(draco::FaceIndex(f), {draco::PointIndex(t[0]), draco::PointIndex(t[1]),
-                                       draco::PointIndex(t[2])});
+    out->SetFace(draco::FaceIndex(f),
+                 {draco::PointIndex(t[0]), draco::PointIndex(t[1]), draco::PointIndex(t[2])});
   }
   return out;
 }

@@ -3,10 +3,10 @@
 // Header-only so each bench executable can include it.
 #pragma once
 
+#include <meshoptimizer.h>
+
 #include <cstdint>
 #include <vector>
-
-#include <meshoptimizer.h>
 
 #include "common/mesh/mesh.h"
 
@@ -35,7 +35,8 @@ inline Mesh simplify_lod(const Mesh& mesh, double fraction) {
     }
     v = remap[v];
   }
-  for (size_t i = 0; i < lod.size(); i += 3) out.triangles.push_back({lod[i], lod[i + 1], lod[i + 2]});
+  for (size_t i = 0; i < lod.size(); i += 3)
+    out.triangles.push_back({lod[i], lod[i + 1], lod[i + 2]});
   return out;
 }
 

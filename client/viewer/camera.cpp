@@ -33,9 +33,15 @@ Mat4 mat4_look_at(Vec3f eye, Vec3f target, Vec3f up) {
   Vec3f s = normalized(cross(f, up));
   Vec3f u = cross(s, f);
   Mat4 m{};
-  m[0] = s.x; m[4] = s.y; m[8] = s.z;
-  m[1] = u.x; m[5] = u.y; m[9] = u.z;
-  m[2] = -f.x; m[6] = -f.y; m[10] = -f.z;
+  m[0] = s.x;
+  m[4] = s.y;
+  m[8] = s.z;
+  m[1] = u.x;
+  m[5] = u.y;
+  m[9] = u.z;
+  m[2] = -f.x;
+  m[6] = -f.y;
+  m[10] = -f.z;
   m[12] = -dot(s, eye);
   m[13] = -dot(u, eye);
   m[14] = dot(f, eye);
@@ -77,8 +83,8 @@ void OrbitCamera::pan(float dx, float dy, float viewport_height) {
 }
 
 void OrbitCamera::zoom(float steps) {
-  distance = std::clamp(distance * std::pow(0.88f, steps), scene_radius * 0.02f,
-                        scene_radius * 50.0f);
+  distance =
+      std::clamp(distance * std::pow(0.88f, steps), scene_radius * 0.02f, scene_radius * 50.0f);
 }
 
 void OrbitCamera::frame(const Mesh& mesh, float aspect, float fill) {

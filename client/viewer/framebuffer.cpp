@@ -12,9 +12,9 @@ Result<OffscreenFramebuffer> OffscreenFramebuffer::create(const GlFunctions& gl,
   gl.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
   gl.GetIntegerv(GL_MAX_SAMPLES, &max_samples);
   if (width < 1 || height < 1 || width > max_size || height > max_size) {
-    return make_error(ErrorCode::kInvalidArgument,
-                      "snapshot size " + std::to_string(width) + "x" + std::to_string(height) +
-                          " is outside 1.." + std::to_string(max_size));
+    return make_error(ErrorCode::kInvalidArgument, "snapshot size " + std::to_string(width) + "x" +
+                                                       std::to_string(height) + " is outside 1.." +
+                                                       std::to_string(max_size));
   }
   samples = std::clamp(samples, 1, std::max(1, static_cast<int>(max_samples)));
   OffscreenFramebuffer fb;
@@ -45,8 +45,7 @@ Result<OffscreenFramebuffer> OffscreenFramebuffer::create(const GlFunctions& gl,
   gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, fb.depth_rb_);
   GLenum draw_status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
   gl.BindFramebuffer(GL_FRAMEBUFFER, fb.resolve_fbo_);
-  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
-                             fb.resolve_rb_);
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, fb.resolve_rb_);
   GLenum resolve_status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
   if (draw_status != GL_FRAMEBUFFER_COMPLETE || resolve_status != GL_FRAMEBUFFER_COMPLETE) {

@@ -80,8 +80,8 @@ class MeshRenderer {
   uint32_t vertex_count_ = 0, triangle_count_ = 0;
   bool has_distances_ = false;
   struct Uniforms {
-    GLint view = -1, projection = -1, viewport = -1, coloring = -1, wireframe = -1,
-          wire_width = -1, distance_max = -1, face_kind = -1;
+    GLint view = -1, projection = -1, viewport = -1, coloring = -1, wireframe = -1, wire_width = -1,
+          distance_max = -1, face_kind = -1;
   } uniforms_;
 };
 

@@ -11,9 +11,7 @@
 namespace meshstream::client {
 namespace {
 
-void* osmesa_proc(const char* name) {
-  return reinterpret_cast<void*>(OSMesaGetProcAddress(name));
-}
+void* osmesa_proc(const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }
 
 struct ContextDeleter {
   void operator()(osmesa_context* context) const { OSMesaDestroyContext(context); }
@@ -34,9 +32,16 @@ Result<RgbaImage> render_offscreen(const Mesh& mesh, const OffscreenRequest& req
   static std::mutex one_context_at_a_time;
   std::lock_guard lock(one_context_at_a_time);
 
-  const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24,
-                            OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                            OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3,
+  const int attributes[] = {OSMESA_FORMAT,
+                            OSMESA_RGBA,
+                            OSMESA_DEPTH_BITS,
+                            24,
+                            OSMESA_PROFILE,
+                            OSMESA_CORE_PROFILE,
+                            OSMESA_CONTEXT_MAJOR_VERSION,
+                            3,
+                            OSMESA_CONTEXT_MINOR_VERSION,
+                            3,
                             0};
   std::unique_ptr<osmesa_context, ContextDeleter> context(
       OSMesaCreateContextAttribs(attributes, nullptr));

@@ -14,7 +14,9 @@ struct RgbaImage {
   int height = 0;
   std::vector<uint8_t> rgba;  // width * height * 4 bytes, row 0 at the top
 
-  const uint8_t* pixel(int x, int y) const { return &rgba[(static_cast<size_t>(y) * width + x) * 4]; }
+  const uint8_t* pixel(int x, int y) const {
+    return &rgba[(static_cast<size_t>(y) * width + x) * 4];
+  }
 };
 
 // Writes an RGBA PNG. kInvalidArgument for an image whose buffer does not

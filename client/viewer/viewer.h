@@ -40,7 +40,8 @@ struct ViewerOptions {
 // may fill options the caller left at their defaults:
 // MESHSTREAM_VIEWER_CAPTURE=FILE.png (exit screenshot with the panel),
 // MESHSTREAM_VIEWER_COLORING=shaded|kinds|distance, MESHSTREAM_VIEWER_WIREFRAME=1.
-Status run_viewer(const ViewerOptions& options, LatestFrameMailbox& frames, StreamControls& controls);
+Status run_viewer(const ViewerOptions& options, LatestFrameMailbox& frames,
+                  StreamControls& controls);
 
 struct SnapshotOptions {
   int width = 1024;

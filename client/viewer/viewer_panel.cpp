@@ -1,8 +1,8 @@
 #include "client/viewer/viewer_panel.h"
 
-#include "imgui.h"
-
 #include <cstdio>
+
+#include "imgui.h"
 
 namespace meshstream::client {
 namespace {
@@ -19,7 +19,9 @@ std::string human_bytes(double bytes) {
   return text;
 }
 
-uint32_t vertices_of(const std::shared_ptr<const Mesh>& mesh) { return mesh ? mesh->vertex_count() : 0; }
+uint32_t vertices_of(const std::shared_ptr<const Mesh>& mesh) {
+  return mesh ? mesh->vertex_count() : 0;
+}
 uint32_t faces_of(const std::shared_ptr<const Mesh>& mesh) { return mesh ? mesh->face_count() : 0; }
 
 }  // namespace
@@ -91,7 +93,8 @@ PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const Dis
     }
     if (state.coloring == ColorMode::kDistance) {
       if (!state.distance_reference_known) {
-        ImGui::TextWrapped("the final mesh is not known yet: distances appear when the stream ends");
+        ImGui::TextWrapped(
+            "the final mesh is not known yet: distances appear when the stream ends");
       } else if (!state.distance_ready) {
         ImGui::TextUnformatted("computing distances...");
       } else {

@@ -16,7 +16,7 @@ struct PanelState {
   // display
   ColorMode coloring = ColorMode::kShaded;
   bool wireframe = false;
-  bool distance_auto = true;          // ramp maximum = 98th percentile of the distances
+  bool distance_auto = true;  // ramp maximum = 98th percentile of the distances
   float distance_p98 = 0;
   float distance_max_percent = 0.5f;  // else this % of the final mesh's diagonal
   float distance_max_found = 0;
@@ -35,7 +35,7 @@ struct PanelState {
   double upload_ms = 0;
   float fps = 0;
   bool screenshot_requested = false;
-  std::string message;  // last screenshot result
+  std::string message;      // last screenshot result
   float right_edge_px = 0;  // where the panel ends, in window pixels (for framing)
 };
 

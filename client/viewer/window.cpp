@@ -3,11 +3,9 @@
 // changes; decoding and ASA stay on the client's threads, distances to the
 // final mesh on a DistanceWorker.
 #define GLFW_INCLUDE_NONE
-#include <GLFW/glfw3.h>
+#include "client/viewer/window.h"
 
-#include "backends/imgui_impl_glfw.h"
-#include "backends/imgui_impl_opengl3.h"
-#include "imgui.h"
+#include <GLFW/glfw3.h>
 
 #include <algorithm>
 #include <chrono>
@@ -17,12 +15,14 @@
 #include <thread>
 #include <vector>
 
+#include "backends/imgui_impl_glfw.h"
+#include "backends/imgui_impl_opengl3.h"
 #include "client/viewer/frame_history.h"
 #include "client/viewer/mesh_renderer.h"
 #include "client/viewer/rgba_image.h"
 #include "client/viewer/vertex_distances.h"
 #include "client/viewer/viewer_panel.h"
-#include "client/viewer/window.h"
+#include "imgui.h"
 
 namespace meshstream::client {
 namespace {
@@ -86,8 +86,8 @@ class GlfwSession {
     glfw_last_error().clear();
     glfwSetErrorCallback(&on_glfw_error);
     if (!glfwInit()) {
-      return make_error(ErrorCode::kUnsupported, "viewer: no display to open a window on: " +
-                                                     glfw_last_error());
+      return make_error(ErrorCode::kUnsupported,
+                        "viewer: no display to open a window on: " + glfw_last_error());
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -164,10 +164,10 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   ViewerReport report;
 
   uint64_t seen = 0;
-  DisplayFrame latest;          // newest frame received (for the panel)
-  DisplayFrame shown;           // frame whose mesh is on the GPU
+  DisplayFrame latest;  // newest frame received (for the panel)
+  DisplayFrame shown;   // frame whose mesh is on the GPU
   bool has_shown = false, framed_once = false, want_frame = false;
-  uint64_t distance_tag = 0;    // identifies `shown` for the distance worker
+  uint64_t distance_tag = 0;  // identifies `shown` for the distance worker
   int screenshot_counter = 0;
   RgbaImage last_model_image;
   double last_x = 0, last_y = 0;
@@ -181,8 +181,8 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     if (!mesh) return;
     // A bad index would make the GPU read out of bounds: refuse, say why.
     if (Status valid = validate_arrays(*mesh); !valid) {
-      panel.message = "frame " + std::to_string(frame.sequence) +
-                      " not shown: " + valid.error().message;
+      panel.message =
+          "frame " + std::to_string(frame.sequence) + " not shown: " + valid.error().message;
       ++report.rejected_meshes;
       return;
     }
@@ -270,15 +270,32 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
       for (int key : input.keys) {
         ScriptedCommand c;
         switch (key) {
-          case GLFW_KEY_F: c.command = ViewerCommand::kFrameModel; break;
-          case GLFW_KEY_W: c.command = ViewerCommand::kToggleWireframe; break;
-          case GLFW_KEY_1: c.command = ViewerCommand::kColorShaded; break;
-          case GLFW_KEY_2: c.command = ViewerCommand::kColorAsaKinds; break;
-          case GLFW_KEY_3: c.command = ViewerCommand::kColorDistance; break;
-          case GLFW_KEY_SPACE: c.command = ViewerCommand::kTogglePause; break;
-          case GLFW_KEY_S: c.command = ViewerCommand::kScreenshot; break;
-          case GLFW_KEY_ESCAPE: c.command = ViewerCommand::kClose; break;
-          default: continue;
+          case GLFW_KEY_F:
+            c.command = ViewerCommand::kFrameModel;
+            break;
+          case GLFW_KEY_W:
+            c.command = ViewerCommand::kToggleWireframe;
+            break;
+          case GLFW_KEY_1:
+            c.command = ViewerCommand::kColorShaded;
+            break;
+          case GLFW_KEY_2:
+            c.command = ViewerCommand::kColorAsaKinds;
+            break;
+          case GLFW_KEY_3:
+            c.command = ViewerCommand::kColorDistance;
+            break;
+          case GLFW_KEY_SPACE:
+            c.command = ViewerCommand::kTogglePause;
+            break;
+          case GLFW_KEY_S:
+            c.command = ViewerCommand::kScreenshot;
+            break;
+          case GLFW_KEY_ESCAPE:
+            c.command = ViewerCommand::kClose;
+            break;
+          default:
+            continue;
         }
         commands.push_back(c);
       }
@@ -286,16 +303,30 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     activity |= !commands.empty();
     for (const ScriptedCommand& c : commands) {
       switch (c.command) {
-        case ViewerCommand::kFrameModel: want_frame = true; break;
-        case ViewerCommand::kToggleWireframe: panel.wireframe = !panel.wireframe; break;
-        case ViewerCommand::kColorShaded: panel.coloring = ColorMode::kShaded; break;
-        case ViewerCommand::kColorAsaKinds: panel.coloring = ColorMode::kAsaKinds; break;
-        case ViewerCommand::kColorDistance: panel.coloring = ColorMode::kDistance; break;
+        case ViewerCommand::kFrameModel:
+          want_frame = true;
+          break;
+        case ViewerCommand::kToggleWireframe:
+          panel.wireframe = !panel.wireframe;
+          break;
+        case ViewerCommand::kColorShaded:
+          panel.coloring = ColorMode::kShaded;
+          break;
+        case ViewerCommand::kColorAsaKinds:
+          panel.coloring = ColorMode::kAsaKinds;
+          break;
+        case ViewerCommand::kColorDistance:
+          panel.coloring = ColorMode::kDistance;
+          break;
         case ViewerCommand::kTogglePause:
           controls.paused() ? controls.resume() : controls.pause();
           break;
-        case ViewerCommand::kScreenshot: panel.screenshot_requested = true; break;
-        case ViewerCommand::kClose: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
+        case ViewerCommand::kScreenshot:
+          panel.screenshot_requested = true;
+          break;
+        case ViewerCommand::kClose:
+          glfwSetWindowShouldClose(window, GLFW_TRUE);
+          break;
         case ViewerCommand::kSetAsa:
           panel.asa_enabled = c.asa_enabled;
           panel.asa = c.asa;
@@ -309,9 +340,9 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
       // to that width, then slide it over by half the panel.
       const auto& mesh = shown.display ? shown.display : shown.decoded;
       float covered = std::clamp(panel.right_edge_px, 0.0f, 0.5f * static_cast<float>(window_w));
-      float free_aspect = window_h > 0 ? (static_cast<float>(window_w) - covered) /
-                                             static_cast<float>(window_h)
-                                       : aspect;
+      float free_aspect =
+          window_h > 0 ? (static_cast<float>(window_w) - covered) / static_cast<float>(window_h)
+                       : aspect;
       camera.frame(*mesh, std::min(aspect, free_aspect));
       camera.pan(covered / 2, 0, static_cast<float>(window_h));
       want_frame = false;
@@ -320,16 +351,15 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     // 3. The model, then (optionally) a screenshot of it, then the panel.
     style.coloring = panel.coloring;
     style.wireframe = panel.wireframe;
-    style.distance_max = panel.distance_auto
-                             ? std::max(panel.distance_p98, 1e-12f)
-                             : panel.distance_max_percent / 100.0f *
-                                   std::max(panel.reference_diagonal, 1e-12f);
+    style.distance_max = panel.distance_auto ? std::max(panel.distance_p98, 1e-12f)
+                                             : panel.distance_max_percent / 100.0f *
+                                                   std::max(panel.reference_diagonal, 1e-12f);
     gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
     renderer->draw(camera, fb_w, fb_h, style);
-    bool last_frame = (options.exit_after_frames != 0 &&
-                       report.frames_drawn + 1 >= options.exit_after_frames) ||
-                      (options.exit_after_records != 0 && has_shown &&
-                       shown.records_decoded >= options.exit_after_records);
+    bool last_frame =
+        (options.exit_after_frames != 0 && report.frames_drawn + 1 >= options.exit_after_frames) ||
+        (options.exit_after_records != 0 && has_shown &&
+         shown.records_decoded >= options.exit_after_records);
     if (panel.screenshot_requested && fb_w > 0 && fb_h > 0) {
       panel.screenshot_requested = false;
       std::string path = options.screenshot_dir + "/meshstream-screenshot-" +
@@ -352,8 +382,9 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
     panel.paused = controls.paused();
     panel.rate_bytes_per_s = controls.current_rate_bytes_per_s();
     panel.history_size = history.size();
-    PanelActions actions = draw_panel(panel, latest, shown, has_shown ? renderer->vertex_count() : 0,
-                                      has_shown ? renderer->triangle_count() : 0);
+    PanelActions actions =
+        draw_panel(panel, latest, shown, has_shown ? renderer->vertex_count() : 0,
+                   has_shown ? renderer->triangle_count() : 0);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (capture_exit && options.exit_screenshot_with_panel) {
@@ -414,7 +445,8 @@ Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,
     std::string coloring = env("MESHSTREAM_VIEWER_COLORING");
     options.initial_coloring = coloring == "kinds" ? 1 : coloring == "distance" ? 2 : 0;
   }
-  if (!options.initial_wireframe) options.initial_wireframe = env("MESHSTREAM_VIEWER_WIREFRAME") == "1";
+  if (!options.initial_wireframe)
+    options.initial_wireframe = env("MESHSTREAM_VIEWER_WIREFRAME") == "1";
   auto report = run_viewer_with_report(options, frames, controls);
   if (!report) return tl::unexpected(report.error());
   return {};

@@ -7,7 +7,6 @@
 
 namespace meshstream::asa::rules {
 
-
 inline Vec3f P(const LevelView& m, uint32_t v) { return m.positions[v]; }
 
 // Walks around vertex(x) counter-clockwise from corner x until an edge is a
@@ -81,7 +80,8 @@ inline uint32_t across_neighbor(const LevelView& m, uint32_t x) {
 
 // Extraordinary stencil of interior vertex(x), valence K, walking
 // counter-clockwise from vertex(next(x)) (the edge's other endpoint, j = 0).
-[[gnu::noinline]] inline Vec3f extraordinary_point(const LevelView& m, uint32_t x, uint32_t K, const ButterflyWeights& wt) {
+[[gnu::noinline]] inline Vec3f extraordinary_point(const LevelView& m, uint32_t x, uint32_t K,
+                                                   const ButterflyWeights& wt) {
   const float* s = wt.extraordinary(K);
   Vec3f sum = P(m, m.corner_vertex[x]) * s[K];
   for (uint32_t j = 0; j < K; ++j) {
@@ -91,7 +91,8 @@ inline uint32_t across_neighbor(const LevelView& m, uint32_t x) {
   return sum;
 }
 
-[[gnu::always_inline]] inline Vec3f zorin_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt) {
+[[gnu::always_inline]] inline Vec3f zorin_point(const LevelView& m, uint32_t c,
+                                                const ButterflyWeights& wt) {
   if (m.feature_edge[c]) return curve_point(m, c);
   const uint32_t n = next_corner(c);
   const uint32_t o = m.opposite[c];
@@ -118,17 +119,19 @@ inline Vec3f unit_face_normal(const LevelView& m, uint32_t f) {
   return normalized(cross(p1 - p0, p2 - p0));
 }
 
-
 // Projection placement of an interior edge's Butterfly point s (the thesis):
 // only its offset along the averaged normal of the edge's two faces is kept.
 inline Vec3f project_point(const LevelView& m, uint32_t c, Vec3f s) {
   const uint32_t o = m.opposite[c];
-  const Vec3f mid = (P(m, m.corner_vertex[next_corner(c)]) + P(m, m.corner_vertex[prev_corner(c)])) * 0.5f;
+  const Vec3f mid =
+      (P(m, m.corner_vertex[next_corner(c)]) + P(m, m.corner_vertex[prev_corner(c)])) * 0.5f;
   const Vec3f normal = normalized(unit_face_normal(m, c / 3) + unit_face_normal(m, o / 3));
   return mid + normal * dot(normal, s - mid);
 }
 
-[[gnu::always_inline]] inline Vec3f edge_point(const LevelView& m, uint32_t c, const ButterflyWeights& wt, EdgePlacement placement) {
+[[gnu::always_inline]] inline Vec3f edge_point(const LevelView& m, uint32_t c,
+                                               const ButterflyWeights& wt,
+                                               EdgePlacement placement) {
   const Vec3f s = zorin_point(m, c, wt);
   if (placement == EdgePlacement::kZorin || m.feature_edge[c]) return s;
   return project_point(m, c, s);

@@ -59,7 +59,8 @@ void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vert
   if (seen >> 63 & 1) {
     for (uint32_t v = 0; v < vertex_count; ++v) {
       const uint32_t K = valence[v];
-      if (vertex_features[v] == 0 && K >= 63 && (K >= offset_.size() || offset_[K] == kNone)) add(K);
+      if (vertex_features[v] == 0 && K >= 63 && (K >= offset_.size() || offset_[K] == kNone))
+        add(K);
     }
   }
 }
@@ -68,12 +69,13 @@ void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vert
                                     const std::vector<uint32_t>& list) {
   for (const uint32_t v : list) {
     const uint32_t K = valence[v];
-    if (vertex_features[v] == 0 && K >= 3 && K != 6 && (K >= offset_.size() || offset_[K] == kNone)) add(K);
+    if (vertex_features[v] == 0 && K >= 3 && K != 6 && (K >= offset_.size() || offset_[K] == kNone))
+      add(K);
   }
 }
 
-void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t first,
-                                    uint32_t count) {
+void ButterflyWeights::add_valences(const uint32_t* valence, const uint8_t* vertex_features,
+                                    uint32_t first, uint32_t count) {
   add_valences(valence + first, vertex_features + first, count);
 }
 

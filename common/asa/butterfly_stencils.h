@@ -23,9 +23,11 @@ class ButterflyWeights {
   // O(V) plus O(K) per new valence.
   void add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t vertex_count);
   // Same for the listed vertices only. O(list) plus O(K) per new valence.
-  void add_valences(const uint32_t* valence, const uint8_t* vertex_features, const std::vector<uint32_t>& list);
+  void add_valences(const uint32_t* valence, const uint8_t* vertex_features,
+                    const std::vector<uint32_t>& list);
   // Same for vertices first .. first + count - 1.
-  void add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t first, uint32_t count);
+  void add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t first,
+                    uint32_t count);
   void add(uint32_t K);
 
   float tension() const { return tension_; }

@@ -11,11 +11,11 @@ namespace meshstream::asa {
 
 // What the split step does with each face of the level.
 enum FaceAction : uint8_t {
-  kKeep = 0,     // copied unchanged
-  kBisect = 1,   // exactly one edge split: two green halves
-  kRed = 2,      // all three edges split: four triangles
-  kOpened = 3,   // a green half whose pair is merged back into its parent,
-                 // which is split 1-to-4 (both halves carry this action)
+  kKeep = 0,    // copied unchanged
+  kBisect = 1,  // exactly one edge split: two green halves
+  kRed = 2,     // all three edges split: four triangles
+  kOpened = 3,  // a green half whose pair is merged back into its parent,
+                // which is split 1-to-4 (both halves carry this action)
 };
 
 struct ClosureBuffers {

@@ -35,11 +35,12 @@ std::string edge_name(uint32_t a, uint32_t b) {
 }
 
 Status same_direction_error(uint32_t v, uint32_t to, uint32_t face_a, const std::string& face_b) {
-  return make_error(ErrorCode::kNonManifold,
-                    edge_name(v, to) +
-                        " is used twice in the same direction (more than two faces, or inconsistent "
-                        "orientation) by faces " +
-                        std::to_string(face_a) + " and " + face_b);
+  return make_error(
+      ErrorCode::kNonManifold,
+      edge_name(v, to) +
+          " is used twice in the same direction (more than two faces, or inconsistent "
+          "orientation) by faces " +
+          std::to_string(face_a) + " and " + face_b);
 }
 
 // Bit j set when third[j] == x, for j < n <= 64 (entries up to the next
@@ -50,7 +51,8 @@ inline uint64_t match_mask(const uint32_t* third, uint32_t n, uint32_t x) {
   const __m128i key = _mm_set1_epi32(static_cast<int>(x));
   for (uint32_t j = 0; j < n; j += 4) {
     const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(third + j));
-    const uint32_t bits = static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(h, key))));
+    const uint32_t bits =
+        static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(h, key))));
     mask |= static_cast<uint64_t>(bits) << j;
   }
 #else
@@ -64,9 +66,11 @@ inline uint64_t match_mask(const uint32_t* third, uint32_t n, uint32_t x) {
 Status fan_error(uint32_t v, const uint32_t* to, const uint32_t* corner, uint32_t n) {
   for (uint32_t i = 0; i < n; ++i)
     for (uint32_t j = i + 1; j < n; ++j)
-      if (to[i] == to[j]) return same_direction_error(v, to[i], corner[i] / 3, std::to_string(corner[j] / 3));
-  return make_error(ErrorCode::kNonManifold,
-                    "vertex " + std::to_string(v) + " joins more than one fan of faces (non-manifold vertex)");
+      if (to[i] == to[j])
+        return same_direction_error(v, to[i], corner[i] / 3, std::to_string(corner[j] / 3));
+  return make_error(
+      ErrorCode::kNonManifold,
+      "vertex " + std::to_string(v) + " joins more than one fan of faces (non-manifold vertex)");
 }
 
 // Outcome of matching one small bucket (errors are built off the hot path).
@@ -77,8 +81,8 @@ enum MatchCode : uint32_t { kMatched = 0, kTooManyFaces = 1, kSameDirection = 2,
 // fan walk below is register-only. On error, *bad is the entry at fault.
 // Groups > 0: n <= 4 * Groups, the thirds are held in registers.
 template <bool Packed, uint32_t Groups>
-inline uint32_t match_small(const uint32_t* to, const uint32_t* third, const uint32_t* corner, uint32_t n,
-                            uint32_t* opposite, uint32_t* across, uint32_t* bad) {
+inline uint32_t match_small(const uint32_t* to, const uint32_t* third, const uint32_t* corner,
+                            uint32_t n, uint32_t* opposite, uint32_t* across, uint32_t* bad) {
   constexpr uint32_t kEnd = Packed ? 15 : kSmallFan;
   uint8_t succ[Packed ? 1 : kSmallFan];
   uint64_t packed = ~uint64_t{0};
@@ -87,7 +91,8 @@ inline uint32_t match_small(const uint32_t* to, const uint32_t* third, const uin
 #if defined(__SSE2__)
   __m128i held[Groups > 0 ? Groups : 1];
   if constexpr (Groups > 0) {
-    for (uint32_t g = 0; g < Groups; ++g) held[g] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(third + 4 * g));
+    for (uint32_t g = 0; g < Groups; ++g)
+      held[g] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(third + 4 * g));
   }
 #endif
   for (uint32_t i = 0; i < n; ++i) {
@@ -97,7 +102,9 @@ inline uint32_t match_small(const uint32_t* to, const uint32_t* third, const uin
       const __m128i key = _mm_set1_epi32(static_cast<int>(to[i]));
       uint32_t bits = 0;
       for (uint32_t g = 0; g < Groups; ++g) {
-        bits |= static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(held[g], key)))) << (4 * g);
+        bits |=
+            static_cast<uint32_t>(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(held[g], key))))
+            << (4 * g);
       }
       mask = bits & all;
     } else {
@@ -146,23 +153,26 @@ inline uint32_t match_small(const uint32_t* to, const uint32_t* third, const uin
 }
 
 // The error for a failed small bucket (cold).
-[[gnu::noinline, gnu::cold]] Status small_bucket_error(uint32_t code, uint32_t v, const uint32_t* to,
-                                                       const uint32_t* corner, uint32_t n, uint32_t bad) {
+[[gnu::noinline, gnu::cold]] Status small_bucket_error(uint32_t code, uint32_t v,
+                                                       const uint32_t* to, const uint32_t* corner,
+                                                       uint32_t n, uint32_t bad) {
   if (code == kTooManyFaces) {
     return make_error(ErrorCode::kNonManifold, edge_name(v, to[bad]) + " has more than two faces");
   }
-  if (code == kSameDirection) return same_direction_error(v, to[bad], corner[bad] / 3, "another face");
+  if (code == kSameDirection)
+    return same_direction_error(v, to[bad], corner[bad] / 3, "another face");
   return fan_error(v, to, corner, n);
 }
 
 // One bucket of more than kSmallFan entries: sorted by third (the three
 // arrays permuted together), matched by binary search.
-Status match_large(uint32_t v, uint32_t* to, uint32_t* third, uint32_t* corner, uint32_t n, uint32_t* opposite,
-                   uint32_t* across, CornerTableScratch& s) {
+Status match_large(uint32_t v, uint32_t* to, uint32_t* third, uint32_t* corner, uint32_t n,
+                   uint32_t* opposite, uint32_t* across, CornerTableScratch& s) {
   std::vector<uint32_t>& order = s.order;
   order.resize(n);
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return third[a] < third[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return third[a] < third[b]; });
   std::vector<uint32_t>& tmp = s.permuted;
   tmp.resize(3 * static_cast<size_t>(n));
   for (uint32_t k = 0; k < n; ++k) {
@@ -223,8 +233,8 @@ Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, Corner
   return build_opposites(mesh, opposite, across, s);
 }
 
-Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, std::vector<uint32_t>& across_out,
-                       CornerTableScratch& s) {
+Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite,
+                       std::vector<uint32_t>& across_out, CornerTableScratch& s) {
   const uint32_t V = mesh.vertex_count(), corners = 3 * mesh.face_count();
   const uint32_t* cv = corners ? mesh.triangles.front().data() : nullptr;
   s.offset.assign(static_cast<size_t>(V) + 1, 0);
@@ -259,11 +269,16 @@ Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite, std::v
       uint32_t bad = 0;
       const uint32_t *t = to + begin, *h = third + begin, *k = corner + begin;
       uint32_t code;
-      if (n <= 4) code = match_small<true, 1>(t, h, k, n, opp, across, &bad);
-      else if (n <= 8) code = match_small<true, 2>(t, h, k, n, opp, across, &bad);
-      else if (n <= 12) code = match_small<true, 3>(t, h, k, n, opp, across, &bad);
-      else if (n < 16) code = match_small<true, 4>(t, h, k, n, opp, across, &bad);
-      else code = match_small<false, 0>(t, h, k, n, opp, across, &bad);
+      if (n <= 4)
+        code = match_small<true, 1>(t, h, k, n, opp, across, &bad);
+      else if (n <= 8)
+        code = match_small<true, 2>(t, h, k, n, opp, across, &bad);
+      else if (n <= 12)
+        code = match_small<true, 3>(t, h, k, n, opp, across, &bad);
+      else if (n < 16)
+        code = match_small<true, 4>(t, h, k, n, opp, across, &bad);
+      else
+        code = match_small<false, 0>(t, h, k, n, opp, across, &bad);
       if (code != kMatched) return small_bucket_error(code, v, to + begin, corner + begin, n, bad);
     } else {
       Status ok = match_large(v, to + begin, third + begin, corner + begin, n, opp, across, s);

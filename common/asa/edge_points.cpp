@@ -42,8 +42,9 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
 // together, term by term: each sum still adds its terms in the order of
 // rules::extraordinary_point (same bits), but the K independent sums
 // vectorize.
-[[gnu::noinline]] void centre_points(const LevelView& m, const uint32_t* edge_vertex, uint32_t first_new,
-                                     const ButterflyWeights& wt, Vec3f* pos, EdgePointScratch& s) {
+[[gnu::noinline]] void centre_points(const LevelView& m, const uint32_t* edge_vertex,
+                                     uint32_t first_new, const ButterflyWeights& wt, Vec3f* pos,
+                                     EdgePointScratch& s) {
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
   // Fans either come from the cache (a uniform child level: no walking) or
@@ -176,13 +177,14 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
   }
 }
 
-
 // Pass 1 for one edge named by corner c with new vertex id: curve and
 // regular stencils are written; an edge at an extraordinary vertex is noted
 // for its centre(s).
-[[gnu::always_inline]] inline void first_pass_edge(const LevelView& m, uint32_t c, uint32_t id, bool irregular_a,
-                                                   bool irregular_b, const uint32_t* across, float w, bool project,
-                                                   uint32_t first_new, Vec3f* pos, EdgePointScratch& s) {
+[[gnu::always_inline]] inline void first_pass_edge(const LevelView& m, uint32_t c, uint32_t id,
+                                                   bool irregular_a, bool irregular_b,
+                                                   const uint32_t* across, float w, bool project,
+                                                   uint32_t first_new, Vec3f* pos,
+                                                   EdgePointScratch& s) {
   const uint32_t* cv = m.corner_vertex;
   const uint8_t* fe = m.feature_edge;
   if (fe[c]) {
@@ -275,8 +277,8 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
       const uint32_t id = edge_vertex[c];
       const uint32_t o = opp[c];
       if (id == kNone || (o != kNone && o < c)) continue;
-      first_pass_edge(m, c, id, irregular[cv[next_corner(c)]], irregular[cv[prev_corner(c)]], across, w, project,
-                      first_new, pos, s);
+      first_pass_edge(m, c, id, irregular[cv[next_corner(c)]], irregular[cv[prev_corner(c)]],
+                      across, w, project, first_new, pos, s);
     }
   }
 

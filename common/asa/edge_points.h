@@ -23,8 +23,8 @@ struct EdgePointScratch {
   std::vector<uint32_t> across;         // only when the level has none
   std::vector<uint8_t> irregular;       // per vertex: an extraordinary centre
   std::vector<uint8_t> arrivals;        // per new vertex (minus first_new): stencils still expected
-  std::vector<float> ring;              // one centre's one-ring (twice over) and sums, per coordinate
-  std::vector<uint32_t> ring_ids;       // new vertex on each ring edge (or kNone)
+  std::vector<float> ring;         // one centre's one-ring (twice over) and sums, per coordinate
+  std::vector<uint32_t> ring_ids;  // new vertex on each ring edge (or kNone)
   // Fans of the extraordinary centres (corners in walk order), recorded by a
   // walk; after a uniform split the caller maps them to the child level
   // (map_fans_to_uniform_children) and the next call reads them instead of
@@ -50,7 +50,8 @@ struct EdgePointScratch {
 void map_fans_to_uniform_children(EdgePointScratch& scratch);
 
 void compute_edge_points(const LevelView& mesh, const uint32_t* edge_vertex, uint32_t first_new,
-                         uint32_t new_count, const ButterflyWeights& weights, EdgePlacement placement,
-                         Vec3f* pos, EdgePointScratch& scratch, const std::vector<uint32_t>* naming = nullptr);
+                         uint32_t new_count, const ButterflyWeights& weights,
+                         EdgePlacement placement, Vec3f* pos, EdgePointScratch& scratch,
+                         const std::vector<uint32_t>* naming = nullptr);
 
 }  // namespace meshstream::asa

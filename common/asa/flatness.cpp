@@ -20,8 +20,8 @@ void compute_face_normals(const LevelView& m, std::vector<Vec3f>& normals) {
   }
 }
 
-uint32_t tag_feature_edges(const LevelView& m, float crease_degrees, const std::vector<Vec3f>& normals,
-                           std::vector<uint8_t>& feature_edge) {
+uint32_t tag_feature_edges(const LevelView& m, float crease_degrees,
+                           const std::vector<Vec3f>& normals, std::vector<uint8_t>& feature_edge) {
   const uint32_t corners = 3 * m.face_count;
   feature_edge.resize(corners);
   uint32_t tagged = 0;
@@ -94,7 +94,8 @@ uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, flo
 }
 
 uint32_t mark_targets_near_fresh(const LevelView& m, const std::vector<Vec3f>& normals,
-                                 const std::vector<uint8_t>& fresh, float t, std::vector<uint8_t>& target) {
+                                 const std::vector<uint8_t>& fresh, float t,
+                                 std::vector<uint8_t>& target) {
   target.assign(m.face_count, 0);
   uint32_t count = 0;
   for (uint32_t f = 0; f < m.face_count; ++f) {

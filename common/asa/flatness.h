@@ -17,8 +17,8 @@ void compute_face_normals(const LevelView& mesh, std::vector<Vec3f>& normals);
 // <= 0 tags boundaries only. Both corners of an edge get the same flag.
 // Needs mesh.corner_vertex, opposite and positions. Returns the number of
 // corners tagged. O(F).
-uint32_t tag_feature_edges(const LevelView& mesh, float crease_degrees, const std::vector<Vec3f>& normals,
-                       std::vector<uint8_t>& feature_edge);
+uint32_t tag_feature_edges(const LevelView& mesh, float crease_degrees,
+                           const std::vector<Vec3f>& normals, std::vector<uint8_t>& feature_edge);
 
 // Per vertex: the number of feature edges at it (saturating at 255). O(F).
 void count_vertex_features(const LevelView& mesh, std::vector<uint8_t>& vertex_features);
@@ -40,6 +40,7 @@ uint32_t mark_targets(const LevelView& mesh, const std::vector<Vec3f>& normals, 
 // mark_targets (the dot product is symmetric bit for bit). Returns the number
 // of targets. O(F) for the flags plus O(fresh faces).
 uint32_t mark_targets_near_fresh(const LevelView& mesh, const std::vector<Vec3f>& normals,
-                                 const std::vector<uint8_t>& fresh, float t, std::vector<uint8_t>& target);
+                                 const std::vector<uint8_t>& fresh, float t,
+                                 std::vector<uint8_t>& target);
 
 }  // namespace meshstream::asa

@@ -14,7 +14,8 @@ bool same_attribute_layout(const Mesh& a, const Mesh& b) {
          a.normals.empty() == b.normals.empty();
 }
 
-void compute_patch_starts(const std::vector<uint32_t>& source, uint32_t faces, std::vector<uint32_t>& start) {
+void compute_patch_starts(const std::vector<uint32_t>& source, uint32_t faces,
+                          std::vector<uint32_t>& start) {
   start.assign(static_cast<size_t>(faces) + 1, 0);
   for (uint32_t s : source) ++start[s + 1];
   for (uint32_t f = 0; f < faces; ++f) start[f + 1] += start[f];
@@ -27,7 +28,8 @@ bool same_bits(const T& a, const T& b) {
 
 }  // namespace
 
-IncrementalSubdivider::IncrementalSubdivider(const AsaOptions& options, const IncrementalOptions& incremental)
+IncrementalSubdivider::IncrementalSubdivider(const AsaOptions& options,
+                                             const IncrementalOptions& incremental)
     : options_(options), incremental_(incremental) {
   options_.track_source_faces = true;
 }
@@ -71,9 +73,10 @@ Status IncrementalSubdivider::update(const Mesh& input) {
   // 1. What changed, by index.
   changed_vertex_.assign(Vn, 0);
   for (uint32_t v = 0; v < Vn; ++v) {
-    bool changed = v >= Vo || !same_bits(input.positions[v], previous_.positions[v]) ||
-                   (!input.colors.empty() && !same_bits(input.colors[v], previous_.colors[v])) ||
-                   (!input.texcoords.empty() && !same_bits(input.texcoords[v], previous_.texcoords[v]));
+    bool changed =
+        v >= Vo || !same_bits(input.positions[v], previous_.positions[v]) ||
+        (!input.colors.empty() && !same_bits(input.colors[v], previous_.colors[v])) ||
+        (!input.texcoords.empty() && !same_bits(input.texcoords[v], previous_.texcoords[v]));
     changed_vertex_[v] = changed;
   }
   auto mark = [&](const Triangle& t) {

@@ -38,7 +38,8 @@ struct IncrementalStats {
 
 class IncrementalSubdivider {
  public:
-  explicit IncrementalSubdivider(const AsaOptions& options, const IncrementalOptions& incremental = {});
+  explicit IncrementalSubdivider(const AsaOptions& options,
+                                 const IncrementalOptions& incremental = {});
 
   // Brings result() up to date with `input`. Vertices and faces are compared
   // with the previous input by index: vertex i is unchanged when its position
@@ -64,14 +65,15 @@ class IncrementalSubdivider {
   IncrementalOptions incremental_;
   AsaWorkspace workspace_;
   bool has_previous_ = false;
-  Mesh previous_;                     // the previous input
+  Mesh previous_;                      // the previous input
   std::vector<uint32_t> patch_start_;  // per previous input face, into result_ faces (+1 sentinel)
   AsaResult result_;
   IncrementalStats stats_;
   // Scratch reused between updates.
   AsaResult region_result_, next_;
   Mesh region_;
-  std::vector<uint32_t> vertex_faces_offset_, vertex_faces_, local_vertex_, global_vertex_, region_faces_;
+  std::vector<uint32_t> vertex_faces_offset_, vertex_faces_, local_vertex_, global_vertex_,
+      region_faces_;
   std::vector<uint32_t> local_face_, region_patch_start_, seam_map_, new_id_prev_, new_id_region_;
   std::vector<uint8_t> changed_vertex_, dirty_face_, in_region_, vertex_mark_;
 };

@@ -39,11 +39,12 @@ struct LevelView {
   const Vec3f* positions = nullptr;
   const uint32_t* corner_vertex = nullptr;  // 3 per face
   const uint32_t* opposite = nullptr;       // 3 per face
-  const uint32_t* across = nullptr;         // per corner: vertex of the opposite corner (kNone on a boundary)
-  const uint8_t* feature_edge = nullptr;    // per corner: the faced edge is boundary or crease
-  const uint8_t* vertex_features = nullptr; // per vertex: feature edges at it (saturating)
-  const uint32_t* valence = nullptr;        // per vertex: faces around it (= valence if interior)
-  const uint8_t* green = nullptr;           // per face GreenKind, may be null (no greens)
+  const uint32_t* across =
+      nullptr;  // per corner: vertex of the opposite corner (kNone on a boundary)
+  const uint8_t* feature_edge = nullptr;     // per corner: the faced edge is boundary or crease
+  const uint8_t* vertex_features = nullptr;  // per vertex: feature edges at it (saturating)
+  const uint32_t* valence = nullptr;         // per vertex: faces around it (= valence if interior)
+  const uint8_t* green = nullptr;            // per face GreenKind, may be null (no greens)
   uint32_t vertex_count = 0;
   uint32_t face_count = 0;
 };

@@ -20,7 +20,7 @@ struct SplitInput {
   const Vec2f* texcoords = nullptr;  // per vertex, or null
   const ButterflyWeights* weights = nullptr;
   EdgePlacement placement = EdgePlacement::kZorin;
-  bool want_topology = true;  // fill opposite/feature/valence data for another level
+  bool want_topology = true;         // fill opposite/feature/valence data for another level
   const uint32_t* source = nullptr;  // per face: input face it descends from; null = untracked
   // Adaptive split with want_topology: the level's unit face normals; the
   // output then gets its own (out.normals, out.fresh). Null: none written.

@@ -175,14 +175,15 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   } else {
     out.texcoords.clear();
   }
-  compute_edge_points(m, s.edge_vertex.data(), V, E, *in.weights, in.placement, out.positions.data(), s.points,
-                      &s.naming);
+  compute_edge_points(m, s.edge_vertex.data(), V, E, *in.weights, in.placement,
+                      out.positions.data(), s.points, &s.naming);
   for (uint32_t k = 0; (colors || texcoords) && k < E; ++k) {
     const uint32_t c = s.naming[k], id = V + k;
     const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
     if (colors) {
       const Vec4f ca = in.colors[a], cb = in.colors[b];
-      out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f, (ca.w + cb.w) * 0.5f};
+      out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f,
+                        (ca.w + cb.w) * 0.5f};
     }
     if (texcoords) {
       const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
@@ -204,11 +205,19 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     const uint8_t a = action[f];
     if (topo) kept_base[f] = a == kKeep ? static_cast<uint32_t>(3 * total) : kNone;
     switch (a) {
-      case kKeep: total += 1; ++kept; break;
-      case kBisect: total += 2; break;
-      case kRed: total += 4; break;
+      case kKeep:
+        total += 1;
+        ++kept;
+        break;
+      case kBisect:
+        total += 2;
+        break;
+      case kRed:
+        total += 4;
+        break;
       case kOpened:
-        if (m.green[f] == kGreenFirst) total += 4 + (split[3 * f] ? 1 : 0) + (split[3 * f + 3] ? 1 : 0);
+        if (m.green[f] == kGreenFirst)
+          total += 4 + (split[3 * f] ? 1 : 0) + (split[3 * f + 3] ? 1 : 0);
         break;
     }
   }
@@ -245,13 +254,17 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
       while (end < F && action[end] == kKeep) ++end;
       const uint32_t n = end - f, g = e.count;
       e.count += n;
-      std::memcpy(e.tri + 3 * static_cast<size_t>(g), cv + 3 * static_cast<size_t>(f), 3 * sizeof(uint32_t) * n);
+      std::memcpy(e.tri + 3 * static_cast<size_t>(g), cv + 3 * static_cast<size_t>(f),
+                  3 * sizeof(uint32_t) * n);
       if (face_kind) std::memset(face_kind->data() + g, static_cast<int>(FaceKind::kUntouched), n);
       if (e.track_source) std::memcpy(out.source.data() + g, in.source + f, sizeof(uint32_t) * n);
       if (topo) {
-        std::memcpy(out.feature_edge.data() + 3 * static_cast<size_t>(g), fe + 3 * static_cast<size_t>(f), 3 * n);
-        if (m.green) std::memcpy(out.green.data() + g, m.green + f, n);
-        else std::memset(out.green.data() + g, kNotGreen, n);
+        std::memcpy(out.feature_edge.data() + 3 * static_cast<size_t>(g),
+                    fe + 3 * static_cast<size_t>(f), 3 * n);
+        if (m.green)
+          std::memcpy(out.green.data() + g, m.green + f, n);
+        else
+          std::memset(out.green.data() + g, kNotGreen, n);
       }
       if (e.normals) {
         std::memcpy(out.normals.data() + g, in.normals + f, sizeof(Vec3f) * n);
@@ -274,7 +287,8 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
       case kKeep:
         break;  // handled above
       case kRed: {
-        const uint32_t mid[3] = {s.edge_vertex[3 * f], s.edge_vertex[3 * f + 1], s.edge_vertex[3 * f + 2]};
+        const uint32_t mid[3] = {s.edge_vertex[3 * f], s.edge_vertex[3 * f + 1],
+                                 s.edge_vertex[3 * f + 2]};
         const uint32_t base = e.emit(v[0], mid[2], mid[1], kNotGreen, FaceKind::kTarget);
         e.emit(v[1], mid[0], mid[2], kNotGreen, FaceKind::kTarget);
         e.emit(v[2], mid[1], mid[0], kNotGreen, FaceKind::kTarget);

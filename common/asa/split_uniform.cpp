@@ -69,7 +69,8 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
       if (colors) {
         const Vec4f ca = in.colors[a], cb = in.colors[b];
-        out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f, (ca.w + cb.w) * 0.5f};
+        out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f,
+                          (ca.w + cb.w) * 0.5f};
       }
       if (texcoords) {
         const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
@@ -91,10 +92,18 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
     const uint32_t v0 = cv[3 * f], v1 = cv[3 * f + 1], v2 = cv[3 * f + 2];
     const uint32_t m0 = edge_of[3 * f], m1 = edge_of[3 * f + 1], m2 = edge_of[3 * f + 2];
     uint32_t* q = t + 12 * static_cast<size_t>(f);
-    q[0] = v0; q[1] = m2; q[2] = m1;
-    q[3] = v1; q[4] = m0; q[5] = m2;
-    q[6] = v2; q[7] = m1; q[8] = m0;
-    q[9] = m0; q[10] = m1; q[11] = m2;
+    q[0] = v0;
+    q[1] = m2;
+    q[2] = m1;
+    q[3] = v1;
+    q[4] = m0;
+    q[5] = m2;
+    q[6] = v2;
+    q[7] = m1;
+    q[8] = m0;
+    q[9] = m0;
+    q[10] = m1;
+    q[11] = m2;
   }
   if (face_kind) face_kind->assign(4 * static_cast<size_t>(F), FaceKind::kTarget);
   if (in.source) {

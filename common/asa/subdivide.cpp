@@ -25,7 +25,7 @@ struct AsaWorkspace::Buffers {
   asa::CornerTableScratch corner_scratch;
   std::vector<Vec3f> normals;
   std::vector<uint8_t> target;
-  std::vector<uint8_t> fresh;  // per face of the current level: made by the last split
+  std::vector<uint8_t> fresh;      // per face of the current level: made by the last split
   std::vector<uint32_t> identity;  // level-0 source faces
   AsaStats stats;
 };
@@ -78,7 +78,9 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
 
   // Level 0: the caller's arrays plus our corner table and feature flags.
   asa::LevelMesh& base = ws.base;
-  if (auto built = asa::build_opposites(mesh, base.opposite, base.across, ws.corner_scratch); !built) return built;
+  if (auto built = asa::build_opposites(mesh, base.opposite, base.across, ws.corner_scratch);
+      !built)
+    return built;
   asa::LevelView view;
   view.positions = mesh.positions.data();
   view.corner_vertex = F ? mesh.triangles.front().data() : nullptr;
@@ -89,7 +91,8 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   // Normals: for crease tagging and flatness (the uniform scheme needs none).
   const bool need_normals = options.crease_degrees > 0 || !options.uniform;
   if (need_normals) asa::compute_face_normals(view, ws.normals);
-  const uint32_t tagged = asa::tag_feature_edges(view, options.crease_degrees, ws.normals, base.feature_edge);
+  const uint32_t tagged =
+      asa::tag_feature_edges(view, options.crease_degrees, ws.normals, base.feature_edge);
   view.feature_edge = base.feature_edge.data();
   if (tagged) {
     asa::count_vertex_features(view, base.vertex_features);
@@ -118,8 +121,10 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   if (options.levels == 0 || F == 0) {
     result.mesh = mesh;
     result.face_kind.assign(F, FaceKind::kUntouched);
-    if (options.track_source_faces) result.source_face = ws.identity;
-    else result.source_face.clear();
+    if (options.track_source_faces)
+      result.source_face = ws.identity;
+    else
+      result.source_face.clear();
     return {};
   }
 
@@ -138,16 +143,19 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     if (options.uniform) {
       asa::split_uniform(in, ws.scratch, out, kinds);
       ws.stats.targets.push_back(view.face_count);
-      ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) - view.vertex_count);
+      ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) -
+                                     view.vertex_count);
     } else {
       // Level 0 tests every edge; later levels only the edges of faces the
       // last split made (their normals came with the split), unless most
       // faces are new anyway.
-      const bool mostly_fresh = level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
+      const bool mostly_fresh =
+          level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
       const uint32_t targets =
           level == 0 || mostly_fresh
               ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
-              : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
+              : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness,
+                                             ws.target);
       if (targets == 0) {
         // Nothing bends: this and every later level would copy the mesh
         // unchanged (same normals, same verdicts). Stop here.
@@ -155,15 +163,23 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
         result.mesh.positions.assign(view.positions, view.positions + V);
         result.mesh.triangles.resize(F);
         if (F) std::memcpy(result.mesh.triangles.data(), view.corner_vertex, F * sizeof(Triangle));
-        if (colors) result.mesh.colors.assign(colors, colors + V);
-        else result.mesh.colors.clear();
-        if (texcoords) result.mesh.texcoords.assign(texcoords, texcoords + V);
-        else result.mesh.texcoords.clear();
+        if (colors)
+          result.mesh.colors.assign(colors, colors + V);
+        else
+          result.mesh.colors.clear();
+        if (texcoords)
+          result.mesh.texcoords.assign(texcoords, texcoords + V);
+        else
+          result.mesh.texcoords.clear();
         result.face_kind.assign(F, FaceKind::kUntouched);
-        if (source) result.source_face.assign(source, source + F);
-        else result.source_face.clear();
-        if (!mesh.normals.empty()) result.mesh.normals = compute_vertex_normals(result.mesh);
-        else result.mesh.normals.clear();
+        if (source)
+          result.source_face.assign(source, source + F);
+        else
+          result.source_face.clear();
+        if (!mesh.normals.empty())
+          result.mesh.normals = compute_vertex_normals(result.mesh);
+        else
+          result.mesh.normals.clear();
         for (int rest = level; rest < options.levels; ++rest) {
           ws.stats.targets.push_back(0);
           ws.stats.split_edges.push_back(0);
@@ -197,8 +213,10 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
       std::swap(result.mesh.triangles, out.triangles);
       std::swap(result.mesh.colors, out.colors);
       std::swap(result.mesh.texcoords, out.texcoords);
-      if (source) std::swap(result.source_face, out.source);
-      else result.source_face.clear();
+      if (source)
+        std::swap(result.source_face, out.source);
+      else
+        result.source_face.clear();
       if (!mesh.normals.empty()) {
         result.mesh.normals = compute_vertex_normals(result.mesh);
       } else {
@@ -211,7 +229,8 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
 
 Result<AsaResult> subdivide(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace) {
   AsaResult result;
-  if (auto ok = subdivide_into(mesh, options, workspace, result); !ok) return tl::unexpected(ok.error());
+  if (auto ok = subdivide_into(mesh, options, workspace, result); !ok)
+    return tl::unexpected(ok.error());
   return result;
 }
 

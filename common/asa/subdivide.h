@@ -55,11 +55,11 @@ enum class ButterflyRule {
 
 struct AsaOptions {
   int levels = 1;
-  float flatness = 0.85f;   // t: an interior edge is flat when t < N1.N2 <= 1
-  bool uniform = false;     // split every triangle (classic modified Butterfly)
+  float flatness = 0.85f;  // t: an interior edge is flat when t < N1.N2 <= 1
+  bool uniform = false;    // split every triangle (classic modified Butterfly)
   ButterflyRule rule = ButterflyRule::kZorin;
-  float tension = 0.0f;     // omega of the ten-point stencil
-  float crease_degrees = 0; // > 0: edges bending more than this stay sharp
+  float tension = 0.0f;             // omega of the ten-point stencil
+  float crease_degrees = 0;         // > 0: edges bending more than this stay sharp
   bool track_source_faces = false;  // fill AsaResult::source_face
 };
 

@@ -8,9 +8,8 @@
 #pragma once
 
 #include <string>
-#include <utility>
-
 #include <tl/expected.hpp>
+#include <utility>
 
 namespace meshstream {
 
@@ -51,15 +50,24 @@ inline tl::unexpected<Error> make_error(ErrorCode code, std::string message) {
 
 inline const char* to_string(ErrorCode code) {
   switch (code) {
-    case ErrorCode::kInvalidArgument: return "invalid argument";
-    case ErrorCode::kIo: return "i/o error";
-    case ErrorCode::kParse: return "parse error";
-    case ErrorCode::kInvalidMesh: return "invalid mesh";
-    case ErrorCode::kNonManifold: return "non-manifold mesh";
-    case ErrorCode::kCorrupt: return "corrupt data";
-    case ErrorCode::kTruncated: return "truncated data";
-    case ErrorCode::kUnsupported: return "unsupported";
-    case ErrorCode::kLimit: return "limit exceeded";
+    case ErrorCode::kInvalidArgument:
+      return "invalid argument";
+    case ErrorCode::kIo:
+      return "i/o error";
+    case ErrorCode::kParse:
+      return "parse error";
+    case ErrorCode::kInvalidMesh:
+      return "invalid mesh";
+    case ErrorCode::kNonManifold:
+      return "non-manifold mesh";
+    case ErrorCode::kCorrupt:
+      return "corrupt data";
+    case ErrorCode::kTruncated:
+      return "truncated data";
+    case ErrorCode::kUnsupported:
+      return "unsupported";
+    case ErrorCode::kLimit:
+      return "limit exceeded";
   }
   return "unknown error";
 }

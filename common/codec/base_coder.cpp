@@ -1,13 +1,13 @@
 // Base mesh coders: see base_coder.h.
 #include "common/codec/base_coder.h"
 
-#include <cstring>
-#include <optional>
-#include <string>
-
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/mesh/mesh.h>
+
+#include <cstring>
+#include <optional>
+#include <string>
 
 #include "common/codec/range_coder.h"
 
@@ -21,24 +21,26 @@ uint32_t get_u32(const uint8_t* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
 }
 
-Status check_ranges(const BaseMesh& base, uint32_t vertex_count, uint32_t face_count, int quant_bits,
-                    const char* coder) {
+Status check_ranges(const BaseMesh& base, uint32_t vertex_count, uint32_t face_count,
+                    int quant_bits, const char* coder) {
   if (base.positions.size() != vertex_count || base.faces.size() != face_count) {
     return make_error(ErrorCode::kCorrupt,
-                      std::string(coder) + " base mesh has " + std::to_string(base.positions.size()) +
-                          " vertices and " + std::to_string(base.faces.size()) +
-                          " faces, the header says " + std::to_string(vertex_count) + " and " +
-                          std::to_string(face_count));
+                      std::string(coder) + " base mesh has " +
+                          std::to_string(base.positions.size()) + " vertices and " +
+                          std::to_string(base.faces.size()) + " faces, the header says " +
+                          std::to_string(vertex_count) + " and " + std::to_string(face_count));
   }
   const int32_t max = (int32_t(1) << quant_bits) - 1;
   for (const Vec3i& p : base.positions)
     for (int a = 0; a < 3; ++a)
       if (p[a] < 0 || p[a] > max)
-        return make_error(ErrorCode::kCorrupt, std::string(coder) + " base vertex outside the grid");
+        return make_error(ErrorCode::kCorrupt,
+                          std::string(coder) + " base vertex outside the grid");
   for (const Triangle& t : base.faces)
     for (uint32_t i : t)
       if (i >= vertex_count)
-        return make_error(ErrorCode::kCorrupt, std::string(coder) + " base face index out of range");
+        return make_error(ErrorCode::kCorrupt,
+                          std::string(coder) + " base face index out of range");
   return {};
 }
 
@@ -71,7 +73,8 @@ Status check_draco_header(std::span<const uint8_t> in, uint32_t vertex_count, ui
   };
   if (in.size() < 13 || std::memcmp(in.data(), "DRACO", 5) != 0) return refuse("no Draco header");
   if (in[5] != 2 || in[6] != 2) {
-    return refuse("bitstream version " + std::to_string(in[5]) + "." + std::to_string(in[6]) + " (2.2 expected)");
+    return refuse("bitstream version " + std::to_string(in[5]) + "." + std::to_string(in[6]) +
+                  " (2.2 expected)");
   }
   if (in[7] != 1 || in[8] != 1) return refuse("not an edgebreaker-coded triangle mesh");
   if (in[9] != 0 || in[10] != 0) return refuse("header flags set (metadata is never written)");
@@ -82,9 +85,9 @@ Status check_draco_header(std::span<const uint8_t> in, uint32_t vertex_count, ui
     return refuse("connectivity counts cut short");
   }
   if (vertices != vertex_count || faces != face_count) {
-    return refuse("it declares " + std::to_string(vertices) + " vertices and " + std::to_string(faces) +
-                  " faces, the record index " + std::to_string(vertex_count) + " and " +
-                  std::to_string(face_count));
+    return refuse("it declares " + std::to_string(vertices) + " vertices and " +
+                  std::to_string(faces) + " faces, the record index " +
+                  std::to_string(vertex_count) + " and " + std::to_string(face_count));
   }
   if (pos >= in.size()) return refuse("connectivity counts cut short");
   ++pos;  // attribute data count
@@ -156,7 +159,8 @@ Result<BaseMesh> decode_base_own(std::span<const uint8_t> bytes, uint32_t vertex
     const int64_t b = a + m.other.decode(dec);
     const int64_t c = a + m.other.decode(dec);
     for (int64_t i : {a, b, c})
-      if (i < 0 || i >= int64_t(nv)) return make_error(ErrorCode::kCorrupt, "base face index out of range");
+      if (i < 0 || i >= int64_t(nv))
+        return make_error(ErrorCode::kCorrupt, "base face index out of range");
     t = {uint32_t(a), uint32_t(b), uint32_t(c)};
     prev_first = a;
   }
@@ -170,7 +174,8 @@ Result<std::vector<uint8_t>> encode_base_draco(const BaseMesh& base) {
   draco::Mesh mesh;
   mesh.set_num_points(static_cast<uint32_t>(base.positions.size()));
   draco::GeometryAttribute ga;
-  ga.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_INT32, false, sizeof(int32_t) * 3, 0);
+  ga.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_INT32, false,
+          sizeof(int32_t) * 3, 0);
   const int att = mesh.AddAttribute(ga, true, static_cast<uint32_t>(base.positions.size()));
   draco::PointAttribute* pa = mesh.attribute(att);
   for (uint32_t v = 0; v < base.positions.size(); ++v) {
@@ -189,15 +194,16 @@ Result<std::vector<uint8_t>> encode_base_draco(const BaseMesh& base) {
   draco::EncoderBuffer buffer;
   const draco::Status status = encoder.EncodeMeshToBuffer(mesh, &buffer);
   if (!status.ok()) {
-    return make_error(ErrorCode::kUnsupported, std::string("Draco refused the base mesh: ") +
-                                                   status.error_msg_string());
+    return make_error(ErrorCode::kUnsupported,
+                      std::string("Draco refused the base mesh: ") + status.error_msg_string());
   }
   return std::vector<uint8_t>(buffer.data(), buffer.data() + buffer.size());
 }
 
 Result<BaseMesh> decode_base_draco(std::span<const uint8_t> bytes, uint32_t vertex_count,
                                    uint32_t face_count, int quant_bits) {
-  if (auto st = check_draco_header(bytes, vertex_count, face_count); !st) return tl::unexpected(st.error());
+  if (auto st = check_draco_header(bytes, vertex_count, face_count); !st)
+    return tl::unexpected(st.error());
   draco::DecoderBuffer buffer;
   buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
   draco::Decoder decoder;
@@ -208,7 +214,8 @@ Result<BaseMesh> decode_base_draco(std::span<const uint8_t> bytes, uint32_t vert
     // Draco sizes vectors from counts in its bitstream (a damaged or hostile
     // base record made it reserve 5.7 GB in tests/fuzz): bad_alloc or
     // length_error is a corrupt record, not a crash of the caller.
-    return make_error(ErrorCode::kCorrupt, std::string("Draco could not decode the base mesh: ") + e.what());
+    return make_error(ErrorCode::kCorrupt,
+                      std::string("Draco could not decode the base mesh: ") + e.what());
   }
   auto& decoded = *attempt;
   if (!decoded.ok()) {

@@ -129,9 +129,9 @@ Result<WrittenContainer> write_container(const StreamHeader& header,
                                          std::span<const std::vector<uint8_t>> payloads,
                                          std::span<const RecordCounts> counts) {
   if (payloads.size() != counts.size()) {
-    return make_error(ErrorCode::kInvalidArgument, "write_container: " + std::to_string(payloads.size()) +
-                                                       " payloads but " + std::to_string(counts.size()) +
-                                                       " record counts");
+    return make_error(ErrorCode::kInvalidArgument,
+                      "write_container: " + std::to_string(payloads.size()) + " payloads but " +
+                          std::to_string(counts.size()) + " record counts");
   }
   if (encode_header(header).size() > kMaxHeaderBytes) {
     return make_error(ErrorCode::kInvalidArgument, "write_container: header too large");
@@ -150,13 +150,14 @@ Result<WrittenContainer> write_container(const StreamHeader& header,
     r.crc32 = crc32(0, payloads[i].data(), payloads[i].size());
     r.crc_trailer = true;
   }
-  if (!out.records.empty() &&
-      (out.records.back().vertices != header.vertex_count || out.records.back().faces != header.face_count)) {
+  if (!out.records.empty() && (out.records.back().vertices != header.vertex_count ||
+                               out.records.back().faces != header.face_count)) {
     return make_error(ErrorCode::kInvalidArgument,
                       "write_container: the last record's counts differ from the header's");
   }
   auto coded = encode_record_index(out.records);  // refuses empty lists and decreasing counts
-  if (!coded) return tl::unexpected(Error{coded.error().code, "write_container: " + coded.error().message});
+  if (!coded)
+    return tl::unexpected(Error{coded.error().code, "write_container: " + coded.error().message});
 
   out.bytes = write_magic_and_header(3, header);
   const size_t index_start = out.bytes.size();  // the index checksum covers count and length too
@@ -179,9 +180,8 @@ Result<WrittenContainer> write_container(const StreamHeader& header,
 Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   auto need = [&](size_t bytes) -> Status {
     if (in.size() < bytes) {
-      return make_error(ErrorCode::kTruncated,
-                        "stream ends after " + std::to_string(in.size()) +
-                            " bytes, inside its header or record index");
+      return make_error(ErrorCode::kTruncated, "stream ends after " + std::to_string(in.size()) +
+                                                   " bytes, inside its header or record index");
     }
     return {};
   };
@@ -191,9 +191,9 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   }
   const uint16_t version = get_u16(in.data() + 4);
   if (version < 1 || version > kContainerVersion) {
-    return make_error(ErrorCode::kUnsupported,
-                      "unsupported .hcs version " + std::to_string(version) + " (this build reads " +
-                          std::to_string(kContainerVersion) + ")");
+    return make_error(ErrorCode::kUnsupported, "unsupported .hcs version " +
+                                                   std::to_string(version) + " (this build reads " +
+                                                   std::to_string(kContainerVersion) + ")");
   }
   // No flags are defined yet; a set one means a feature this build lacks.
   if (get_u16(in.data() + 6) != 0) {
@@ -238,7 +238,8 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   // that record 0 starts right after it.
   auto check_index_and_set_payload_offset = [&](size_t index_end) -> Status {
     if (auto s = need(index_end + 4); !s) return s;
-    if (crc32(0, in.data() + index_start, index_end - index_start) != get_u32(in.data() + index_end)) {
+    if (crc32(0, in.data() + index_start, index_end - index_start) !=
+        get_u32(in.data() + index_end)) {
       return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
     }
     index.payload_offset = index_end + 4;
@@ -248,7 +249,8 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   // and checked: a hostile count costs no memory before.
   if (version == 1) {
     const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
-    if (auto s = check_index_and_set_payload_offset(index_end); !s) return tl::unexpected(s.error());
+    if (auto s = check_index_and_set_payload_offset(index_end); !s)
+      return tl::unexpected(s.error());
     index.records.resize(record_count);
     for (uint32_t i = 0; i < record_count; ++i) {
       const uint8_t* e = in.data() + count_at + 4 + size_t(i) * kIndexEntryBytes;
@@ -266,13 +268,16 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
     if (index_bytes == 0 || index_bytes > uint64_t(kMaxIndexBytesPerRecord) * record_count ||
         record_count > uint64_t(kMaxRecordsPerIndexByte) * index_bytes) {
-      return make_error(ErrorCode::kParse, "implausible record index length " + std::to_string(index_bytes) +
-                                               " for " + std::to_string(record_count) + " records");
+      return make_error(ErrorCode::kParse, "implausible record index length " +
+                                               std::to_string(index_bytes) + " for " +
+                                               std::to_string(record_count) + " records");
     }
     const size_t entries_at = count_at + 8;
     const size_t index_end = entries_at + index_bytes;
-    if (auto s = check_index_and_set_payload_offset(index_end); !s) return tl::unexpected(s.error());
-    auto records = decode_record_index(in.subspan(entries_at, index_bytes), record_count, index.payload_offset);
+    if (auto s = check_index_and_set_payload_offset(index_end); !s)
+      return tl::unexpected(s.error());
+    auto records = decode_record_index(in.subspan(entries_at, index_bytes), record_count,
+                                       index.payload_offset);
     if (!records) return tl::unexpected(records.error());
     index.records = std::move(*records);
     for (RecordEntry& r : index.records) {
@@ -282,25 +287,31 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   } else {
     if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
     const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
-    if (index_bytes < 7ull * record_count || index_bytes > 19ull * record_count) {  // 3 varints + CRC
-      return make_error(ErrorCode::kParse, "implausible record index length " + std::to_string(index_bytes));
+    if (index_bytes < 7ull * record_count ||
+        index_bytes > 19ull * record_count) {  // 3 varints + CRC
+      return make_error(ErrorCode::kParse,
+                        "implausible record index length " + std::to_string(index_bytes));
     }
     const size_t entries_at = count_at + 8;
     const size_t index_end = entries_at + index_bytes;
-    if (auto s = check_index_and_set_payload_offset(index_end); !s) return tl::unexpected(s.error());
+    if (auto s = check_index_and_set_payload_offset(index_end); !s)
+      return tl::unexpected(s.error());
     index.records.resize(record_count);
     size_t pos = entries_at;
     uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
     for (uint32_t i = 0; i < record_count; ++i) {
       RecordEntry& r = index.records[i];
       uint32_t size = 0, dv = 0, zigzag = 0;
-      if (!get_varint(in.data(), index_end, pos, size) || !get_varint(in.data(), index_end, pos, dv) ||
+      if (!get_varint(in.data(), index_end, pos, size) ||
+          !get_varint(in.data(), index_end, pos, dv) ||
           !get_varint(in.data(), index_end, pos, zigzag) || pos + 4 > index_end) {
-        return make_error(ErrorCode::kParse, "record index entry " + std::to_string(i) + " is malformed");
+        return make_error(ErrorCode::kParse,
+                          "record index entry " + std::to_string(i) + " is malformed");
       }
       const int64_t gap = zigzag & 1 ? -(int64_t(zigzag) + 1) / 2 : int64_t(zigzag) / 2;
       const int64_t df = 2 * int64_t(dv) - gap;
-      if (df < 0) return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " removes faces");
+      if (df < 0)
+        return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " removes faces");
       vertices += dv;
       faces += uint64_t(df);
       if (vertices > UINT32_MAX || faces > UINT32_MAX) {
@@ -320,9 +331,9 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   for (uint32_t i = 0; i < record_count; ++i) {
     RecordEntry& r = index.records[i];
     if (r.offset != expected_offset) {
-      return make_error(ErrorCode::kParse,
-                        "record " + std::to_string(i) + " does not start where record " +
-                            std::to_string(i == 0 ? 0 : i - 1) + " ends");
+      return make_error(ErrorCode::kParse, "record " + std::to_string(i) +
+                                               " does not start where record " +
+                                               std::to_string(i == 0 ? 0 : i - 1) + " ends");
     }
     if (i > 0 && (r.vertices < index.records[i - 1].vertices)) {
       return make_error(ErrorCode::kParse,

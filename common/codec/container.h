@@ -36,7 +36,8 @@
 namespace meshstream {
 
 inline constexpr char kContainerMagic[4] = {'M', 'H', 'C', 'S'};
-inline constexpr uint16_t kContainerVersion = 3;  // 1 and 2 (index CRCs, bare payloads) are still read
+inline constexpr uint16_t kContainerVersion =
+    3;  // 1 and 2 (index CRCs, bare payloads) are still read
 // Version 3 records end in a CRC-32 of their payload.
 inline constexpr uint32_t kRecordTrailerBytes = 4;
 // Refuse absurd counts before allocating anything for them.
@@ -48,7 +49,7 @@ struct StreamHeader {
   uint32_t face_count = 0;
   uint32_t base_vertex_count = 0;
   uint32_t base_face_count = 0;
-  BoundingBox bounds;         // quantization grid spans this box
+  BoundingBox bounds;  // quantization grid spans this box
   uint8_t quant_bits = 12;
   uint8_t base_coder = 0;       // which coder made record 0 (codec-defined ids)
   uint8_t structure_coder = 0;  // coder of refinement structure symbols
@@ -58,7 +59,7 @@ struct StreamHeader {
 };
 
 struct RecordEntry {
-  uint64_t offset = 0;  // from the start of the stream
+  uint64_t offset = 0;    // from the start of the stream
   uint32_t size = 0;      // bytes in the stream (payload and trailer, if any)
   uint32_t vertices = 0;  // cumulative, after this record
   uint32_t faces = 0;

@@ -9,7 +9,8 @@ namespace meshstream {
 namespace {
 
 uint32_t get_u32(const std::vector<uint8_t>& s, size_t at) {
-  return uint32_t(s[at]) | uint32_t(s[at + 1]) << 8 | uint32_t(s[at + 2]) << 16 | uint32_t(s[at + 3]) << 24;
+  return uint32_t(s[at]) | uint32_t(s[at + 1]) << 8 | uint32_t(s[at + 2]) << 16 |
+         uint32_t(s[at + 3]) << 24;
 }
 void put_u32(std::vector<uint8_t>& s, size_t at, uint32_t v) {
   for (int i = 0; i < 4; ++i) s[at + i] = static_cast<uint8_t>(v >> (8 * i));
@@ -43,7 +44,8 @@ void reseal_checksums(std::vector<uint8_t>& s) {
       const size_t e = count_at + 4 + i * 24;
       const uint64_t offset = uint64_t(get_u32(s, e)) | uint64_t(get_u32(s, e + 4)) << 32;
       const uint64_t size = get_u32(s, e + 8);
-      if (offset <= s.size() && size <= s.size() - offset) put_u32(s, e + 20, crc32(0, s.data() + offset, size));
+      if (offset <= s.size() && size <= s.size() - offset)
+        put_u32(s, e + 20, crc32(0, s.data() + offset, size));
     }
     put_u32(s, index_end, crc32(0, s.data() + count_at, index_end - count_at));
     return;
@@ -63,7 +65,7 @@ void reseal_checksums(std::vector<uint8_t>& s) {
     if (!records) return;
     for (const RecordEntry& r : *records) {
       if (r.offset > s.size() || r.size > s.size() - r.offset) break;  // contiguous: the rest too
-      const size_t payload = r.size - kRecordTrailerBytes;  // sizes are >= 4
+      const size_t payload = r.size - kRecordTrailerBytes;             // sizes are >= 4
       put_u32(s, r.offset + payload, crc32(0, s.data() + r.offset, payload));
     }
     return;
@@ -81,7 +83,8 @@ void reseal_checksums(std::vector<uint8_t>& s) {
         !get_varint(s, index_end, pos, df) || pos + 4 > index_end) {
       break;
     }
-    if (offset <= s.size() && size <= s.size() - offset) put_u32(s, pos, crc32(0, s.data() + offset, size));
+    if (offset <= s.size() && size <= s.size() - offset)
+      put_u32(s, pos, crc32(0, s.data() + offset, size));
     pos += 4;
     offset += size;
   }

@@ -34,7 +34,9 @@ Vec3l cross_l(Vec3l a, Vec3l b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 double dot_d(Vec3l a, Vec3d b) { return double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z; }
-double norm_l(Vec3l a) { return std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z); }
+double norm_l(Vec3l a) {
+  return std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
+}
 
 // Plane quadric (Garland & Heckbert 1997): sum of w (n.p + d)^2 over planes,
 // in grid units; `weight` is the summed plane weight (area).
@@ -42,14 +44,30 @@ struct Quadric {
   double a00 = 0, a01 = 0, a02 = 0, a03 = 0, a11 = 0, a12 = 0, a13 = 0, a22 = 0, a23 = 0, a33 = 0;
   double weight = 0;
   void add_plane(const Vec3d& n, double d, double w) {
-    a00 += w * n.x * n.x; a01 += w * n.x * n.y; a02 += w * n.x * n.z; a03 += w * n.x * d;
-    a11 += w * n.y * n.y; a12 += w * n.y * n.z; a13 += w * n.y * d;
-    a22 += w * n.z * n.z; a23 += w * n.z * d; a33 += w * d * d;
+    a00 += w * n.x * n.x;
+    a01 += w * n.x * n.y;
+    a02 += w * n.x * n.z;
+    a03 += w * n.x * d;
+    a11 += w * n.y * n.y;
+    a12 += w * n.y * n.z;
+    a13 += w * n.y * d;
+    a22 += w * n.z * n.z;
+    a23 += w * n.z * d;
+    a33 += w * d * d;
     weight += w;
   }
   void add(const Quadric& o) {
-    a00 += o.a00; a01 += o.a01; a02 += o.a02; a03 += o.a03; a11 += o.a11; a12 += o.a12;
-    a13 += o.a13; a22 += o.a22; a23 += o.a23; a33 += o.a33; weight += o.weight;
+    a00 += o.a00;
+    a01 += o.a01;
+    a02 += o.a02;
+    a03 += o.a03;
+    a11 += o.a11;
+    a12 += o.a12;
+    a13 += o.a13;
+    a22 += o.a22;
+    a23 += o.a23;
+    a33 += o.a33;
+    weight += o.weight;
   }
   // Mean squared distance of p from the planes.
   double mean_error(Vec3i q) const {
@@ -59,7 +77,6 @@ struct Quadric {
     return weight > 0 ? std::max(0.0, e) / weight : 0.0;
   }
 };
-
 
 struct Candidate {
   double cost;
@@ -123,7 +140,8 @@ class LayerBuilder {
     // chain's, crank 2.5x -> 2.0x; with the prediction weight 0.05 too,
     // 1.1x and 2.1x).
     if (mean_weight > 0) error *= quadrics[v].weight / mean_weight;
-    return std::log1p(std::sqrt(error) + kPredictionWeight * length(d)) + kValenceWeight * double(k);
+    return std::log1p(std::sqrt(error) + kPredictionWeight * length(d)) +
+           kValenceWeight * double(k);
   }
 
   // The best valid apex of v's fan (index into ring_, which holds v's ring
@@ -137,7 +155,8 @@ class LayerBuilder {
     if (boundary) {
       // The new boundary edge (ring[k-1], ring[0]) must not exist yet.
       m_.star(ring_[k - 1], apex_ring_, apex_corners_);
-      if (std::find(apex_ring_.begin(), apex_ring_.end(), ring_[0]) != apex_ring_.end()) return kNone;
+      if (std::find(apex_ring_.begin(), apex_ring_.end(), ring_[0]) != apex_ring_.end())
+        return kNone;
     }
     Vec3l star_normal{0, 0, 0};
     for (uint32_t i = 0; i < corners_.size(); ++i) {

@@ -45,8 +45,8 @@ namespace meshstream {
 inline constexpr uint32_t kMaxRemovalValence = 16;
 
 struct Removal {
-  uint32_t vertex = 0;          // id in the input mesh
-  std::vector<uint32_t> ring;   // ring[0] is the fan apex; CCW around vertex
+  uint32_t vertex = 0;         // id in the input mesh
+  std::vector<uint32_t> ring;  // ring[0] is the fan apex; CCW around vertex
   Vec3i position;
   // kNone for an interior vertex; for a boundary vertex the index i of the
   // ring edge (ring[i], ring[i+1]) that its removal turned into a boundary edge.

@@ -42,8 +42,8 @@ struct IncrementalDecoder::State {
 
   // `e` with the record it concerns named first.
   Error about_record(uint32_t i, const Error& e) const {
-    return Error{e.code, "record " + std::to_string(i) + " of " + std::to_string(index->records.size()) + ": " +
-                             e.message};
+    return Error{e.code, "record " + std::to_string(i) + " of " +
+                             std::to_string(index->records.size()) + ": " + e.message};
   }
 
   Status check_header() {
@@ -53,7 +53,8 @@ struct IncrementalDecoder::State {
                                                  std::to_string(h.quant_bits) + " (8..20 allowed)");
     }
     if (h.base_coder != kBaseCoderOwn && h.base_coder != kBaseCoderDraco) {
-      return make_error(ErrorCode::kUnsupported, "unknown base mesh coder " + std::to_string(h.base_coder));
+      return make_error(ErrorCode::kUnsupported,
+                        "unknown base mesh coder " + std::to_string(h.base_coder));
     }
     if (h.extra.empty() || h.extra[0] < kRefinementFormatPlain || h.extra[0] > kRefinementFormat) {
       return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
@@ -73,7 +74,8 @@ struct IncrementalDecoder::State {
     }
     for (float f : {h.bounds.min.x, h.bounds.min.y, h.bounds.min.z, h.bounds.max.x, h.bounds.max.y,
                     h.bounds.max.z}) {
-      if (!std::isfinite(f)) return make_error(ErrorCode::kCorrupt, "stream bounding box is not finite");
+      if (!std::isfinite(f))
+        return make_error(ErrorCode::kCorrupt, "stream bounding box is not finite");
     }
     const RecordEntry& r0 = index->records[0];
     if (r0.vertices != h.base_vertex_count || r0.faces != h.base_face_count) {
@@ -84,7 +86,8 @@ struct IncrementalDecoder::State {
       const RecordEntry& r = index->records[i];
       const RecordEntry& q = index->records[i - 1];
       const uint64_t added = uint64_t(r.vertices) - q.vertices;
-      if (uint64_t(r.faces) < uint64_t(q.faces) + added || uint64_t(r.faces) > uint64_t(q.faces) + 2 * added) {
+      if (uint64_t(r.faces) < uint64_t(q.faces) + added ||
+          uint64_t(r.faces) > uint64_t(q.faces) + 2 * added) {
         return make_error(ErrorCode::kCorrupt, "record " + std::to_string(i) +
                                                    " counts break 1..2 faces per added vertex");
       }
@@ -107,7 +110,8 @@ struct IncrementalDecoder::State {
                       ? decode_base_draco(payload, rec.vertices, rec.faces, coarse_bits)
                       : decode_base_own(payload, rec.vertices, rec.faces, coarse_bits);
       if (!base) return where(base.error());
-      auto state = RefinementState::from_coarse_base(base->positions, base->faces, h.quant_bits, base_shift);
+      auto state =
+          RefinementState::from_coarse_base(base->positions, base->faces, h.quant_bits, base_shift);
       if (!state) return where(state.error());
       refine = std::move(*state);
       refine->format = format;
@@ -120,7 +124,8 @@ struct IncrementalDecoder::State {
       const uint64_t received = std::min<uint64_t>(index->total_bytes(), stream_pos);
       const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * received;
       const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
-      const uint32_t nf = static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
+      const uint32_t nf = static_cast<uint32_t>(
+          std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
       refine->mesh.reserve(nv, nf);
       refine->vertices.reserve(nv);
       refine->vertex_layer.reserve(nv);
@@ -140,11 +145,13 @@ struct IncrementalDecoder::State {
       for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
     } else {
       AppliedRecord applied;
-      if (auto s = apply_refinement_record(*refine, payload, rec.vertices, rec.faces, applied); !s) {
+      if (auto s = apply_refinement_record(*refine, payload, rec.vertices, rec.faces, applied);
+          !s) {
         return where(s.error());
       }
       if (refine->layer > h.layer_count) {
-        return where({ErrorCode::kCorrupt, "more layers than the header's " + std::to_string(h.layer_count)});
+        return where({ErrorCode::kCorrupt,
+                      "more layers than the header's " + std::to_string(h.layer_count)});
       }
       const auto& positions = refine->mesh.positions();
       // QuantGrid::dequantize's arithmetic with its step computed once per
@@ -152,7 +159,8 @@ struct IncrementalDecoder::State {
       const double step = grid.step();
       const Vec3f& lo = grid.bounds.min;
       auto dequantize = [&](Vec3i q) {
-        return Vec3f{static_cast<float>(double(lo.x) + q.x * step), static_cast<float>(double(lo.y) + q.y * step),
+        return Vec3f{static_cast<float>(double(lo.x) + q.x * step),
+                     static_cast<float>(double(lo.y) + q.y * step),
                      static_cast<float>(double(lo.z) + q.z * step)};
       };
       for (uint32_t v : applied.added_vertices) {
@@ -214,15 +222,17 @@ Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
     const RecordEntry& rec = s.index->records[s.records_done];
     if (s.stream_pos < rec.offset + rec.size) break;
     if (s.buffer_start > rec.offset) {
-      s.error = Error{ErrorCode::kInvalidArgument, "bytes of record " + std::to_string(s.records_done) +
-                                                       " were skipped (resume offset past it)"};
+      s.error =
+          Error{ErrorCode::kInvalidArgument, "bytes of record " + std::to_string(s.records_done) +
+                                                 " were skipped (resume offset past it)"};
       return tl::unexpected(*s.error);
     }
     const size_t at = static_cast<size_t>(rec.offset - s.buffer_start);
     const std::span<const uint8_t> record_bytes(s.buffer.data() + at, rec.size);
     if (!record_intact(rec, record_bytes)) {
       // Checked before anything is applied, so the state stays good.
-      s.error = s.about_record(s.records_done, {ErrorCode::kCorrupt, "checksum mismatch (corrupt or altered bytes)"});
+      s.error = s.about_record(
+          s.records_done, {ErrorCode::kCorrupt, "checksum mismatch (corrupt or altered bytes)"});
       s.error_recoverable = true;
       return tl::unexpected(*s.error);
     }
@@ -300,8 +310,12 @@ uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget)
   for (size_t i = 0; i < index.records.size(); ++i) {
     bool fits = false;
     switch (budget.kind) {
-      case DecodeBudget::Kind::kBytes: fits = double(end_of(i)) <= budget.value; break;
-      case DecodeBudget::Kind::kVertices: fits = double(index.records[i].vertices) <= budget.value; break;
+      case DecodeBudget::Kind::kBytes:
+        fits = double(end_of(i)) <= budget.value;
+        break;
+      case DecodeBudget::Kind::kVertices:
+        fits = double(index.records[i].vertices) <= budget.value;
+        break;
       case DecodeBudget::Kind::kPercentVertices:
         fits = double(index.records[i].vertices) <=
                budget.value / 100.0 * double(index.header.vertex_count) + 1e-9;
@@ -309,7 +323,9 @@ uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget)
       case DecodeBudget::Kind::kRatio:
         fits = budget.value > 0 && double(end_of(i)) <= total / budget.value + 1e-9;
         break;
-      case DecodeBudget::Kind::kAll: fits = true; break;
+      case DecodeBudget::Kind::kAll:
+        fits = true;
+        break;
     }
     if (fits) best = i;
   }

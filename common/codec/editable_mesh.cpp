@@ -5,7 +5,8 @@
 
 namespace meshstream {
 
-Result<EditableMesh> EditableMesh::build(std::vector<Vec3i> positions, std::vector<Triangle> faces) {
+Result<EditableMesh> EditableMesh::build(std::vector<Vec3i> positions,
+                                         std::vector<Triangle> faces) {
   Mesh plain;
   plain.positions.resize(positions.size());
   plain.triangles = faces;
@@ -25,7 +26,8 @@ Result<EditableMesh> EditableMesh::build(std::vector<Vec3i> positions, std::vect
   return m;
 }
 
-void EditableMesh::star(uint32_t v, std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) const {
+void EditableMesh::star(uint32_t v, std::vector<uint32_t>& ring,
+                        std::vector<uint32_t>& corners) const {
   ring.clear();
   corners.clear();
   const uint32_t start = vertex_corner_[v];
@@ -123,7 +125,8 @@ void EditableMesh::remove_vertex(uint32_t v, const std::vector<uint32_t>& ring,
       if (o[j] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * fan_slot[j] + 1;
     } else {
       // R_a-1 sits only in T_k-2 (corner 2); its outgoing ring edge goes to the apex.
-      if (o[k - 1] == kNone || in_star(vertex_corner_[u])) vertex_corner_[u] = 3 * fan_slot[k - 2] + 2;
+      if (o[k - 1] == kNone || in_star(vertex_corner_[u]))
+        vertex_corner_[u] = 3 * fan_slot[k - 2] + 2;
     }
   }
 }

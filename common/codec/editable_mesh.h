@@ -79,8 +79,9 @@ class EditableMesh {
   // re-enters (k-1 faces replace k-2). Returns the new vertex id; appends
   // every face slot it wrote to `touched`. The caller has validated the
   // patch (refinement_codec's resolve_patch). O(k).
-  uint32_t insert_vertex(const std::vector<uint32_t>& ring, const std::vector<uint32_t>& fan_corners,
-                         uint32_t open, Vec3i position, std::vector<uint32_t>* touched);
+  uint32_t insert_vertex(const std::vector<uint32_t>& ring,
+                         const std::vector<uint32_t>& fan_corners, uint32_t open, Vec3i position,
+                         std::vector<uint32_t>* touched);
 
   // Cache hints for the decoder, which visits vertices in an order the
   // memory layout does not follow: asks for v's start corner and position
@@ -138,7 +139,6 @@ class EditableMesh {
   std::vector<uint32_t> vertex_corner_;
   std::vector<uint8_t> boundary_;
   std::vector<uint8_t> dead_;
-
 };
 
 }  // namespace meshstream

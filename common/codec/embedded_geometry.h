@@ -103,7 +103,8 @@ struct PlaneBitReader {
 // step) is read and replaced by this vertex's. Returns false when the
 // decoded magnitude could not belong to a grid position (hostile bytes).
 template <class Io>
-bool plane_step(GeometryModels& m, Io& io, VertexGeometry& g, uint8_t& prev_new, int32_t max_coordinate) {
+bool plane_step(GeometryModels& m, Io& io, VertexGeometry& g, uint8_t& prev_new,
+                int32_t max_coordinate) {
   const int below = g.shift - 1;
   const int plane = below < 7 ? below : 7;
   const bool base = g.normal_axis == kBaseVertexAxis;

@@ -39,8 +39,8 @@ uint64_t position_key(Vec3i p) {
 struct ChosenBase {
   uint8_t coder = kBaseCoderOwn;
   std::vector<uint8_t> bytes;
-  BaseMesh decoded;                 // what the decoder will start from
-  std::vector<uint32_t> to_input;   // decoded vertex -> input vertex id
+  BaseMesh decoded;                // what the decoder will start from
+  std::vector<uint32_t> to_input;  // decoded vertex -> input vertex id
 };
 
 // Own coder, with vertices in order of first use by the faces (a cheap
@@ -50,7 +50,8 @@ ChosenBase code_base_own(const DecimationResult& dec, const std::vector<Vec3i>& 
   std::unordered_map<uint32_t, uint32_t> id;
   for (const Triangle& t : dec.base_faces) {
     for (uint32_t v : t) {
-      if (id.emplace(v, static_cast<uint32_t>(out.to_input.size())).second) out.to_input.push_back(v);
+      if (id.emplace(v, static_cast<uint32_t>(out.to_input.size())).second)
+        out.to_input.push_back(v);
     }
   }
   for (uint32_t v : dec.base_vertices) {
@@ -86,7 +87,8 @@ std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std
   // other two corners are already mapped (a directed edge names one face in
   // a manifold mesh). Then the oriented faces must match id for id.
   const uint32_t n = static_cast<uint32_t>(base.positions.size());
-  if (decoded->positions.size() != n || decoded->faces.size() != base.faces.size()) return std::nullopt;
+  if (decoded->positions.size() != n || decoded->faces.size() != base.faces.size())
+    return std::nullopt;
   std::unordered_map<uint64_t, std::vector<uint32_t>> by_position;
   for (uint32_t v = 0; v < n; ++v) by_position[position_key(base.positions[v])].push_back(v);
   std::vector<uint32_t> map(n, kNone);  // decoded -> base
@@ -110,7 +112,8 @@ std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std
         const uint32_t a = t[i], b = t[(i + 1) % 3], c = t[(i + 2) % 3];
         if (map[c] != kNone || map[a] == kNone || map[b] == kNone) continue;
         auto it = third.find(edge_key(map[a], map[b]));
-        if (it == third.end() || taken[it->second] || !(base.positions[it->second] == decoded->positions[c])) {
+        if (it == third.end() || taken[it->second] ||
+            !(base.positions[it->second] == decoded->positions[c])) {
           continue;
         }
         map[c] = it->second;
@@ -127,7 +130,8 @@ std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std
   };
   std::vector<Triangle> ours, theirs;
   for (const Triangle& t : base.faces) ours.push_back(oriented(t));
-  for (const Triangle& t : decoded->faces) theirs.push_back(oriented({map[t[0]], map[t[1]], map[t[2]]}));
+  for (const Triangle& t : decoded->faces)
+    theirs.push_back(oriented({map[t[0]], map[t[1]], map[t[2]]}));
   std::sort(ours.begin(), ours.end());
   std::sort(theirs.begin(), theirs.end());
   if (ours != theirs) return std::nullopt;
@@ -172,7 +176,8 @@ struct EncoderTruth {
 // surface within itself) measured worse on CAD meshes, where a vertex on a
 // crease slides across the other face.
 double displacement_error2(Vec3i recon, Vec3i truth) {
-  const double e[3] = {double(recon.x) - truth.x, double(recon.y) - truth.y, double(recon.z) - truth.z};
+  const double e[3] = {double(recon.x) - truth.x, double(recon.y) - truth.y,
+                       double(recon.z) - truth.z};
   return e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
 }
 
@@ -204,7 +209,8 @@ double fan_distance2(const std::vector<Vec3i>& pos, const std::vector<uint32_t>&
   double best = std::numeric_limits<double>::infinity();
   const Vec3d a = grid_point(pos[ring[0]]);
   for (size_t i = 1; i + 1 < ring.size(); ++i) {
-    const Vec3d c = closest_point_on_triangle(q, a, grid_point(pos[ring[i]]), grid_point(pos[ring[i + 1]]));
+    const Vec3d c =
+        closest_point_on_triangle(q, a, grid_point(pos[ring[i]]), grid_point(pos[ring[i + 1]]));
     const double dx = c.x - q.x, dy = c.y - q.y, dz = c.z - q.z;
     best = std::min(best, dx * dx + dy * dy + dz * dz);
   }
@@ -272,8 +278,10 @@ class StructureWriter {
     double drop = 0;
     const uint32_t n = layer_vertices_;
     while (remaining_ > 0) {
-      while (s_.cursor != kNone && s_.vertices[s_.cursor].layer == s_.layer) s_.cursor = s_.vertices[s_.cursor].next;
-      if (s_.cursor == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: walk ended with patches left");
+      while (s_.cursor != kNone && s_.vertices[s_.cursor].layer == s_.layer)
+        s_.cursor = s_.vertices[s_.cursor].next;
+      if (s_.cursor == kNone)
+        return make_error(ErrorCode::kInvalidMesh, "internal: walk ended with patches left");
       const uint32_t u = s_.cursor;
       s_.cursor = s_.vertices[u].next;
       ++walk_steps;
@@ -288,7 +296,8 @@ class StructureWriter {
         for (uint32_t f = 0; f < faces; ++f) {
           if (star_ring_[f] == r.ring[1] && star_ring_[(f + 1) % ring_size] == r.ring[2]) pos = f;
         }
-        if (pos == kNone) return make_error(ErrorCode::kInvalidMesh, "internal: patch not found at its apex");
+        if (pos == kNone)
+          return make_error(ErrorCode::kInvalidMesh, "internal: patch not found at its apex");
         order_.push_back({pos, i});
       }
       std::sort(order_.begin(), order_.end());
@@ -311,7 +320,8 @@ class StructureWriter {
           if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
         }
       } else if (count > 0) {
-        return make_error(ErrorCode::kInvalidMesh, "internal: patch at a vertex without free faces");
+        return make_error(ErrorCode::kInvalidMesh,
+                          "internal: patch at a vertex without free faces");
       }
       s_.last_count = count;
       patches_.resize(count);
@@ -332,19 +342,23 @@ class StructureWriter {
         free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
         rank_patch_starts(s_.mesh, u, star_ring_, used_, k, candidates_, scores_);
         const auto it = std::find(candidates_.begin(), candidates_.end(), order_[j].first);
-        if (it == candidates_.end()) return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
+        if (it == candidates_.end())
+          return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
         if (bits_) enc.set_cost_sink(&bits_->rank);
         const uint32_t rank = static_cast<uint32_t>(it - candidates_.begin());
         if (format_ >= 3) {
           const size_t c = candidates_.size();
-          encode_start_rank3(m, enc, start_rank_context(k, c, scores_[0], c > 1 ? scores_[1] : -1), c, rank);
+          encode_start_rank3(m, enc, start_rank_context(k, c, scores_[0], c > 1 ? scores_[1] : -1),
+                             c, rank);
         } else {
           encode_start_rank(m, enc, k, rank);
         }
         for (uint32_t f = 0; f + 2 < k; ++f) used_[(order_[j].first + f) % faces] = 1;
-        if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k, patches_[j]) ||
+        if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k,
+                           patches_[j]) ||
             patches_[j].ring != r.ring) {
-          return make_error(ErrorCode::kInvalidMesh, "internal: patch does not resolve to its ring");
+          return make_error(ErrorCode::kInvalidMesh,
+                            "internal: patch does not resolve to its ring");
         }
         patch_boundary_edges(s_.mesh, patches_[j], open_edges_);
         if (!open_edges_.empty()) {
@@ -352,7 +366,8 @@ class StructureWriter {
           for (uint32_t e = 0; e < open_edges_.size(); ++e)
             if (open_edges_[e] == r.open) choice = e + 1;
           if (r.open != kNone && choice == 0)
-            return make_error(ErrorCode::kInvalidMesh, "internal: open edge of a boundary patch not on the boundary");
+            return make_error(ErrorCode::kInvalidMesh,
+                              "internal: open edge of a boundary patch not on the boundary");
           if (bits_) {
             ++bits_->open_choices;
             enc.set_cost_sink(&bits_->open_edge);
@@ -363,13 +378,15 @@ class StructureWriter {
             m.open_edge.encode(enc, choice);
           }
         } else if (r.open != kNone) {
-          return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
+          return make_error(ErrorCode::kInvalidMesh,
+                            "internal: boundary patch without boundary edges");
         }
         InsertionPrediction prediction;
         predict_insertion(s_, patches_[j].ring, min_shift, prediction);
         const int shift = format_ >= 2 ? prediction.shift : 0;
         if (bits_) enc.set_cost_sink(&bits_->residual);
-        encode_coarse_residual(m, enc, prediction.ctx, r.position, prediction.predicted, shift, geometry_[j]);
+        encode_coarse_residual(m, enc, prediction.ctx, r.position, prediction.predicted, shift,
+                               geometry_[j]);
       }
       enc.set_cost_sink(nullptr);
       const uint32_t vertices_before = s_.mesh.vertex_count();
@@ -387,11 +404,13 @@ class StructureWriter {
                              double(r.position.z) - pred.z};
         const double dn = d[0] * nrm.x + d[1] * nrm.y + d[2] * nrm.z;
         const Vec3i recon = reconstruct(g, s_.max_coordinate);
-        const double before = t_.surface ? fan_distance2(s_.mesh.positions(), patches_[j].ring, r.position) : dn * dn;
+        const double before =
+            t_.surface ? fan_distance2(s_.mesh.positions(), patches_[j].ring, r.position) : dn * dn;
         const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
         inserted.push_back({r.vertex, v});
         t_.position.push_back(r.position);
-        t_.residual.push_back({r.position.x - pred.x, r.position.y - pred.y, r.position.z - pred.z});
+        t_.residual.push_back(
+            {r.position.x - pred.x, r.position.y - pred.y, r.position.z - pred.z});
         t_.weight.push_back(area * std::sqrt(double(vertices_before + count)));
         drop += area * (before - vertex_error2(t_, v, recon)) / 6.0;
       }
@@ -400,7 +419,8 @@ class StructureWriter {
       if (enc.bytes_so_far() >= target) break;
     }
     out = Finished{};
-    write_record_header({starts_layer_, walk_steps, insertions, uint32_t(min_shift)}, out.payload, format_);
+    write_record_header({starts_layer_, walk_steps, insertions, uint32_t(min_shift)}, out.payload,
+                        format_);
     starts_layer_ = false;
     std::vector<uint8_t> coded = enc.finish();
     out.payload.insert(out.payload.end(), coded.begin(), coded.end());
@@ -430,7 +450,9 @@ class StructureWriter {
 // A plane step's true bits without coding them (for estimates).
 struct PlaneBitOracle {
   Vec3i residual;
-  uint32_t bit(BitModel&, int axis, int below) { return (uint32_t(std::abs(residual[axis])) >> below) & 1u; }
+  uint32_t bit(BitModel&, int axis, int below) {
+    return (uint32_t(std::abs(residual[axis])) >> below) & 1u;
+  }
   uint32_t sign(BitModel&, int axis) { return residual[axis] < 0 ? 1u : 0u; }
 };
 
@@ -452,8 +474,8 @@ struct PlainPlaneWriter {
 
 // Bytes of the next plane step of vertices [first, first + count) through
 // the plain coder (the state is not changed; `models` learn).
-size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32_t first, uint32_t count,
-                         PlainPlaneModels& models) {
+size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32_t first,
+                         uint32_t count, PlainPlaneModels& models) {
   RangeEncoder enc;
   GeometryModels unused;
   uint8_t prev_new = 0;
@@ -469,10 +491,10 @@ size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32
 // A run of vertex ids refined together by plane records (a batch).
 struct PlaneGroup {
   uint32_t first = 0, count = 0;
-  bool started = false;      // a plane record was written for it
-  uint32_t pending = 0;      // vertices with shift > 0
-  int top_plane = 0;         // largest shift - 1 among them
-  double scaled_drop = 0;    // estimated drop of its next plane x vertex count
+  bool started = false;    // a plane record was written for it
+  uint32_t pending = 0;    // vertices with shift > 0
+  int top_plane = 0;       // largest shift - 1 among them
+  double scaled_drop = 0;  // estimated drop of its next plane x vertex count
 };
 
 void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g) {
@@ -490,8 +512,7 @@ void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g) {
     uint8_t prev_new = 0;
     plane_step(scratch, io, geo, prev_new, s.max_coordinate);
     const Vec3i after = reconstruct(geo, s.max_coordinate);
-    g.scaled_drop += t.weight[v] *
-                     (vertex_error2(t, v, before) - vertex_error2(t, v, after)) / 6.0;
+    g.scaled_drop += t.weight[v] * (vertex_error2(t, v, before) - vertex_error2(t, v, after)) / 6.0;
   }
 }
 
@@ -518,17 +539,19 @@ struct EncodedStream {
   size_t records = 0;
 };
 
-Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
-                                  const DecimationResult& dec, const EncodeOptions& options,
-                                  uint32_t record_bytes, double plane_calibration, EncodeReport* report,
+Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
+                                  const std::vector<Vec3i>& q, const DecimationResult& dec,
+                                  const EncodeOptions& options, uint32_t record_bytes,
+                                  double plane_calibration, EncodeReport* report,
                                   const TriangleBvh* surface) {
   const int bits = grid.bits;
-  const uint8_t format = options.refinement_format == 0 ? kRefinementFormat
-                                                        : static_cast<uint8_t>(options.refinement_format);
-  const int base_shift =
-      options.embedded ? std::clamp(options.base_shift < 0 ? bits - 8 : options.base_shift, 0,
-                                    std::min(kMaxBaseShift, bits - 1))
-                       : 0;
+  const uint8_t format = options.refinement_format == 0
+                             ? kRefinementFormat
+                             : static_cast<uint8_t>(options.refinement_format);
+  const int base_shift = options.embedded
+                             ? std::clamp(options.base_shift < 0 ? bits - 8 : options.base_shift, 0,
+                                          std::min(kMaxBaseShift, bits - 1))
+                             : 0;
   std::vector<Vec3i> coarse(q.size());
   for (size_t v = 0; v < q.size(); ++v)
     for (int a = 0; a < 3; ++a) coarse[v][a] = q[v][a] >> base_shift;
@@ -540,7 +563,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
       base = std::move(*draco);
     }
   }
-  auto state = RefinementState::from_coarse_base(base.decoded.positions, base.decoded.faces, bits, base_shift);
+  auto state = RefinementState::from_coarse_base(base.decoded.positions, base.decoded.faces, bits,
+                                                 base_shift);
   if (!state) return tl::unexpected(state.error());
   state->format = format;
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
@@ -583,7 +607,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
     report->records.clear();
     report->base_shift = static_cast<uint32_t>(base_shift);
     report->ordering = {plane_calibration, surface ? 2 : 1};
-    report->plane_bits_raw = report->plane_bytes_coded = report->plane_bytes_plain = report->structure_bytes = 0;
+    report->plane_bits_raw = report->plane_bytes_coded = report->plane_bytes_plain =
+        report->structure_bytes = 0;
     report->structure_bits = StructureBits{};
     report->records.push_back({false, base_n, uint32_t(base.bytes.size()), hash_state(*state), 0});
   }
@@ -593,7 +618,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
   std::vector<PlaneGroup> groups;
   auto add_range = [&](uint32_t first, uint32_t count) {
     while (count > 0) {
-      if (!groups.empty() && !groups.back().started && groups.back().first + groups.back().count == first &&
+      if (!groups.empty() && !groups.back().started &&
+          groups.back().first + groups.back().count == first &&
           groups.back().count < group_vertices) {
         const uint32_t take = std::min(count, group_vertices - groups.back().count);
         groups.back().count += take;
@@ -652,9 +678,13 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
       const uint32_t first_new = state->mesh.vertex_count();
       Finished f;
       inserted.clear();
-      if (auto st = writer.write_record(record_bytes, options.embedded ? options.insertion_shift : 0, f, inserted); !st) return tl::unexpected(st.error());
+      if (auto st = writer.write_record(
+              record_bytes, options.embedded ? options.insertion_shift : 0, f, inserted);
+          !st)
+        return tl::unexpected(st.error());
       for (const auto& [input, decoded] : inserted) to_decoder[input] = decoded;
-      structure_slope = std::isfinite(f.drop) ? std::max(f.drop, 0.0) / double(f.payload.size()) : 0.0;
+      structure_slope =
+          std::isfinite(f.drop) ? std::max(f.drop, 0.0) / double(f.payload.size()) : 0.0;
       if (report) {
         report->structure_bytes += f.payload.size();
         report->records.push_back(
@@ -675,21 +705,26 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
       const VertexGeometry& geo = state->geometry[v];
       if (geo.shift == 0 || geo.normal_axis == kBaseVertexAxis) continue;
       for (int a = 0; a < 3; ++a)
-        sign_bits += geo.mag[a] == 0 && ((uint32_t(std::abs(truth.residual[v][a])) >> (geo.shift - 1)) & 1u);
+        sign_bits +=
+            geo.mag[a] == 0 && ((uint32_t(std::abs(truth.residual[v][a])) >> (geo.shift - 1)) & 1u);
     }
-    if (report) report->plane_bytes_plain += plain_plane_bytes(*state, truth, g.first, g.count, plain_models);
+    if (report)
+      report->plane_bytes_plain += plain_plane_bytes(*state, truth, g.first, g.count, plain_models);
     f.payload = write_plane_record(*state, g.first, g.count, truth.residual);
     f.vertices = state->mesh.vertex_count();
     f.faces = state->mesh.face_slot_count();
     f.drop = g.scaled_drop / std::sqrt(n_now);
     const size_t head = 1 + (g.first >= 128 ? 3 : 1) + (g.count >= 128 ? 2 : 1);
-    const double coded_bits = 8.0 * (double(f.payload.size()) - double(std::min(head, f.payload.size())));
-    plane_bits_per_step[plane] = 0.7 * plane_bits_per_step[plane] + 0.3 * coded_bits / std::max(1u, steps);
+    const double coded_bits =
+        8.0 * (double(f.payload.size()) - double(std::min(head, f.payload.size())));
+    plane_bits_per_step[plane] =
+        0.7 * plane_bits_per_step[plane] + 0.3 * coded_bits / std::max(1u, steps);
     g.started = true;
     if (report) {
       report->plane_bits_raw += 3ull * steps + sign_bits;
       report->plane_bytes_coded += f.payload.size() - std::min(head, f.payload.size());
-      report->records.push_back({true, f.vertices, uint32_t(f.payload.size()), hash_state(*state), f.drop});
+      report->records.push_back(
+          {true, f.vertices, uint32_t(f.payload.size()), hash_state(*state), f.drop});
     }
     evaluate_group(*state, truth, g);
     records.push_back(std::move(f));
@@ -719,7 +754,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid, const
     payloads.push_back(std::move(r.payload));
   }
   if (counts.back().vertices != header.vertex_count || counts.back().faces != header.face_count) {
-    return make_error(ErrorCode::kInvalidMesh, "internal: the records do not rebuild the whole mesh");
+    return make_error(ErrorCode::kInvalidMesh,
+                      "internal: the records do not rebuild the whole mesh");
   }
   auto written = write_container(header, payloads, counts);
   if (!written) return tl::unexpected(written.error());
@@ -750,7 +786,6 @@ uint64_t position_hash(const std::vector<Vec3f>& positions) {
   return h;
 }
 
-
 Result<Mesh> quantized_reference(const Mesh& mesh, int quant_bits) {
   auto grid = make_grid(mesh, quant_bits);
   if (!grid) return tl::unexpected(grid.error());
@@ -771,12 +806,14 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
                                         EncodeReport* report) {
   if (options.refinement_format != 0 && options.refinement_format != kRefinementFormatEmbedded &&
       options.refinement_format != kRefinementFormat) {
-    return make_error(ErrorCode::kInvalidArgument,
-                      "refinement format " + std::to_string(options.refinement_format) + " cannot be written (2 or 3)");
+    return make_error(ErrorCode::kInvalidArgument, "refinement format " +
+                                                       std::to_string(options.refinement_format) +
+                                                       " cannot be written (2 or 3)");
   }
   if (options.distortion_estimate < 0 || options.distortion_estimate > 2) {
-    return make_error(ErrorCode::kInvalidArgument,
-                      "distortion estimate " + std::to_string(options.distortion_estimate) + " is not 0, 1 or 2");
+    return make_error(
+        ErrorCode::kInvalidArgument,
+        "distortion estimate " + std::to_string(options.distortion_estimate) + " is not 0, 1 or 2");
   }
   auto grid = make_grid(mesh, options.quant_bits);
   if (!grid) return tl::unexpected(grid.error());
@@ -802,14 +839,17 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   }
   // The original in grid units, for the surface-distance estimate.
   TriangleBvh grid_surface;
-  if (std::any_of(orderings.begin(), orderings.end(), [](const RecordOrdering& o) { return o.distortion_estimate == 2; })) {
+  if (std::any_of(orderings.begin(), orderings.end(),
+                  [](const RecordOrdering& o) { return o.distortion_estimate == 2; })) {
     Mesh grid_mesh;
     grid_mesh.triangles = mesh.triangles;
     grid_mesh.positions.reserve(q.size());
     for (const Vec3i& p : q) grid_mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
     grid_surface = TriangleBvh::build(grid_mesh);
   }
-  auto surface_for = [&](const RecordOrdering& o) { return o.distortion_estimate == 2 ? &grid_surface : nullptr; };
+  auto surface_for = [&](const RecordOrdering& o) {
+    return o.distortion_estimate == 2 ? &grid_surface : nullptr;
+  };
 
   // Granularity (issue II): at least min(n / 50, 200) record boundaries and
   // no refinement record above 2 % of the stream. Automatic record sizes
@@ -823,25 +863,29 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   const double wanted = std::max(50.0, 1.1 * std::min<double>(n / 50, 200));
   const size_t wanted_records = std::min<size_t>(n / 50, 200) + 1;  // + the base
   auto granular = [&](const EncodedStream& e) {
-    return e.records >= wanted_records && double(e.largest_refinement) <= 0.02 * double(e.bytes.size());
+    return e.records >= wanted_records &&
+           double(e.largest_refinement) <= 0.02 * double(e.bytes.size());
   };
-  uint32_t record_bytes = automatic ? static_cast<uint32_t>(std::clamp(estimate / wanted, 32.0, 8192.0))
-                                    : std::max<uint32_t>(options.record_bytes, 16);
+  uint32_t record_bytes = automatic
+                              ? static_cast<uint32_t>(std::clamp(estimate / wanted, 32.0, 8192.0))
+                              : std::max<uint32_t>(options.record_bytes, 16);
   auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report) {
-    return encode_once(mesh, *grid, q, dec, options, bytes, orderings[i].plane_calibration, candidate_report,
-                       surface_for(orderings[i]));
+    return encode_once(mesh, *grid, q, dec, options, bytes, orderings[i].plane_calibration,
+                       candidate_report, surface_for(orderings[i]));
   };
   // The other candidates run on their own threads (they share only
   // read-only inputs) at the first record size while the first candidate
   // settles the record size; one that settles elsewhere is encoded again.
-  const bool parallel = orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
+  const bool parallel =
+      orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
   const uint32_t first_record_bytes = record_bytes;
   std::vector<EncodeReport> candidate_reports(orderings.size());
   auto report_of = [&](size_t i) { return report ? &candidate_reports[i] : nullptr; };
   std::vector<std::future<Result<EncodedStream>>> early;  // destroyed (joined) before what it reads
   if (parallel) {
     for (size_t i = 1; i < orderings.size(); ++i)
-      early.push_back(std::async(std::launch::async, encode_candidate, i, first_record_bytes, report_of(i)));
+      early.push_back(
+          std::async(std::launch::async, encode_candidate, i, first_record_bytes, report_of(i)));
   }
   EncodedStream chosen;
   for (int attempt = 0;; ++attempt) {
@@ -854,8 +898,10 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (orderings.size() < 2) return std::move(chosen.bytes);
   std::vector<EncodedStream> candidates(orderings.size());
   for (size_t i = 1; i < orderings.size(); ++i) {
-    auto candidate = parallel ? early[i - 1].get() : encode_candidate(i, record_bytes, report_of(i));
-    if (parallel && record_bytes != first_record_bytes) candidate = encode_candidate(i, record_bytes, report_of(i));
+    auto candidate =
+        parallel ? early[i - 1].get() : encode_candidate(i, record_bytes, report_of(i));
+    if (parallel && record_bytes != first_record_bytes)
+      candidate = encode_candidate(i, record_bytes, report_of(i));
     if (!candidate) return tl::unexpected(candidate.error());
     candidates[i] = std::move(*candidate);
   }
@@ -877,8 +923,8 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   };
   std::vector<std::future<Result<double>>> other_scores;  // joined before `measure` goes
   for (size_t i = 1; i < orderings.size(); ++i) {
-    other_scores.push_back(std::async(parallel ? std::launch::async : std::launch::deferred, score_of,
-                                      std::cref(candidates[i].bytes)));
+    other_scores.push_back(std::async(parallel ? std::launch::async : std::launch::deferred,
+                                      score_of, std::cref(candidates[i].bytes)));
   }
   auto chosen_score = score_of(chosen.bytes);
   if (!chosen_score) return tl::unexpected(chosen_score.error());

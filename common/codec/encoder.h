@@ -15,13 +15,13 @@
 namespace meshstream {
 
 struct EncodeOptions {
-  int quant_bits = 12;                 // 8..20, grid over the bounding box
-  uint32_t target_base_vertices = 300; // stop decimating at about this many
+  int quant_bits = 12;                  // 8..20, grid over the bounding box
+  uint32_t target_base_vertices = 300;  // stop decimating at about this many
   // Close a refinement record at about this size; 0 = automatic (sized
   // for min(n / 50, 200) boundaries and no record beyond the base above 2 %
   // of the stream; re-encoded with smaller records when missed).
   uint32_t record_bytes = 0;
-  bool allow_draco_base = true;        // false: always the own base coder (tests)
+  bool allow_draco_base = true;  // false: always the own base coder (tests)
   // true: successive-approximation positions and rate-distortion ordering
   // (issue II). false: issue I's ordering, every position exact at
   // insertion, no plane records (kept as a peer for the benchmark).
@@ -75,10 +75,13 @@ inline constexpr RecordOrdering kOrderingCandidates[] = {{1.0, 1}, {1.0, 2}};
 
 // Ids written in the stream header (`structure_coder`, `geometry_coder`).
 inline constexpr uint8_t kStructureCoderRange = 1;  // adaptive binary range coder
-inline constexpr uint8_t kGeometryCoderRangeAverage = 1;  // ring average + range-coded residual (format 1)
-inline constexpr uint8_t kGeometryCoderEmbedded = 2;  // ring average, coarse residual + context-coded bit planes
+inline constexpr uint8_t kGeometryCoderRangeAverage =
+    1;  // ring average + range-coded residual (format 1)
+inline constexpr uint8_t kGeometryCoderEmbedded =
+    2;  // ring average, coarse residual + context-coded bit planes
 inline constexpr uint8_t kRefinementFormatPlain = 1;  // header extra[0]: issue I's records
-inline constexpr uint8_t kRefinementFormatEmbedded = 2;  // header extra[0]: embedded records; extra[1] = base shift
+inline constexpr uint8_t kRefinementFormatEmbedded =
+    2;  // header extra[0]: embedded records; extra[1] = base shift
 // Header extra[0] of what the encoder writes: format 2's records with finer
 // contexts for counts, valences and start ranks (refinement_codec.h).
 inline constexpr uint8_t kRefinementFormat = 3;
@@ -86,13 +89,16 @@ inline constexpr int kMaxBaseShift = 12;
 
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion = 8;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3 (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank contexts); 7: 8-bit base by default; 8: surface-distance ordering candidate
+inline constexpr uint32_t kEncoderVersion =
+    8;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3
+        // (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank
+        // contexts); 7: 8-bit base by default; 8: surface-distance ordering candidate
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {
-  bool plane = false;          // a plane record (else base or structure)
-  uint32_t vertices = 0;       // mesh vertices after the record
-  uint32_t bytes = 0;          // payload size
+  bool plane = false;     // a plane record (else base or structure)
+  uint32_t vertices = 0;  // mesh vertices after the record
+  uint32_t bytes = 0;     // payload size
   // FNV-1a of the dequantized float positions (bit patterns, vertex order)
   // the decoder must show after this record.
   uint64_t position_hash = 0;
@@ -104,13 +110,13 @@ struct EncodedRecord {
 // sink) of the structure records' symbol classes, summed over the stream,
 // and the events they describe: where the structure bytes go.
 struct StructureBits {
-  double count = 0;      // patch counts (walk steps with free faces)
-  double valence = 0;    // k of each inserted vertex
-  double rank = 0;       // start ranks
-  double open_edge = 0;  // boundary re-entry choices
-  double residual = 0;   // coarse position residuals at insertion
-  uint64_t walk_steps = 0;    // all walk steps
-  uint64_t count_steps = 0;   // walk steps that coded a count
+  double count = 0;          // patch counts (walk steps with free faces)
+  double valence = 0;        // k of each inserted vertex
+  double rank = 0;           // start ranks
+  double open_edge = 0;      // boundary re-entry choices
+  double residual = 0;       // coarse position residuals at insertion
+  uint64_t walk_steps = 0;   // all walk steps
+  uint64_t count_steps = 0;  // walk steps that coded a count
   uint64_t insertions = 0;
   uint64_t open_choices = 0;  // patches that coded an open-edge choice
 };
@@ -118,13 +124,13 @@ struct StructureBits {
 struct EncodeReport {
   std::vector<EncodedRecord> records;
   StructureBits structure_bits;
-  uint64_t plane_bits_raw = 0;    // plane bits and signs, uncoded (one bit each)
-  uint64_t plane_bytes_coded = 0; // their context-coded payload (range-coded blocks)
+  uint64_t plane_bits_raw = 0;     // plane bits and signs, uncoded (one bit each)
+  uint64_t plane_bytes_coded = 0;  // their context-coded payload (range-coded blocks)
   // The same bits through issue I's kind of coder, for comparison: adaptive
   // binary models by plane only (no axis role, significance or neighbour
   // contexts), one block per record.
   uint64_t plane_bytes_plain = 0;
-  uint64_t structure_bytes = 0;   // structure records
+  uint64_t structure_bytes = 0;  // structure records
   uint32_t base_shift = 0;
   // The record ordering the stream was written with (the measured choice's
   // winner when automatic).

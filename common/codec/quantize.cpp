@@ -10,9 +10,9 @@
 namespace meshstream {
 
 double QuantGrid::step() const {
-  const double extent = std::max({double(bounds.max.x) - bounds.min.x,
-                                  double(bounds.max.y) - bounds.min.y,
-                                  double(bounds.max.z) - bounds.min.z});
+  const double extent =
+      std::max({double(bounds.max.x) - bounds.min.x, double(bounds.max.y) - bounds.min.y,
+                double(bounds.max.z) - bounds.min.z});
   return extent > 0 ? extent / double(max_coordinate()) : 0.0;
 }
 

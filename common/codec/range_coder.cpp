@@ -92,7 +92,8 @@ std::vector<uint8_t> RangeEncoder::finish() {
   for (int i = 0; i < 5; ++i) shift_low();
   // At most 4: a run of near-certain symbols also ends in zero bytes, and
   // the decoder refuses a block that reads more than 8 bytes past its end.
-  for (int dropped = 0; dropped < 4 && !out_.empty() && out_.back() == 0; ++dropped) out_.pop_back();
+  for (int dropped = 0; dropped < 4 && !out_.empty() && out_.back() == 0; ++dropped)
+    out_.pop_back();
   return std::move(out_);
 }
 
@@ -125,7 +126,8 @@ void AdaptiveIntModelT<Model>::encode(RangeEncoder& enc, int32_t value) {
   enc.encode_bit(zero, value == 0 ? 0 : 1);
   if (value == 0) return;
   enc.encode_bit(sign, value < 0 ? 1 : 0);
-  const uint32_t mag = value < 0 ? static_cast<uint32_t>(-int64_t(value)) : static_cast<uint32_t>(value);
+  const uint32_t mag =
+      value < 0 ? static_cast<uint32_t>(-int64_t(value)) : static_cast<uint32_t>(value);
   magnitude.encode(enc, mag - 1);
 }
 

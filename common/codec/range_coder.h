@@ -52,11 +52,13 @@ MESHSTREAM_MODEL_INLINE uint16_t bit_model_after0(uint32_t state) {
     return static_cast<uint16_t>(state + ((2048u - p) >> 5));
   }
   const uint32_t n = state >> kBitModelVSeenShift;  // < kBitModelVSeenMax
-  return static_cast<uint16_t>((p + ((2048u - p) >> bit_model_rate(n))) | ((n + 1) << kBitModelVSeenShift));
+  return static_cast<uint16_t>((p + ((2048u - p) >> bit_model_rate(n))) |
+                               ((n + 1) << kBitModelVSeenShift));
 }
 MESHSTREAM_MODEL_INLINE uint16_t bit_model_after1(uint32_t state) {
   const uint32_t p = state & 2047u;
-  if (state >= (kBitModelVSeenMax << kBitModelVSeenShift)) return static_cast<uint16_t>(state - (p >> 5));
+  if (state >= (kBitModelVSeenMax << kBitModelVSeenShift))
+    return static_cast<uint16_t>(state - (p >> 5));
   const uint32_t n = state >> kBitModelVSeenShift;
   return static_cast<uint16_t>((p - (p >> bit_model_rate(n))) | ((n + 1) << kBitModelVSeenShift));
 }
@@ -207,8 +209,8 @@ struct BitTreeModel {
 };
 
 // Adaptive Exp-Golomb for unsigned integers up to 2^32 - 1: the bit length
-// (0..32) through a 5-level bit tree (31 escapes to 31 or 32), then the two bits below the leading one through
-// models indexed by the length, then the rest as equiprobable bits.
+// (0..32) through a 5-level bit tree (31 escapes to 31 or 32), then the two bits below the leading
+// one through models indexed by the length, then the rest as equiprobable bits.
 template <class Model>
 struct AdaptiveUIntModelT {
   BitTreeModel<5, Model> length;

@@ -9,7 +9,9 @@
 namespace meshstream {
 
 Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOptions& options) {
-  if (original.triangles.empty()) return make_error(ErrorCode::kInvalidArgument, "rate-distortion measure: mesh has no triangles");
+  if (original.triangles.empty())
+    return make_error(ErrorCode::kInvalidArgument,
+                      "rate-distortion measure: mesh has no triangles");
   RdMeasure m;
   m.options_ = options;
   const SurfaceSamples area = sample_surface(original, std::max<uint32_t>(options.samples, 1), 1);
@@ -17,14 +19,16 @@ Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOption
   // The original never changes, so fixed area samples serve (and cost less
   // than a point per triangle of a large original).
   m.original_samples_.points.assign(area.points.begin(), area.points.begin() + area.area_count);
-  m.original_samples_.weights.assign(area.area_count, area.area / std::max<uint32_t>(area.area_count, 1));
+  m.original_samples_.weights.assign(area.area_count,
+                                     area.area / std::max<uint32_t>(area.area_count, 1));
   m.original_samples_.area = area.area;
   m.original_bvh_ = TriangleBvh::build(original);
   m.diagonal_ = bounding_box(original).diagonal();
   return m;
 }
 
-Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream, uint64_t reference_bytes) const {
+Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
+                                              uint64_t reference_bytes) const {
   auto index = read_stream_index(stream);
   if (!index) return tl::unexpected(index.error());
   std::vector<RdPoint> points;
@@ -44,7 +48,9 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream, u
     }
     const Mesh& shown = decoder.mesh();
     p.vertices = shown.vertex_count();
-    if (shown.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "rate-distortion measure: decoded prefix has no triangles");
+    if (shown.triangles.empty())
+      return make_error(ErrorCode::kInvalidMesh,
+                        "rate-distortion measure: decoded prefix has no triangles");
     p.relative_rms = relative_rms(shown);
     points.push_back(p);
   }
@@ -53,7 +59,8 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream, u
 
 double RdMeasure::relative_rms(const Mesh& shown) const {
   const double to_shown = weighted_rms_distance(original_samples_, TriangleBvh::build(shown));
-  const double to_original = weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_);
+  const double to_original =
+      weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_);
   return diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;
 }
 

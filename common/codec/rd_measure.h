@@ -32,15 +32,17 @@ struct RdMeasureOptions {
   // 4000 samples and 5 budgets up to 1/8 of the stream: the balance matters
   // most early, and the measurement stays about as costly as one encode.
   uint32_t samples = 4000;
-  uint32_t budgets = 5;     // log-spaced budgets between first_fraction and last_fraction of the stream
+  uint32_t budgets =
+      5;  // log-spaced budgets between first_fraction and last_fraction of the stream
   double first_fraction = 1.0 / 64;
   double last_fraction = 1.0 / 8;
 };
 
 // One measured point of a stream's curve.
 struct RdPoint {
-  uint64_t budget = 0;    // bytes allowed
-  uint64_t bytes = 0;     // the prefix decoded: largest record boundary within the budget (at least the base)
+  uint64_t budget = 0;  // bytes allowed
+  uint64_t bytes =
+      0;  // the prefix decoded: largest record boundary within the budget (at least the base)
   uint32_t vertices = 0;
   double relative_rms = 0;  // symmetric RMS over the original's bounding-box diagonal
 };
@@ -56,7 +58,8 @@ class RdMeasure {
   // and measures each prefix. Fails with the decoder's error on a stream it
   // cannot decode. Cost: one decode plus, per budget, a hierarchy over the
   // prefix and 2 x samples closest-point queries.
-  Result<std::vector<RdPoint>> curve(std::span<const uint8_t> stream, uint64_t reference_bytes) const;
+  Result<std::vector<RdPoint>> curve(std::span<const uint8_t> stream,
+                                     uint64_t reference_bytes) const;
 
   // The symmetric RMS distance of `shown` (e.g. one decoded prefix) to the
   // original, over the original's bounding-box diagonal. Precondition:

@@ -17,7 +17,7 @@ struct IndexModels {
   BitModel plane[2];  // context: the previous record was a plane record
   AdaptiveUIntModel base_size;
   AdaptiveUIntModel base_vertices;
-  AdaptiveIntModel size_delta[3];  // by kind (the base's is unused)
+  AdaptiveIntModel size_delta[3];   // by kind (the base's is unused)
   AdaptiveIntModel vertices_delta;  // structure records
   AdaptiveIntModel gap[3];          // by kind
 };
@@ -87,7 +87,8 @@ Result<std::vector<uint8_t>> encode_record_index(std::span<const RecordEntry> re
     auto refuse = [&](const std::string& what) {
       return make_error(ErrorCode::kInvalidArgument, "record " + std::to_string(i) + ": " + what);
     };
-    if (r.size < kRecordTrailerBytes || r.size > kMaxRecordBytes) return refuse("size outside 4 bytes .. 1 GiB");
+    if (r.size < kRecordTrailerBytes || r.size > kMaxRecordBytes)
+      return refuse("size outside 4 bytes .. 1 GiB");
     if (r.vertices < prev_vertices || r.faces < prev_faces) return refuse("counts decrease");
     const int64_t dv = int64_t(r.vertices) - prev_vertices;
     const int64_t gap = 2 * dv - (int64_t(r.faces) - prev_faces);
@@ -100,9 +101,11 @@ Result<std::vector<uint8_t>> encode_record_index(std::span<const RecordEntry> re
       kind = dv == 0 ? kPlane : kStructure;
       enc.encode_bit(m.plane[prev_plane], kind == kPlane);
       // Sizes are at most 2^30: the difference fits.
-      m.size_delta[kind].encode(enc, static_cast<int32_t>(int64_t(r.size) - int64_t(pred.last_size[kind])));
+      m.size_delta[kind].encode(
+          enc, static_cast<int32_t>(int64_t(r.size) - int64_t(pred.last_size[kind])));
       // Prediction in [0, 2^32], dv in [1, 2^32): |delta| <= 2^32.
-      if (kind == kStructure) encode_wide(m.vertices_delta, enc, dv - int64_t(pred.predict_vertices(r.size)));
+      if (kind == kStructure)
+        encode_wide(m.vertices_delta, enc, dv - int64_t(pred.predict_vertices(r.size)));
     }
     encode_wide(m.gap[kind], enc, gap);
     pred.update(kind, r.size, static_cast<uint64_t>(dv));
@@ -128,8 +131,9 @@ Result<std::vector<RecordEntry>> decode_record_index(std::span<const uint8_t> co
   if (count == 0 || count > kMaxRecords || coded.empty() ||
       coded.size() > uint64_t(kMaxIndexBytesPerRecord) * count ||
       count > uint64_t(kMaxRecordsPerIndexByte) * coded.size()) {
-    return make_error(ErrorCode::kParse, "implausible record index: " + std::to_string(count) + " records in " +
-                                             std::to_string(coded.size()) + " bytes");
+    return make_error(ErrorCode::kParse, "implausible record index: " + std::to_string(count) +
+                                             " records in " + std::to_string(coded.size()) +
+                                             " bytes");
   }
   IndexModels m;
   Predictor pred;
@@ -154,7 +158,8 @@ Result<std::vector<RecordEntry>> decode_record_index(std::span<const uint8_t> co
       size = int64_t(pred.last_size[kind]) + m.size_delta[kind].decode(dec);
     }
     if (size < int64_t(kRecordTrailerBytes) || size > int64_t(kMaxRecordBytes)) {
-      return tl::unexpected(bad_entry(i, "size " + std::to_string(size) + " outside 4 bytes .. 1 GiB"));
+      return tl::unexpected(
+          bad_entry(i, "size " + std::to_string(size) + " outside 4 bytes .. 1 GiB"));
     }
     if (kind == kStructure) {
       dv = int64_t(pred.predict_vertices(uint64_t(size))) + m.vertices_delta.decode(dec);
@@ -164,10 +169,12 @@ Result<std::vector<RecordEntry>> decode_record_index(std::span<const uint8_t> co
     }
     const int64_t df = 2 * dv - m.gap[kind].decode(dec);
     if (df < 0) return tl::unexpected(bad_entry(i, "removes faces"));
-    if (dec.overrun() > kDroppedZeros) return tl::unexpected(bad_entry(i, "the index bytes end inside it"));
+    if (dec.overrun() > kDroppedZeros)
+      return tl::unexpected(bad_entry(i, "the index bytes end inside it"));
     vertices += uint64_t(dv);
     faces += uint64_t(df);
-    if (vertices > UINT32_MAX || faces > UINT32_MAX) return tl::unexpected(bad_entry(i, "counts overflow"));
+    if (vertices > UINT32_MAX || faces > UINT32_MAX)
+      return tl::unexpected(bad_entry(i, "counts overflow"));
     RecordEntry& r = records.emplace_back();
     r.offset = offset;
     r.size = static_cast<uint32_t>(size);
@@ -180,8 +187,9 @@ Result<std::vector<RecordEntry>> decode_record_index(std::span<const uint8_t> co
     prev_plane = kind == kPlane;
   }
   if (dec.consumed() != coded.size()) {
-    return make_error(ErrorCode::kParse, "record index has " + std::to_string(coded.size() - dec.consumed()) +
-                                             " trailing bytes");
+    return make_error(
+        ErrorCode::kParse,
+        "record index has " + std::to_string(coded.size() - dec.consumed()) + " trailing bytes");
   }
   return records;
 }

@@ -55,8 +55,8 @@ Result<RefinementState> RefinementState::from_base(std::vector<Vec3i> positions,
 }
 
 Result<RefinementState> RefinementState::from_coarse_base(const std::vector<Vec3i>& coarse,
-                                                          std::vector<Triangle> faces, int quant_bits,
-                                                          int base_shift) {
+                                                          std::vector<Triangle> faces,
+                                                          int quant_bits, int base_shift) {
   const int32_t max = (int32_t(1) << quant_bits) - 1;
   std::vector<VertexGeometry> geometry(coarse.size());
   std::vector<Vec3i> positions(coarse.size());
@@ -125,8 +125,9 @@ namespace {
 // into apply_refinement_record so its range decoder stays in registers
 // (see MESHSTREAM_DECODE_INLINE in range_coder.h).
 MESHSTREAM_DECODE_INLINE bool decode_residual_inline(RefinementModels& models, RangeDecoder& dec,
-                                                     const ResidualContext& ctx, Vec3i predicted, int shift,
-                                                     int32_t max_coordinate, VertexGeometry& out) {
+                                                     const ResidualContext& ctx, Vec3i predicted,
+                                                     int shift, int32_t max_coordinate,
+                                                     VertexGeometry& out) {
   const int bucket = std::max(ctx.scale - shift, 0);
   out = VertexGeometry{};
   out.anchor = predicted;
@@ -148,7 +149,8 @@ MESHSTREAM_DECODE_INLINE bool decode_residual_inline(RefinementModels& models, R
   return true;
 }
 
-MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, RangeDecoder& dec, uint32_t k) {
+MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, RangeDecoder& dec,
+                                                           uint32_t k) {
   const uint32_t rank = m.start_rank[std::min(k - 3, 5u)].decode(dec);
   return rank < 15 ? rank : 15 + m.start_rank_big.decode(dec);
 }
@@ -159,7 +161,8 @@ MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, 
 // apex itself, whose offset from the apex is 0). The divisions by k are
 // 32-bit when the dividends fit (they do for grid coordinates < 2^20 and
 // k <= 16), which gives the same quotients as the 64-bit ones.
-MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s, const std::vector<uint32_t>& ring,
+MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s,
+                                                       const std::vector<uint32_t>& ring,
                                                        int min_shift, InsertionPrediction& out) {
   const Vec3i* p = s.mesh.positions().data();
   const uint8_t* vertex_shift = s.vertex_shift.data();
@@ -178,7 +181,8 @@ MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s,
     sy += b.y;
     sz += b.z;
     shift = std::max<int>(shift, vertex_shift[u]);
-    total += std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
+    total +=
+        std::abs(int64_t(a.x) - b.x) + std::abs(int64_t(a.y) - b.y) + std::abs(int64_t(a.z) - b.z);
     const int64_t dx = int64_t(b.x) - o.x, dy = int64_t(b.y) - o.y, dz = int64_t(b.z) - o.z;
     n0 += py * dz - pz * dy;
     n1 += pz * dx - px * dz;
@@ -188,7 +192,8 @@ MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s,
     pz = dz;
     a = b;
   }
-  total += std::abs(int64_t(a.x) - o.x) + std::abs(int64_t(a.y) - o.y) + std::abs(int64_t(a.z) - o.z);
+  total +=
+      std::abs(int64_t(a.x) - o.x) + std::abs(int64_t(a.y) - o.y) + std::abs(int64_t(a.z) - o.z);
 
   const int64_t sum[3] = {sx, sy, sz};
   const int64_t kk = static_cast<int64_t>(k);
@@ -199,7 +204,8 @@ MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s,
                            : static_cast<int32_t>(num / kk);
   }
   const uint64_t mean = (uint64_t(total) <= UINT32_MAX ? uint64_t(uint32_t(total) / uint32_t(k))
-                                                       : uint64_t(total) / k) + 1;
+                                                       : uint64_t(total) / k) +
+                        1;
   ResidualContext& ctx = out.ctx;
   ctx = ResidualContext{};
   // log2 of the mean L1 edge length, in integers: octave buckets (finer
@@ -220,7 +226,8 @@ MESHSTREAM_DECODE_INLINE void predict_insertion_inline(const RefinementState& s,
 }  // namespace
 
 bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
-                            Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out) {
+                            Vec3i predicted, int shift, int32_t max_coordinate,
+                            VertexGeometry& out) {
   return decode_residual_inline(models, dec, ctx, predicted, shift, max_coordinate, out);
 }
 
@@ -302,15 +309,18 @@ struct StartScratch {
 // start[i]), unsorted; returns their number. The scratch is prepared for
 // used.size() faces. Raw arrays: a push_back per candidate cost more than
 // the scoring of it.
-uint32_t score_patch_starts_raw(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                                const std::vector<uint8_t>& used, uint32_t k, StartScratch& scratch) {
+uint32_t score_patch_starts_raw(const EditableMesh& mesh, uint32_t apex,
+                                const std::vector<uint32_t>& star_ring,
+                                const std::vector<uint8_t>& used, uint32_t k,
+                                StartScratch& scratch) {
   const uint32_t faces = static_cast<uint32_t>(used.size());
   const uint32_t fan = k - 2;
   const bool boundary = mesh.is_boundary(apex);
   if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return 0;
   const Vec3i* p = mesh.positions().data();
   auto l2 = [&](uint32_t a, uint32_t b) {
-    const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y, dz = int64_t(p[a].z) - p[b].z;
+    const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y,
+                  dz = int64_t(p[a].z) - p[b].z;
     return dx * dx + dy * dy + dz * dz;
   };
   int64_t* edge = scratch.edge;
@@ -355,9 +365,9 @@ uint32_t score_patch_starts_raw(const EditableMesh& mesh, uint32_t apex, const s
 }
 
 // The same into a vector (the encoder's side).
-void score_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                        const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
-                        StartScratch& scratch) {
+void score_patch_starts(const EditableMesh& mesh, uint32_t apex,
+                        const std::vector<uint32_t>& star_ring, const std::vector<uint8_t>& used,
+                        uint32_t k, std::vector<uint32_t>& out, StartScratch& scratch) {
   const uint32_t n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
   out.assign(scratch.start, scratch.start + n);
 }
@@ -384,23 +394,25 @@ void sort_patch_starts(std::vector<uint32_t>& out, int64_t* score) {
 
 }  // namespace
 
-void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out) {
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex,
+                       const std::vector<uint32_t>& star_ring, const std::vector<uint8_t>& used,
+                       uint32_t k, std::vector<uint32_t>& out) {
   StartScratch scratch(static_cast<uint32_t>(used.size()));
   score_patch_starts(mesh, apex, star_ring, used, k, out, scratch);
   sort_patch_starts(out, scratch.score);
 }
 
-void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
-                       std::vector<int64_t>& scores) {
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex,
+                       const std::vector<uint32_t>& star_ring, const std::vector<uint8_t>& used,
+                       uint32_t k, std::vector<uint32_t>& out, std::vector<int64_t>& scores) {
   StartScratch scratch(static_cast<uint32_t>(used.size()));
   score_patch_starts(mesh, apex, star_ring, used, k, out, scratch);
   sort_patch_starts(out, scratch.score);
   scores.assign(scratch.score, scratch.score + out.size());
 }
 
-uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex,
+                            const std::vector<uint32_t>& star_ring,
                             const std::vector<uint8_t>& used, uint32_t k, uint32_t rank,
                             std::vector<uint32_t>& scratch_starts) {
   StartScratch scratch(static_cast<uint32_t>(used.size()));
@@ -458,7 +470,8 @@ uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k) {
 
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
                      Vec3i position, std::vector<uint32_t>* touched) {
-  const uint32_t v = state.mesh.insert_vertex(patch.ring, patch.fan_corners, open, position, touched);
+  const uint32_t v =
+      state.mesh.insert_vertex(patch.ring, patch.fan_corners, open, position, touched);
   const uint32_t apex = patch.ring[0];
   const uint32_t k = static_cast<uint32_t>(patch.ring.size());
   state.vertices.push_back({state.vertices[apex].next, state.layer, k});
@@ -495,7 +508,8 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,
                      const VertexGeometry& geometry, std::vector<uint32_t>* touched) {
   state.geometry.push_back(geometry);
-  const uint32_t v = apply_patch(state, patch, open, reconstruct(geometry, state.max_coordinate), touched);
+  const uint32_t v =
+      apply_patch(state, patch, open, reconstruct(geometry, state.max_coordinate), touched);
   state.vertex_shift[v] = geometry.shift;
   return v;
 }
@@ -528,8 +542,8 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
   }
   const uint32_t n = state.mesh.vertex_count();
   if (count == 0 || first >= n || count > n - first) {
-    return bad("plane record covers vertices " + std::to_string(first) + " + " + std::to_string(count) +
-               " of a mesh of " + std::to_string(n));
+    return bad("plane record covers vertices " + std::to_string(first) + " + " +
+               std::to_string(count) + " of a mesh of " + std::to_string(n));
   }
   RangeDecoder dec(payload.subspan(pos));
   PlaneBitReader io{dec};
@@ -543,9 +557,11 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
     state.vertex_shift[v] = g.shift;
     if (g.shift == 0 && g.normal_axis != kBaseVertexAxis) {
       for (int a = 0; a < 3; ++a) {
-        const int64_t value = int64_t(g.anchor[a]) + ((g.negative >> a) & 1 ? -int64_t(g.mag[a]) : int64_t(g.mag[a]));
+        const int64_t value =
+            int64_t(g.anchor[a]) + ((g.negative >> a) & 1 ? -int64_t(g.mag[a]) : int64_t(g.mag[a]));
         if (value < 0 || value > state.max_coordinate) {
-          return bad("plane record puts vertex " + std::to_string(v) + " outside the quantization grid");
+          return bad("plane record puts vertex " + std::to_string(v) +
+                     " outside the quantization grid");
         }
       }
     }
@@ -597,8 +613,8 @@ template <class DecodeRank>
 MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, uint32_t apex,
                                                       const std::vector<uint32_t>& star_ring,
                                                       const std::vector<uint8_t>& used, uint32_t k,
-                                                      StartScratch& scratch, DecodeRank&& decode_rank,
-                                                      uint32_t& rank) {
+                                                      StartScratch& scratch,
+                                                      DecodeRank&& decode_rank, uint32_t& rank) {
   scratch.prepare(static_cast<uint32_t>(used.size()));
   const size_t n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
   const uint32_t* starts = scratch.start;
@@ -632,8 +648,9 @@ MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, 
 // instance per model family (V: format 3's models), so the decoding loop,
 // inlined whole, holds no per-symbol format branches.
 template <bool V>
-Status decode_structure_block(RefinementState& state, std::span<const uint8_t> block, const RecordHeader& h,
-                              uint32_t expected_vertices, uint32_t expected_faces, AppliedRecord& applied) {
+Status decode_structure_block(RefinementState& state, std::span<const uint8_t> block,
+                              const RecordHeader& h, uint32_t expected_vertices,
+                              uint32_t expected_faces, AppliedRecord& applied) {
   RangeDecoder dec(block);
   RefinementModels& m = state.models;
   EditableMesh& mesh = state.mesh;
@@ -729,19 +746,22 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
         rank = decode_start_rank_inline(m, dec, k);
         r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
       } else {
-        r = select_patch_start3(mesh, u, star_ring, used_faces, k, start_scratch,
-                                [&](uint32_t context) __attribute__((always_inline)) {
-                                  return decode_start_rank_inline3(m, dec, context);
-                                }, rank);
+        r = select_patch_start3(
+            mesh, u, star_ring, used_faces, k, start_scratch,
+            [&](uint32_t context) __attribute__((always_inline)) {
+              return decode_start_rank_inline3(m, dec, context);
+            },
+            rank);
       }
       free_left = free_left >= k - 2 ? free_left - (k - 2) : 0;
       if (r == kNone) {
-        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " (valence " +
-                    std::to_string(k) + ", start rank " + std::to_string(rank) + ") does not fit its star of " +
-                    std::to_string(faces) + " faces");
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) +
+                    " (valence " + std::to_string(k) + ", start rank " + std::to_string(rank) +
+                    ") does not fit its star of " + std::to_string(faces) + " faces");
       }
       if (!resolve_patch(mesh, u, star_ring, star_corners, r, k, patches[i])) {
-        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) + " does not fit");
+        return fail("patch " + std::to_string(i) + " at vertex " + std::to_string(u) +
+                    " does not fit");
       }
       for (uint32_t j = 0, f = r; j + 2 < k; ++j, f = f + 1 == faces ? 0 : f + 1) used_faces[f] = 1;
       opens[i] = kNone;
@@ -755,7 +775,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
         }
         if (choice > open_edges.size()) {
           return fail("patch at vertex " + std::to_string(u) + " re-enters boundary edge " +
-                                 std::to_string(choice) + " of " + std::to_string(open_edges.size()));
+                      std::to_string(choice) + " of " + std::to_string(open_edges.size()));
         }
         if (choice > 0) opens[i] = open_edges[choice - 1];
       }
@@ -763,31 +783,30 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
       predict_insertion_inline(state, patches[i].ring, static_cast<int>(h.min_shift), prediction);
       if (!decode_residual_inline(m, dec, prediction.ctx, prediction.predicted, prediction.shift,
                                   state.max_coordinate, positions[i])) {
-        return fail("vertex position outside the quantization grid at vertex " +
-                               std::to_string(u));
+        return fail("vertex position outside the quantization grid at vertex " + std::to_string(u));
       }
     }
     if (dec.exhausted_badly()) return fail("refinement record data ends early");
     for (uint32_t i = 0; i < count; ++i) {
-      const uint32_t v = apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
+      const uint32_t v =
+          apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
       applied.added_vertices.push_back(v);
     }
     inserted += count;
   }
   if (inserted != h.insertions) {
-    return fail("refinement record holds " + std::to_string(inserted) + " insertions, its header says " +
-                           std::to_string(h.insertions));
+    return fail("refinement record holds " + std::to_string(inserted) +
+                " insertions, its header says " + std::to_string(h.insertions));
   }
   if (dec.exhausted_badly()) return fail("refinement record data ends early");
   if (mesh.vertex_count() != expected_vertices || mesh.face_slot_count() != expected_faces) {
     return fail("refinement record yields " + std::to_string(mesh.vertex_count()) +
-                           " vertices and " + std::to_string(mesh.face_slot_count()) +
-                           " faces, the index says " + std::to_string(expected_vertices) + " and " +
-                           std::to_string(expected_faces));
+                " vertices and " + std::to_string(mesh.face_slot_count()) +
+                " faces, the index says " + std::to_string(expected_vertices) + " and " +
+                std::to_string(expected_faces));
   }
   return {};
 }
-
 
 Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> payload,
                                uint32_t expected_vertices, uint32_t expected_faces,
@@ -799,7 +818,8 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   const uint8_t flags = payload[0];
   if (flags == kRecordPlane) {
     if (auto st = apply_plane_record(state, payload, applied); !st) return st;
-    if (state.mesh.vertex_count() != expected_vertices || state.mesh.face_slot_count() != expected_faces) {
+    if (state.mesh.vertex_count() != expected_vertices ||
+        state.mesh.face_slot_count() != expected_faces) {
       return bad("plane record where the index says the mesh grows");
     }
     return {};
@@ -812,15 +832,17 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     return bad("refinement record header is cut short or malformed");
   }
   if (state.format >= 2) {
-    if (!read_varint(payload, pos, h.min_shift)) return bad("refinement record header is cut short or malformed");
-    if (h.min_shift > kMaxShift) return bad("refinement record shift " + std::to_string(h.min_shift) + " too large");
+    if (!read_varint(payload, pos, h.min_shift))
+      return bad("refinement record header is cut short or malformed");
+    if (h.min_shift > kMaxShift)
+      return bad("refinement record shift " + std::to_string(h.min_shift) + " too large");
   }
   const uint32_t vertices_before = state.mesh.vertex_count();
   // Each insertion needs at least one walk step's worth of bits; refuse
   // counts that could not fit before allocating for them.
   if (h.walk_steps > vertices_before) {
-    return bad("refinement record walks " + std::to_string(h.walk_steps) + " vertices but the mesh has " +
-               std::to_string(vertices_before));
+    return bad("refinement record walks " + std::to_string(h.walk_steps) +
+               " vertices but the mesh has " + std::to_string(vertices_before));
   }
   if (h.insertions > 64 * static_cast<uint64_t>(payload.size())) {
     return bad("refinement record claims " + std::to_string(h.insertions) +
@@ -836,8 +858,10 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
 
   state.models.v_models = state.format >= 3;
   const std::span<const uint8_t> block = payload.subspan(pos);
-  return state.models.v_models ? decode_structure_block<true>(state, block, h, expected_vertices, expected_faces, applied)
-                               : decode_structure_block<false>(state, block, h, expected_vertices, expected_faces, applied);
+  return state.models.v_models ? decode_structure_block<true>(state, block, h, expected_vertices,
+                                                              expected_faces, applied)
+                               : decode_structure_block<false>(state, block, h, expected_vertices,
+                                                               expected_faces, applied);
 }
 
 }  // namespace meshstream

@@ -45,11 +45,11 @@ inline constexpr int kScaleContexts = 20;
 struct RefinementModels {
   BitTreeModel<2> patch_count[8 * 2 * 3 * 4];  // by count_context; 3 = escape
   AdaptiveUIntModel patch_count_extra;
-  BitTreeModel<4> start_rank[6];     // by min(k - 3, 5); 15 = escape
+  BitTreeModel<4> start_rank[6];  // by min(k - 3, 5); 15 = escape
   AdaptiveUIntModel start_rank_big;
-  BitTreeModel<4> valence[13];       // k - 3 (k <= 18), by min(apex ring size, 12)
+  BitTreeModel<4> valence[13];  // k - 3 (k <= 18), by min(apex ring size, 12)
   AdaptiveIntModel residual[kScaleContexts][3];
-  AdaptiveUIntModel open_edge;       // 0 interior vertex, i+1: re-enters boundary edge i
+  AdaptiveUIntModel open_edge;  // 0 interior vertex, i+1: re-enters boundary edge i
   // Format 3 codes the structure symbols (counts, valences, ranks, open
   // edges) through models whose adaptation slows as they learn (BitModelV),
   // with finer contexts for valences and start ranks (valence_model3,
@@ -59,7 +59,7 @@ struct RefinementModels {
   bool v_models = false;  // format >= 3: use the models below (set by the coders)
   BitTreeModel<2, BitModelV> patch_count3[8 * 2 * 3 * 4];  // by count_context
   AdaptiveUIntModelV patch_count_extra3;
-  BitTreeModel<4, BitModelV> valence3[13 * 8];     // by valence_model3
+  BitTreeModel<4, BitModelV> valence3[13 * 8];        // by valence_model3
   BitTreeModel<4, BitModelV> start_rank3[6 * 3 * 4];  // by start_rank_context
   AdaptiveUIntModelV start_rank_big3;
   AdaptiveUIntModelV open_edge3;
@@ -75,7 +75,7 @@ struct RefinementState {
     uint32_t next = kNone;
     uint32_t layer = 0;
     uint32_t valence = 0;
-    uint32_t taken = 0;        // faces holding a vertex of layer `taken_layer`
+    uint32_t taken = 0;  // faces holding a vertex of layer `taken_layer`
     uint32_t taken_layer = 0;
   };
   std::vector<VertexEntry> vertices;
@@ -90,10 +90,10 @@ struct RefinementState {
   std::vector<uint32_t> vertex_layer;
   std::vector<uint8_t> vertex_shift;
   uint32_t order_head = kNone;
-  uint32_t layer = 0;                   // layers started so far
-  uint32_t cursor = kNone;              // next vertex of the walk
+  uint32_t layer = 0;       // layers started so far
+  uint32_t cursor = kNone;  // next vertex of the walk
   int32_t max_coordinate = 4095;
-  uint32_t last_count = 0;              // patches at the previous walk vertex
+  uint32_t last_count = 0;  // patches at the previous walk vertex
   RefinementModels models;
   // Successive-approximation state of every vertex (embedded_geometry.h);
   // mesh.positions() holds reconstruct() of each entry.
@@ -105,8 +105,8 @@ struct RefinementState {
   uint8_t format = 2;
 
   // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
-  static Result<RefinementState> from_base(std::vector<Vec3i> positions, std::vector<Triangle> faces,
-                                           int quant_bits);
+  static Result<RefinementState> from_base(std::vector<Vec3i> positions,
+                                           std::vector<Triangle> faces, int quant_bits);
   // Same from the coarse base points of an embedded stream: vertex v starts
   // at coarse[v] << base_shift with its low base_shift bits unknown.
   static Result<RefinementState> from_coarse_base(const std::vector<Vec3i>& coarse,
@@ -153,14 +153,16 @@ inline uint32_t count_context(const RefinementState& s, uint32_t u, uint32_t fre
 // — the count two walk steps back, and the number of u's free faces whose
 // two other vertices the walk has already visited, which only a patch at u
 // could still use.)
-inline BitTreeModel<2, BitModelV>& count_model3(RefinementState& s, uint32_t u, uint32_t free_faces) {
+inline BitTreeModel<2, BitModelV>& count_model3(RefinementState& s, uint32_t u,
+                                                uint32_t free_faces) {
   return s.models.patch_count3[count_context(s, u, free_faces)];
 }
 
 // Format 3's model of k - 3 for a patch at apex u: by u's ring size (as
 // format 2) and the free faces of u left for it (min 7; k - 2 of them
 // become the fan, after the patches already read at u).
-inline BitTreeModel<4, BitModelV>& valence_model3(RefinementState& s, uint32_t ring_size, uint32_t free_left) {
+inline BitTreeModel<4, BitModelV>& valence_model3(RefinementState& s, uint32_t ring_size,
+                                                  uint32_t free_left) {
   return s.models.valence3[std::min(ring_size, 12u) * 8 + std::min<uint32_t>(free_left, 7)];
 }
 
@@ -172,10 +174,12 @@ inline BitTreeModel<4, BitModelV>& valence_model3(RefinementState& s, uint32_t r
 inline uint32_t start_rank_context(uint32_t k, size_t candidates, int64_t best, int64_t second) {
   const uint32_t kb = std::min(k - 3, 5u);
   const uint32_t cb = candidates <= 2 ? 0 : candidates <= 4 ? 1 : 2;
-  const uint32_t gap = 4 * best < 5 * second ? 0 : best < 2 * second ? 1 : best < 4 * second ? 2 : 3;
+  const uint32_t gap = 4 * best < 5 * second ? 0
+                       : best < 2 * second   ? 1
+                       : best < 4 * second   ? 2
+                                             : 3;
   return (kb * 3 + cb) * 4 + gap;
 }
-
 
 // Resolves the patch whose first fan face is star index r and whose vertex
 // has valence k, given the apex's star. False when it does not fit (r or k
@@ -195,14 +199,16 @@ void patch_boundary_edges(const EditableMesh& mesh, const ResolvedPatch& patch,
 // sum of the squared lengths of the fan's diagonals (k >= 4) or of the
 // edge opposite the apex (k = 3), larger first, ties by r. Integer-exact.
 // O(faces * k).
-void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out);
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex,
+                       const std::vector<uint32_t>& star_ring, const std::vector<uint8_t>& used,
+                       uint32_t k, std::vector<uint32_t>& out);
 
 // The decoder's shortcut: the same as rank_patch_starts(...)[rank], or
 // kNone when there are not more than `rank` candidates. Rank 0 (the common
 // case) is one pass over the candidates instead of a sort. `scratch_starts`
 // is working space kept by the caller (no allocation per call).
-uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+uint32_t select_patch_start(const EditableMesh& mesh, uint32_t apex,
+                            const std::vector<uint32_t>& star_ring,
                             const std::vector<uint8_t>& used, uint32_t k, uint32_t rank,
                             std::vector<uint32_t>& scratch_starts);
 
@@ -240,8 +246,8 @@ void encode_coarse_residual(RefinementModels& models, RangeEncoder& enc, const R
 // Returns false when the decoded residual cannot belong to a grid position
 // (shift 0: the position leaves the grid [0, max_coordinate]).
 bool decode_coarse_residual(RefinementModels& models, RangeDecoder& dec, const ResidualContext& ctx,
-                            Vec3i predicted, int shift, int32_t max_coordinate, VertexGeometry& out);
-
+                            Vec3i predicted, int shift, int32_t max_coordinate,
+                            VertexGeometry& out);
 
 // Inserts a vertex into a resolved patch and links it after the apex in the
 // order list. Returns its id; appends written face slots to `touched`.
@@ -252,9 +258,9 @@ void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint3
 void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context, size_t candidates,
                         uint32_t rank);
 // rank_patch_starts with the candidates' scores in the same order.
-void rank_patch_starts(const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-                       const std::vector<uint8_t>& used, uint32_t k, std::vector<uint32_t>& out,
-                       std::vector<int64_t>& scores);
+void rank_patch_starts(const EditableMesh& mesh, uint32_t apex,
+                       const std::vector<uint32_t>& star_ring, const std::vector<uint8_t>& used,
+                       uint32_t k, std::vector<uint32_t>& out, std::vector<int64_t>& scores);
 uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k);
 
 uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_t open,

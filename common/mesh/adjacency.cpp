@@ -20,9 +20,9 @@ Result<Adjacency> Adjacency::build(const Mesh& mesh) {
     const Triangle& t = mesh.triangles[f];
     for (uint32_t i = 0; i < 3; ++i) {
       if (t[i] >= vertex_count) {
-        return make_error(ErrorCode::kInvalidMesh, "triangle " + std::to_string(f) +
-                                                       " refers to missing vertex " +
-                                                       std::to_string(t[i]));
+        return make_error(
+            ErrorCode::kInvalidMesh,
+            "triangle " + std::to_string(f) + " refers to missing vertex " + std::to_string(t[i]));
       }
       adj.corner_vertex_[3 * f + i] = t[i];
     }

@@ -41,7 +41,8 @@ std::string describe_non_finite(const Vec3f& p) {
 // Applies old->new vertex renumbering (kNone = removed; the first old vertex
 // mapped to a new index provides its data) to positions and attributes.
 template <class T>
-void remap_array(std::vector<T>& values, const std::vector<uint32_t>& new_index, uint32_t new_count) {
+void remap_array(std::vector<T>& values, const std::vector<uint32_t>& new_index,
+                 uint32_t new_count) {
   if (values.empty()) return;
   std::vector<T> out(new_count);
   std::vector<uint8_t> written(new_count, 0);
@@ -66,7 +67,8 @@ void renumber(Mesh& mesh, const std::vector<uint32_t>& new_index, uint32_t new_c
 
 // True when every group of merged vertices has bit-identical values.
 template <class T>
-bool consistent_after_merge(const std::vector<T>& values, const std::vector<uint32_t>& representative) {
+bool consistent_after_merge(const std::vector<T>& values,
+                            const std::vector<uint32_t>& representative) {
   if (values.empty()) return true;
   for (size_t v = 0; v < values.size(); ++v) {
     if (std::memcmp(&values[v], &values[representative[v]], sizeof(T)) != 0) return false;
@@ -177,7 +179,8 @@ uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin) {
   std::vector<uint8_t> shared_edges(mesh.face_count(), 0);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     if (groups.use_count(e) < 2) continue;
-    for (uint32_t k = groups.begin[e]; k < groups.begin[e + 1]; ++k) shared_edges[groups.uses[k].face] = 1;
+    for (uint32_t k = groups.begin[e]; k < groups.begin[e + 1]; ++k)
+      shared_edges[groups.uses[k].face] = 1;
   }
   std::vector<Triangle> kept;
   kept.reserve(mesh.triangles.size());
@@ -236,8 +239,8 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
     const Vec3f& p = mesh.positions[v];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
       return make_error(ErrorCode::kInvalidMesh,
-                        "vertex " + std::to_string(v) + " has a non-finite coordinate (NaN/Inf): " +
-                            describe_non_finite(p));
+                        "vertex " + std::to_string(v) +
+                            " has a non-finite coordinate (NaN/Inf): " + describe_non_finite(p));
     }
   }
 
@@ -293,7 +296,8 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
       drop_unreferenced(mesh);
     }
     if (mesh.triangles.empty()) {
-      return make_error(ErrorCode::kInvalidMesh, "no usable triangle: every face is a double-sided flap");
+      return make_error(ErrorCode::kInvalidMesh,
+                        "no usable triangle: every face is a double-sided flap");
     }
   }
   return report;

@@ -12,17 +12,17 @@
 //  - points (Draco's per-corner records) are not vertices: a vertex is the
 //    position *value* a corner maps to (STL: each point, since an STL file
 //    has no shared vertices and the reader merges them itself).
-#include <cstring>
-#include <filesystem>
-#include <string_view>
-#include <fstream>
-#include <iterator>
-#include <memory>
-
 #include <draco/compression/decode.h>
 #include <draco/io/obj_decoder.h>
 #include <draco/io/stl_decoder.h>
 #include <draco/mesh/mesh.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string_view>
 
 #include "common/mesh/mesh_readers.h"
 
@@ -40,7 +40,8 @@ std::string lower_extension(const std::string& path) {
 
 Result<std::unique_ptr<draco::Mesh>> decode(const std::string& path, const std::string& ext) {
   auto fail = [](const draco::Status& status) {
-    return make_error(ErrorCode::kParse, std::string("Draco could not read it: ") + status.error_msg());
+    return make_error(ErrorCode::kParse,
+                      std::string("Draco could not read it: ") + status.error_msg());
   };
   auto mesh = std::make_unique<draco::Mesh>();
   if (ext == "obj") {
@@ -140,7 +141,8 @@ Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext)
     return make_error(ErrorCode::kParse, std::string("Draco could not read it: ") + e.what());
   }
   if (!decoded) {
-    if (decoded.error().code == ErrorCode::kUnsupported && ext == "stl") return read_ascii_stl(path);
+    if (decoded.error().code == ErrorCode::kUnsupported && ext == "stl")
+      return read_ascii_stl(path);
     return tl::unexpected(std::move(decoded).error());
   }
   const draco::Mesh& dm = **decoded;
@@ -157,8 +159,8 @@ Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext)
       per_point ? dm.num_points() : static_cast<uint32_t>(position->size());
   mesh.positions.resize(vertex_count);
   for (uint32_t v = 0; v < vertex_count; ++v) {
-    const auto index = per_point ? position->mapped_index(draco::PointIndex(v))
-                                 : draco::AttributeValueIndex(v);
+    const auto index =
+        per_point ? position->mapped_index(draco::PointIndex(v)) : draco::AttributeValueIndex(v);
     if (!position->ConvertValue<float>(index, 3, &mesh.positions[v].x)) {
       return make_error(ErrorCode::kParse, "vertex " + std::to_string(v) + " could not be read");
     }
@@ -178,15 +180,15 @@ Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext)
       mesh.triangles[f][i] = v;
       corner_vertex[3 * f + i] = v;
       if (v >= vertex_count) {
-        return make_error(ErrorCode::kInvalidMesh, "face " + std::to_string(f) +
-                                                       " refers to a vertex that does not exist");
+        return make_error(ErrorCode::kInvalidMesh,
+                          "face " + std::to_string(f) + " refers to a vertex that does not exist");
       }
     }
   }
   raw.vertices_in_file = vertex_count;
 
-  auto optional = [&](draco::GeometryAttribute::Type type, const char* name, auto& target,
-                      auto tag, float fill) {
+  auto optional = [&](draco::GeometryAttribute::Type type, const char* name, auto& target, auto tag,
+                      float fill) {
     const draco::PointAttribute* attribute = dm.GetNamedAttribute(type);
     if (attribute == nullptr) return;
     using V = typename std::remove_reference_t<decltype(target)>::value_type;
@@ -199,8 +201,8 @@ Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext)
   };
   optional(draco::GeometryAttribute::NORMAL, "normals", mesh.normals,
            std::integral_constant<int, 3>{}, 0.0f);
-  optional(draco::GeometryAttribute::COLOR, "colors", mesh.colors,
-           std::integral_constant<int, 4>{}, 1.0f);
+  optional(draco::GeometryAttribute::COLOR, "colors", mesh.colors, std::integral_constant<int, 4>{},
+           1.0f);
   optional(draco::GeometryAttribute::TEX_COORD, "texture coordinates", mesh.texcoords,
            std::integral_constant<int, 2>{}, 0.0f);
   return raw;

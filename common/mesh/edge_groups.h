@@ -14,8 +14,8 @@ namespace meshstream {
 // `local` to corner (local + 1) % 3.
 struct EdgeUse {
   uint32_t face;
-  uint8_t local;    // 0..2
-  bool forward;     // the face walks the edge from `lo` to `hi`
+  uint8_t local;  // 0..2
+  bool forward;   // the face walks the edge from `lo` to `hi`
 };
 
 // All edges, grouped: edge k is (lo[k], hi[k]) with lo < hi and its uses are

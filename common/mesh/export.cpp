@@ -29,8 +29,14 @@ using File = std::unique_ptr<std::FILE, FileCloser>;
 class Writer {
  public:
   explicit Writer(std::FILE* file) : file_(file) { buffer_.reserve(kBlock + 256); }
-  void text(const char* s) { buffer_ += s; maybe_flush(); }
-  void text(const std::string& s) { buffer_ += s; maybe_flush(); }
+  void text(const char* s) {
+    buffer_ += s;
+    maybe_flush();
+  }
+  void text(const std::string& s) {
+    buffer_ += s;
+    maybe_flush();
+  }
   void number(float x) {
     char tmp[32];
     auto [end, ec] = std::to_chars(tmp, tmp + sizeof(tmp), x);
@@ -56,7 +62,8 @@ class Writer {
 
  private:
   void flush() {
-    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
+    if (!buffer_.empty() &&
+        std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
       ok_ = false;
     }
     buffer_.clear();
@@ -77,7 +84,8 @@ Status open_for_writing(const std::string& path, File& file) {
 
 Status check_writable(const Mesh& mesh, const std::string& path) {
   if (auto status = validate_arrays(mesh); !status) {
-    return make_error(ErrorCode::kInvalidMesh, path + ": refusing to write: " + status.error().message);
+    return make_error(ErrorCode::kInvalidMesh,
+                      path + ": refusing to write: " + status.error().message);
   }
   return {};
 }
@@ -113,13 +121,15 @@ Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding
   out.text("property float x\nproperty float y\nproperty float z\n");
   if (normals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
   if (colors) {
-    out.text("property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n");
+    out.text(
+        "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n");
   }
   if (texcoords) out.text("property float u\nproperty float v\n");
   out.text("element face " + std::to_string(mesh.face_count()) + "\n");
   out.text("property list uchar int vertex_indices\nend_header\n");
 
-  static_assert(std::endian::native == std::endian::little, "binary PLY writer assumes little-endian");
+  static_assert(std::endian::native == std::endian::little,
+                "binary PLY writer assumes little-endian");
   for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
     if (binary) {
       out.raw(&mesh.positions[v], 12);
@@ -186,7 +196,8 @@ Status write_obj(const Mesh& mesh, const std::string& path) {
   }
   if (normals) {
     for (const Vec3f& n : mesh.normals) {
-      out.text("vn "), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '), out.number(n.z);
+      out.text("vn "), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '),
+          out.number(n.z);
       out.put('\n');
     }
   }

@@ -11,7 +11,8 @@ namespace meshstream {
 
 enum class PlyEncoding { kBinary, kAscii };
 
-Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding = PlyEncoding::kBinary);
+Status write_ply(const Mesh& mesh, const std::string& path,
+                 PlyEncoding encoding = PlyEncoding::kBinary);
 Status write_obj(const Mesh& mesh, const std::string& path);
 // By extension: .ply (binary), .obj. kInvalidArgument for anything else.
 Status write_mesh(const Mesh& mesh, const std::string& path);

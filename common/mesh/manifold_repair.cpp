@@ -247,7 +247,8 @@ std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& g
     for (uint32_t i = first; i < first + count; ++i) {
       for (uint32_t k = i + 1; k < first + count; ++k) {
         if (groups.uses[i].forward == groups.uses[k].forward) continue;
-        const float score = dot(face_normal(mesh, groups.uses[i].face), face_normal(mesh, groups.uses[k].face));
+        const float score =
+            dot(face_normal(mesh, groups.uses[i].face), face_normal(mesh, groups.uses[k].face));
         if (score > best) {
           best = score;
           keep_a = i;
@@ -296,8 +297,8 @@ Status check_manifold(const Mesh& mesh) {
     }
     if (count == 2 && uses[0].forward == uses[1].forward) {
       return make_error(ErrorCode::kNonManifold,
-                        "inconsistent orientation: faces " + std::to_string(uses[0].face) + " and " +
-                            std::to_string(uses[1].face) + " walk the " +
+                        "inconsistent orientation: faces " + std::to_string(uses[0].face) +
+                            " and " + std::to_string(uses[1].face) + " walk the " +
                             edge_name(mesh, groups.lo[e], groups.hi[e]) + " in the same direction");
     }
   }
@@ -309,8 +310,8 @@ Status check_manifold(const Mesh& mesh) {
     if (first_root[v] == kNone) {
       first_root[v] = root;
     } else if (first_root[v] != root) {
-      return make_error(ErrorCode::kNonManifold,
-                        "non-manifold vertex: " + where(mesh, v) + " joins several separate fans of faces");
+      return make_error(ErrorCode::kNonManifold, "non-manifold vertex: " + where(mesh, v) +
+                                                     " joins several separate fans of faces");
     }
   }
   return {};
@@ -343,7 +344,8 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
     last_problem = adjacency.error().message;
     if (*flipped == 0 && split == 0) break;  // stuck
   }
-  return make_error(ErrorCode::kNonManifold, "non-manifold repair did not converge: " + last_problem);
+  return make_error(ErrorCode::kNonManifold,
+                    "non-manifold repair did not converge: " + last_problem);
 }
 
 }  // namespace meshstream

@@ -21,24 +21,23 @@ Status validate_arrays(const Mesh& mesh) {
   auto attribute_ok = [n](size_t size) { return size == 0 || size == n; };
   if (!attribute_ok(mesh.normals.size()) || !attribute_ok(mesh.colors.size()) ||
       !attribute_ok(mesh.texcoords.size())) {
-    return make_error(ErrorCode::kInvalidMesh,
-                      "per-vertex attribute count does not match the " + std::to_string(n) +
-                          " vertices");
+    return make_error(ErrorCode::kInvalidMesh, "per-vertex attribute count does not match the " +
+                                                   std::to_string(n) + " vertices");
   }
   for (size_t v = 0; v < n; ++v) {
     const Vec3f& p = mesh.positions[v];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return make_error(ErrorCode::kInvalidMesh,
-                        "vertex " + std::to_string(v) + " has a non-finite coordinate (NaN or Inf)");
+      return make_error(ErrorCode::kInvalidMesh, "vertex " + std::to_string(v) +
+                                                     " has a non-finite coordinate (NaN or Inf)");
     }
   }
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
     const Triangle& t = mesh.triangles[f];
     for (uint32_t i : t) {
       if (i >= n) {
-        return make_error(ErrorCode::kInvalidMesh,
-                          "triangle " + std::to_string(f) + " refers to vertex " +
-                              std::to_string(i) + " but there are only " + std::to_string(n));
+        return make_error(ErrorCode::kInvalidMesh, "triangle " + std::to_string(f) +
+                                                       " refers to vertex " + std::to_string(i) +
+                                                       " but there are only " + std::to_string(n));
       }
     }
     if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {

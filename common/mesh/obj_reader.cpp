@@ -71,7 +71,8 @@ std::string_view next_token(std::string_view& rest) {
 // "nan" are accepted (the caller decides what a non-finite value means).
 // Magnitudes beyond float range become +-Inf, below it 0, as strtof does.
 bool parse_float(std::string_view token, float& value) {
-  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') token.remove_prefix(1);
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+')
+    token.remove_prefix(1);
   const char* end = token.data() + token.size();
   auto [ptr, ec] = std::from_chars(token.data(), end, value);
   if (ec == std::errc::result_out_of_range) {
@@ -86,14 +87,16 @@ bool parse_float(std::string_view token, float& value) {
       const size_t dot = std::min(mantissa.find('.'), mantissa.size());
       const size_t first = mantissa.find_first_of("123456789");
       int64_t magnitude = first == std::string_view::npos ? 0
-                          : first < dot ? static_cast<int64_t>(dot - first) - 1
-                                        : -static_cast<int64_t>(first - dot);
+                          : first < dot                   ? static_cast<int64_t>(dot - first) - 1
+                                                          : -static_cast<int64_t>(first - dot);
       if (e != std::string_view::npos) {
         std::string_view exponent = token.substr(e + 1);
         if (!exponent.empty() && exponent[0] == '+') exponent.remove_prefix(1);
         int64_t value10 = 0;
-        auto [eptr, eec] = std::from_chars(exponent.data(), exponent.data() + exponent.size(), value10);
-        if (eec == std::errc::result_out_of_range) value10 = exponent[0] == '-' ? -(1ll << 40) : (1ll << 40);
+        auto [eptr, eec] =
+            std::from_chars(exponent.data(), exponent.data() + exponent.size(), value10);
+        if (eec == std::errc::result_out_of_range)
+          value10 = exponent[0] == '-' ? -(1ll << 40) : (1ll << 40);
         magnitude += std::clamp<int64_t>(value10, -(1ll << 40), 1ll << 40);
       }
       wide = magnitude < 0 ? 0.0 : HUGE_VAL;
@@ -118,9 +121,12 @@ std::string describe(const float* values, int n) {
   std::string out = "(";
   for (int i = 0; i < n; ++i) {
     if (i) out += ", ";
-    if (std::isnan(values[i])) out += "NaN";
-    else if (std::isinf(values[i])) out += values[i] > 0 ? "Inf" : "-Inf";
-    else out += std::to_string(values[i]);
+    if (std::isnan(values[i]))
+      out += "NaN";
+    else if (std::isinf(values[i]))
+      out += values[i] > 0 ? "Inf" : "-Inf";
+    else
+      out += std::to_string(values[i]);
   }
   return out + ")";
 }
@@ -129,11 +135,11 @@ std::string describe(const float* values, int n) {
 // grouping, smoothing, materials, and free-form geometry.
 bool is_ignored_keyword(std::string_view k) {
   static const std::string_view kIgnored[] = {
-      "o",      "g",     "s",       "usemtl",  "mtllib",   "vp",       "cstype",     "deg",
-      "bmat",   "step",  "curv",    "curv2",   "surf",     "parm",     "trim",       "hole",
-      "scrv",   "sp",    "end",     "con",     "mg",       "lod",      "usemap",     "maplib",
-      "bevel",  "c_interp", "d_interp", "shadow_obj", "trace_obj", "ctech", "stech", "call",
-      "csh"};
+      "o",         "g",      "s",      "usemtl", "mtllib",   "vp",       "cstype",
+      "deg",       "bmat",   "step",   "curv",   "curv2",    "surf",     "parm",
+      "trim",      "hole",   "scrv",   "sp",     "end",      "con",      "mg",
+      "lod",       "usemap", "maplib", "bevel",  "c_interp", "d_interp", "shadow_obj",
+      "trace_obj", "ctech",  "stech",  "call",   "csh"};
   return std::find(std::begin(kIgnored), std::end(kIgnored), k) != std::end(kIgnored);
 }
 
@@ -212,11 +218,10 @@ Status ObjParser::parse_vertex(std::string_view rest) {
     ++n;
   }
   if (n != 3 && n != 4 && n != 6) {
-    return make_error(ErrorCode::kParse, at_line(line_) + "vertex " +
-                                             std::to_string(positions_.size()) +
-                                             ": 'v' needs x y z, x y z w or x y z r g b; found " +
-                                             (n == 8 ? std::string("more than 7") : std::to_string(n)) +
-                                             " numbers");
+    return make_error(ErrorCode::kParse,
+                      at_line(line_) + "vertex " + std::to_string(positions_.size()) +
+                          ": 'v' needs x y z, x y z w or x y z r g b; found " +
+                          (n == 8 ? std::string("more than 7") : std::to_string(n)) + " numbers");
   }
   if (!finite(values, 3)) {
     return make_error(ErrorCode::kInvalidMesh,
@@ -231,11 +236,12 @@ Status ObjParser::parse_vertex(std::string_view rest) {
   // geometry; Draco ignores it too.
   if (n == 6) {
     if (!finite(values + 3, 3)) {
-      return make_error(ErrorCode::kParse, at_line(line_) + "vertex " +
-                                               std::to_string(positions_.size() - 1) +
-                                               " has a non-finite colour " + describe(values + 3, 3));
+      return make_error(ErrorCode::kParse,
+                        at_line(line_) + "vertex " + std::to_string(positions_.size() - 1) +
+                            " has a non-finite colour " + describe(values + 3, 3));
     }
-    if (vertices_with_color_ + 1 == positions_.size()) colors_.push_back({values[3], values[4], values[5]});
+    if (vertices_with_color_ + 1 == positions_.size())
+      colors_.push_back({values[3], values[4], values[5]});
     ++vertices_with_color_;
   }
   return {};
@@ -252,8 +258,8 @@ Status ObjParser::parse_normal(std::string_view rest) {
     ++count;
   }
   if (count != 3) {
-    return make_error(ErrorCode::kParse, at_line(line_) + "'vn' needs three numbers, found " +
-                                             std::to_string(count));
+    return make_error(ErrorCode::kParse,
+                      at_line(line_) + "'vn' needs three numbers, found " + std::to_string(count));
   }
   if (!finite(n, 3) && first_bad_normal_line_ == 0) first_bad_normal_line_ = line_;
   normals_.push_back({n[0], n[1], n[2]});
@@ -265,8 +271,8 @@ Status ObjParser::parse_texcoord(std::string_view rest) {
   int count = 0;
   for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest)) {
     if (count == 3 || !parse_float(token, t[count])) {
-      return make_error(ErrorCode::kParse, at_line(line_) + "'vt' needs u [v [w]] (" + quoted(token) +
-                                               " is one too many or not a number)");
+      return make_error(ErrorCode::kParse, at_line(line_) + "'vt' needs u [v [w]] (" +
+                                               quoted(token) + " is one too many or not a number)");
     }
     ++count;
   }
@@ -282,11 +288,12 @@ Status ObjParser::resolve(int64_t written, std::string_view token, const char* w
                           LargestIndex& largest, uint32_t& out) {
   if (written > 0) {
     if (written >= static_cast<int64_t>(kAbsent)) {
-      return make_error(ErrorCode::kInvalidMesh, at_line(line_) + "face corner " + quoted(token) +
-                                                     " refers to " + what + " " +
-                                                     std::to_string(written) + ", far beyond any file");
+      return make_error(ErrorCode::kInvalidMesh,
+                        at_line(line_) + "face corner " + quoted(token) + " refers to " + what +
+                            " " + std::to_string(written) + ", far beyond any file");
     }
-    if (static_cast<uint64_t>(written) > largest.index) largest = {static_cast<uint64_t>(written), line_};
+    if (static_cast<uint64_t>(written) > largest.index)
+      largest = {static_cast<uint64_t>(written), line_};
     out = static_cast<uint32_t>(written - 1);
     return {};
   }
@@ -295,10 +302,10 @@ Status ObjParser::resolve(int64_t written, std::string_view token, const char* w
                                              " has index 0 (OBJ counts from 1, or back from -1)");
   }
   if (written < -static_cast<int64_t>(count)) {  // not -written: INT64_MIN has no negation
-    return make_error(ErrorCode::kInvalidMesh,
-                      at_line(line_) + "face corner " + quoted(token) + ": relative index " +
-                          std::to_string(written) + " reaches before the first " + what + " (" +
-                          std::to_string(count) + " defined so far)");
+    return make_error(ErrorCode::kInvalidMesh, at_line(line_) + "face corner " + quoted(token) +
+                                                   ": relative index " + std::to_string(written) +
+                                                   " reaches before the first " + what + " (" +
+                                                   std::to_string(count) + " defined so far)");
   }
   out = static_cast<uint32_t>(static_cast<int64_t>(count) + written);
   return {};
@@ -354,12 +361,15 @@ Status ObjParser::parse_corner(const char*& p, const char* end, Corner& corner) 
     return s;
   }
   if (has_vt) {
-    if (auto s = resolve(vt, token(), "texture coordinate", texcoords_.size(), largest_vt_, corner.vt); !s) {
+    if (auto s =
+            resolve(vt, token(), "texture coordinate", texcoords_.size(), largest_vt_, corner.vt);
+        !s) {
       return s;
     }
   }
   if (has_vn) {
-    if (auto s = resolve(vn, token(), "normal", normals_.size(), largest_vn_, corner.vn); !s) return s;
+    if (auto s = resolve(vn, token(), "normal", normals_.size(), largest_vn_, corner.vn); !s)
+      return s;
   }
   return {};
 }
@@ -391,11 +401,13 @@ Status ObjParser::parse_face(std::string_view rest) {
     polygon_.push_back(corner);
   }
   if (polygon_.size() < 3) {
-    return make_error(ErrorCode::kParse, at_line(line_) + "a face needs at least 3 corners, found " +
+    return make_error(ErrorCode::kParse, at_line(line_) +
+                                             "a face needs at least 3 corners, found " +
                                              std::to_string(polygon_.size()));
   }
   // Fan from the first corner, as Draco and the manifest's tool triangulate.
-  for (size_t k = 2; k < polygon_.size(); ++k) add_triangle(polygon_[0], polygon_[k - 1], polygon_[k]);
+  for (size_t k = 2; k < polygon_.size(); ++k)
+    add_triangle(polygon_[0], polygon_[k - 1], polygon_[k]);
   return {};
 }
 
@@ -420,9 +432,10 @@ Status ObjParser::parse_line(std::string_view line) {
 Status ObjParser::check_largest(const LargestIndex& largest, const char* what, const char* keyword,
                                 size_t count) const {
   if (largest.index <= count) return {};
-  return make_error(ErrorCode::kInvalidMesh, at_line(largest.line) + "a face refers to " + what + " " +
-                                                 std::to_string(largest.index) + " but the file has " +
-                                                 std::to_string(count) + " '" + keyword + "' lines");
+  return make_error(ErrorCode::kInvalidMesh, at_line(largest.line) + "a face refers to " + what +
+                                                 " " + std::to_string(largest.index) +
+                                                 " but the file has " + std::to_string(count) +
+                                                 " '" + keyword + "' lines");
 }
 
 // Per-corner values to per-vertex ones, the way the Draco path did it: kept
@@ -430,7 +443,8 @@ Status ObjParser::check_largest(const LargestIndex& largest, const char* what, c
 // dropped with a note. Unreferenced vertices get zeros.
 template <class V>
 bool gather(const std::vector<Triangle>& triangles, const std::vector<uint32_t>& corner_index,
-            const std::vector<V>& values, uint32_t vertex_count, std::vector<V>& out, bool& some_missing) {
+            const std::vector<V>& values, uint32_t vertex_count, std::vector<V>& out,
+            bool& some_missing) {
   out.assign(vertex_count, V{});
   std::vector<uint8_t> set(vertex_count, 0);
   some_missing = false;
@@ -476,7 +490,8 @@ void ObjParser::gather_attributes(RawMesh& raw) {
     }
   };
   attribute(normals_, corner_vn_, mesh.normals, "normals", "vn", first_bad_normal_line_);
-  attribute(texcoords_, corner_vt_, mesh.texcoords, "texture coordinates", "vt", first_bad_texcoord_line_);
+  attribute(texcoords_, corner_vt_, mesh.texcoords, "texture coordinates", "vt",
+            first_bad_texcoord_line_);
 
   if (vertices_with_color_ == n && n > 0) {
     // 0..1 floats, or 0..255 integers when any value exceeds 1 (both occur).
@@ -526,14 +541,16 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
     bool continued = false;
     joined_.clear();
     for (;;) {
-      const char* nl = static_cast<const char*>(std::memchr(text.data() + pos, '\n', text.size() - pos));
+      const char* nl =
+          static_cast<const char*>(std::memchr(text.data() + pos, '\n', text.size() - pos));
       const size_t end = nl ? static_cast<size_t>(nl - text.data()) : text.size();
       std::string_view physical = text.substr(pos, end - pos);
       pos = end + 1;
       if (const size_t hash = physical.find('#'); hash != std::string_view::npos) {
         physical = physical.substr(0, hash);
       }
-      while (!physical.empty() && (physical.back() == '\r' || physical.back() == ' ' || physical.back() == '\t')) {
+      while (!physical.empty() &&
+             (physical.back() == '\r' || physical.back() == ' ' || physical.back() == '\t')) {
         physical.remove_suffix(1);
       }
       bool continues = !physical.empty() && physical.back() == '\\';
@@ -561,11 +578,13 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
     line_ = last_line;
   }
 
-  if (auto s = check_largest(largest_v_, "vertex", "v", positions_.size()); !s) return tl::unexpected(s.error());
+  if (auto s = check_largest(largest_v_, "vertex", "v", positions_.size()); !s)
+    return tl::unexpected(s.error());
   if (auto s = check_largest(largest_vt_, "texture coordinate", "vt", texcoords_.size()); !s) {
     return tl::unexpected(s.error());
   }
-  if (auto s = check_largest(largest_vn_, "normal", "vn", normals_.size()); !s) return tl::unexpected(s.error());
+  if (auto s = check_largest(largest_vn_, "normal", "vn", normals_.size()); !s)
+    return tl::unexpected(s.error());
 
   RawMesh raw;
   raw.vertices_in_file = static_cast<uint32_t>(positions_.size());
@@ -578,8 +597,8 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
                         " point elements ('p') skipped: only faces are read");
   }
   if (unknown_lines_ > 0) {
-    raw.notes.push_back(std::to_string(unknown_lines_) + " lines with an unknown keyword ignored (first: " +
-                        first_unknown_ + ")");
+    raw.notes.push_back(std::to_string(unknown_lines_) +
+                        " lines with an unknown keyword ignored (first: " + first_unknown_ + ")");
   }
   return raw;
 }

@@ -115,13 +115,14 @@ Result<RawMesh> read_off(const std::string& path) {
   size_t first_count = 0;
   if (parse_keyword(tokens[0], layout, unsupported)) {
     if (unsupported) {
-      return make_error(ErrorCode::kUnsupported,
-                        at_line(reader.line_number()) + "OFF variant '" + std::string(tokens[0]) +
-                            "' is not supported (only 3-D [ST][C][N]OFF)");
+      return make_error(ErrorCode::kUnsupported, at_line(reader.line_number()) + "OFF variant '" +
+                                                     std::string(tokens[0]) +
+                                                     "' is not supported (only 3-D [ST][C][N]OFF)");
     }
     first_count = 1;
     if (tokens.size() == 1) {
-      if (!reader.next(line)) return make_error(ErrorCode::kTruncated, "OFF file ends after its keyword");
+      if (!reader.next(line))
+        return make_error(ErrorCode::kTruncated, "OFF file ends after its keyword");
       split(line, tokens);
       first_count = 0;
     }
@@ -129,8 +130,8 @@ Result<RawMesh> read_off(const std::string& path) {
   uint64_t vertex_count = 0, face_count = 0;
   if (tokens.size() < first_count + 2 || !parse_uint(tokens[first_count], vertex_count) ||
       !parse_uint(tokens[first_count + 1], face_count)) {
-    return make_error(ErrorCode::kParse, at_line(reader.line_number()) +
-                                             "expected 'vertices faces edges' counts");
+    return make_error(ErrorCode::kParse,
+                      at_line(reader.line_number()) + "expected 'vertices faces edges' counts");
   }
   // Every vertex needs at least 6 bytes ("0 0 0\n"), every face 8: counts that
   // cannot fit in the file are lies, refused before allocating for them.
@@ -167,8 +168,8 @@ Result<RawMesh> read_off(const std::string& path) {
     for (size_t k = 0; k < needed + color_tokens; ++k) {
       if (!parse_float(tokens[k], values[k])) {
         return make_error(ErrorCode::kParse, at_line(reader.line_number()) + "vertex " +
-                                                 std::to_string(v) + ": '" + std::string(tokens[k]) +
-                                                 "' is not a number");
+                                                 std::to_string(v) + ": '" +
+                                                 std::string(tokens[k]) + "' is not a number");
       }
     }
     size_t k = 0;
@@ -205,12 +206,13 @@ Result<RawMesh> read_off(const std::string& path) {
     uint64_t corners = 0;
     if (tokens.empty() || !parse_uint(tokens[0], corners)) {
       return make_error(ErrorCode::kParse, at_line(reader.line_number()) + "face " +
-                                               std::to_string(f) + " must start with its vertex count");
+                                               std::to_string(f) +
+                                               " must start with its vertex count");
     }
     if (corners < 3) {
-      return make_error(ErrorCode::kParse, at_line(reader.line_number()) + "face " +
-                                               std::to_string(f) + " has " + std::to_string(corners) +
-                                               " vertices; a polygon needs at least 3");
+      return make_error(ErrorCode::kParse,
+                        at_line(reader.line_number()) + "face " + std::to_string(f) + " has " +
+                            std::to_string(corners) + " vertices; a polygon needs at least 3");
     }
     if (tokens.size() < corners + 1) {
       return make_error(ErrorCode::kParse, at_line(reader.line_number()) + "face " +
@@ -222,16 +224,15 @@ Result<RawMesh> read_off(const std::string& path) {
     for (uint64_t k = 0; k < corners; ++k) {
       uint64_t index = 0;
       if (!parse_uint(tokens[k + 1], index)) {
-        return make_error(ErrorCode::kParse, at_line(reader.line_number()) + "face " +
-                                                 std::to_string(f) + ": '" +
-                                                 std::string(tokens[k + 1]) +
-                                                 "' is not a vertex index");
+        return make_error(ErrorCode::kParse,
+                          at_line(reader.line_number()) + "face " + std::to_string(f) + ": '" +
+                              std::string(tokens[k + 1]) + "' is not a vertex index");
       }
       if (index >= vertex_count) {
         return make_error(ErrorCode::kInvalidMesh,
                           at_line(reader.line_number()) + "face " + std::to_string(f) +
-                              " refers to vertex " + std::to_string(index) + " but there are only " +
-                              std::to_string(vertex_count));
+                              " refers to vertex " + std::to_string(index) +
+                              " but there are only " + std::to_string(vertex_count));
       }
       const uint32_t i = static_cast<uint32_t>(index);
       if (k == 0) first = i;

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <bit>
 #include <cctype>
-#include <cmath>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -23,12 +23,13 @@ bool parse_scalar_type(std::string_view name, Scalar& type) {
   static const struct {
     const char* name;
     Scalar type;
-  } kTypes[] = {{"char", Scalar::kInt8},     {"int8", Scalar::kInt8},       {"uchar", Scalar::kUint8},
-                {"uint8", Scalar::kUint8},   {"short", Scalar::kInt16},     {"int16", Scalar::kInt16},
-                {"ushort", Scalar::kUint16}, {"uint16", Scalar::kUint16},   {"int", Scalar::kInt32},
-                {"int32", Scalar::kInt32},   {"uint", Scalar::kUint32},     {"uint32", Scalar::kUint32},
-                {"float", Scalar::kFloat32}, {"float32", Scalar::kFloat32}, {"double", Scalar::kFloat64},
-                {"float64", Scalar::kFloat64}};
+  } kTypes[] = {
+      {"char", Scalar::kInt8},      {"int8", Scalar::kInt8},       {"uchar", Scalar::kUint8},
+      {"uint8", Scalar::kUint8},    {"short", Scalar::kInt16},     {"int16", Scalar::kInt16},
+      {"ushort", Scalar::kUint16},  {"uint16", Scalar::kUint16},   {"int", Scalar::kInt32},
+      {"int32", Scalar::kInt32},    {"uint", Scalar::kUint32},     {"uint32", Scalar::kUint32},
+      {"float", Scalar::kFloat32},  {"float32", Scalar::kFloat32}, {"double", Scalar::kFloat64},
+      {"float64", Scalar::kFloat64}};
   for (const auto& t : kTypes) {
     if (name == t.name) {
       type = t.type;
@@ -40,10 +41,18 @@ bool parse_scalar_type(std::string_view name, Scalar& type) {
 
 size_t scalar_size(Scalar type) {
   switch (type) {
-    case Scalar::kInt8: case Scalar::kUint8: return 1;
-    case Scalar::kInt16: case Scalar::kUint16: return 2;
-    case Scalar::kInt32: case Scalar::kUint32: case Scalar::kFloat32: return 4;
-    case Scalar::kFloat64: return 8;
+    case Scalar::kInt8:
+    case Scalar::kUint8:
+      return 1;
+    case Scalar::kInt16:
+    case Scalar::kUint16:
+      return 2;
+    case Scalar::kInt32:
+    case Scalar::kUint32:
+    case Scalar::kFloat32:
+      return 4;
+    case Scalar::kFloat64:
+      return 8;
   }
   return 0;
 }
@@ -51,13 +60,20 @@ size_t scalar_size(Scalar type) {
 // Largest value of an integer type, to scale colours to 0..1.
 double integer_range(Scalar type) {
   switch (type) {
-    case Scalar::kInt8: return 127;
-    case Scalar::kUint8: return 255;
-    case Scalar::kInt16: return 32767;
-    case Scalar::kUint16: return 65535;
-    case Scalar::kInt32: return 2147483647.0;
-    case Scalar::kUint32: return 4294967295.0;
-    default: return 1;
+    case Scalar::kInt8:
+      return 127;
+    case Scalar::kUint8:
+      return 255;
+    case Scalar::kInt16:
+      return 32767;
+    case Scalar::kUint16:
+      return 65535;
+    case Scalar::kInt32:
+      return 2147483647.0;
+    case Scalar::kUint32:
+      return 4294967295.0;
+    default:
+      return 1;
   }
 }
 
@@ -96,17 +112,49 @@ class BodyReader {
     unsigned char bytes[8];
     std::memcpy(bytes, data_.data() + pos_, size);
     pos_ += size;
-    const bool swap = (encoding_ == Encoding::kBinaryBig) == (std::endian::native == std::endian::little);
+    const bool swap =
+        (encoding_ == Encoding::kBinaryBig) == (std::endian::native == std::endian::little);
     if (swap) std::reverse(bytes, bytes + size);
     switch (type) {
-      case Scalar::kInt8: value = static_cast<int8_t>(bytes[0]); break;
-      case Scalar::kUint8: value = bytes[0]; break;
-      case Scalar::kInt16: { int16_t x; std::memcpy(&x, bytes, 2); value = x; break; }
-      case Scalar::kUint16: { uint16_t x; std::memcpy(&x, bytes, 2); value = x; break; }
-      case Scalar::kInt32: { int32_t x; std::memcpy(&x, bytes, 4); value = x; break; }
-      case Scalar::kUint32: { uint32_t x; std::memcpy(&x, bytes, 4); value = x; break; }
-      case Scalar::kFloat32: { std::memcpy(&as_float, bytes, 4); value = as_float; return true; }
-      case Scalar::kFloat64: { std::memcpy(&value, bytes, 8); break; }
+      case Scalar::kInt8:
+        value = static_cast<int8_t>(bytes[0]);
+        break;
+      case Scalar::kUint8:
+        value = bytes[0];
+        break;
+      case Scalar::kInt16: {
+        int16_t x;
+        std::memcpy(&x, bytes, 2);
+        value = x;
+        break;
+      }
+      case Scalar::kUint16: {
+        uint16_t x;
+        std::memcpy(&x, bytes, 2);
+        value = x;
+        break;
+      }
+      case Scalar::kInt32: {
+        int32_t x;
+        std::memcpy(&x, bytes, 4);
+        value = x;
+        break;
+      }
+      case Scalar::kUint32: {
+        uint32_t x;
+        std::memcpy(&x, bytes, 4);
+        value = x;
+        break;
+      }
+      case Scalar::kFloat32: {
+        std::memcpy(&as_float, bytes, 4);
+        value = as_float;
+        return true;
+      }
+      case Scalar::kFloat64: {
+        std::memcpy(&value, bytes, 8);
+        break;
+      }
     }
     as_float = static_cast<float>(value);
     return true;
@@ -167,7 +215,8 @@ class BodyReader {
 int find_property(const Element& element, std::initializer_list<const char*> names) {
   for (const char* name : names) {
     for (size_t i = 0; i < element.properties.size(); ++i) {
-      if (!element.properties[i].is_list && element.properties[i].name == name) return static_cast<int>(i);
+      if (!element.properties[i].is_list && element.properties[i].name == name)
+        return static_cast<int>(i);
     }
   }
   return -1;
@@ -197,10 +246,12 @@ Result<RawMesh> read_ply(const std::string& path) {
     return true;
   };
   auto header_error = [&](const std::string& what) {
-    return make_error(ErrorCode::kParse, "PLY header line " + std::to_string(line_number) + ": " + what);
+    return make_error(ErrorCode::kParse,
+                      "PLY header line " + std::to_string(line_number) + ": " + what);
   };
   std::string_view line;
-  if (!next_line(line) || line != "ply") return make_error(ErrorCode::kParse, "not a PLY file (no 'ply' magic)");
+  if (!next_line(line) || line != "ply")
+    return make_error(ErrorCode::kParse, "not a PLY file (no 'ply' magic)");
   Encoding encoding = Encoding::kAscii;
   bool have_format = false, have_end = false;
   std::vector<Element> elements;
@@ -216,10 +267,14 @@ Result<RawMesh> read_ply(const std::string& path) {
     if (keyword == "format") {
       std::string name, version;
       words >> name >> version;
-      if (name == "ascii") encoding = Encoding::kAscii;
-      else if (name == "binary_little_endian") encoding = Encoding::kBinaryLittle;
-      else if (name == "binary_big_endian") encoding = Encoding::kBinaryBig;
-      else return header_error("unknown format '" + name + "'");
+      if (name == "ascii")
+        encoding = Encoding::kAscii;
+      else if (name == "binary_little_endian")
+        encoding = Encoding::kBinaryLittle;
+      else if (name == "binary_big_endian")
+        encoding = Encoding::kBinaryBig;
+      else
+        return header_error("unknown format '" + name + "'");
       have_format = true;
     } else if (keyword == "element") {
       Element element;
@@ -240,7 +295,8 @@ Result<RawMesh> read_ply(const std::string& path) {
         }
       } else {
         words >> property.name;
-        if (!parse_scalar_type(type, property.type)) return header_error("unknown type '" + type + "'");
+        if (!parse_scalar_type(type, property.type))
+          return header_error("unknown type '" + type + "'");
       }
       if (property.name.empty()) return header_error("property without a name");
       elements.back().properties.push_back(std::move(property));
@@ -256,7 +312,8 @@ Result<RawMesh> read_ply(const std::string& path) {
   const size_t body_size = data.size() - std::min(pos, data.size());
   for (const Element& e : elements) {
     if (e.count > body_size + 1) {
-      return make_error(ErrorCode::kParse, "element '" + e.name + "' claims " + std::to_string(e.count) +
+      return make_error(ErrorCode::kParse, "element '" + e.name + "' claims " +
+                                               std::to_string(e.count) +
                                                " entries but the data has only " +
                                                std::to_string(body_size) + " bytes");
     }
@@ -279,12 +336,16 @@ Result<RawMesh> read_ply(const std::string& path) {
   for (const Element& element : elements) {
     const bool is_vertex = element.name == "vertex" && !have_vertices;
     const bool is_face = element.name == "face" && !have_faces;
-    int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1, r = -1, g = -1, b = -1, a = -1, u = -1, v = -1;
+    int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1, r = -1, g = -1, b = -1, a = -1, u = -1,
+        v = -1;
     int indices = -1;
     if (is_vertex) {
-      x = find_property(element, {"x"}), y = find_property(element, {"y"}), z = find_property(element, {"z"});
-      if (x < 0 || y < 0 || z < 0) return make_error(ErrorCode::kParse, "PLY vertices have no x, y, z");
-      nx = find_property(element, {"nx"}), ny = find_property(element, {"ny"}), nz = find_property(element, {"nz"});
+      x = find_property(element, {"x"}), y = find_property(element, {"y"}),
+      z = find_property(element, {"z"});
+      if (x < 0 || y < 0 || z < 0)
+        return make_error(ErrorCode::kParse, "PLY vertices have no x, y, z");
+      nx = find_property(element, {"nx"}), ny = find_property(element, {"ny"}),
+      nz = find_property(element, {"nz"});
       r = find_property(element, {"red", "r", "diffuse_red"});
       g = find_property(element, {"green", "g", "diffuse_green"});
       b = find_property(element, {"blue", "b", "diffuse_blue"});
@@ -301,13 +362,15 @@ Result<RawMesh> read_ply(const std::string& path) {
     if (is_face) {
       for (size_t i = 0; i < element.properties.size() && indices < 0; ++i) {
         const Property& p = element.properties[i];
-        if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) indices = static_cast<int>(i);
+        if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"))
+          indices = static_cast<int>(i);
       }
       for (size_t i = 0; i < element.properties.size() && indices < 0; ++i) {
         if (element.properties[i].is_list) indices = static_cast<int>(i);
       }
       if (indices < 0) return make_error(ErrorCode::kParse, "PLY faces have no vertex index list");
-      if (!have_vertices) return make_error(ErrorCode::kParse, "PLY faces come before the vertices");
+      if (!have_vertices)
+        return make_error(ErrorCode::kParse, "PLY faces come before the vertices");
       mesh.triangles.reserve(std::min<uint64_t>(element.count * 2, body_size));
       have_faces = true;
     }
@@ -326,8 +389,9 @@ Result<RawMesh> read_ply(const std::string& path) {
         float unused = 0;
         if (!reader.read(property.count_type, count_value, unused)) return body_error(where);
         if (count_value < 0 || count_value > 1e6) {
-          return make_error(ErrorCode::kParse, where + ": list length " + std::to_string(count_value) +
-                                                   " is out of range");
+          return make_error(
+              ErrorCode::kParse,
+              where + ": list length " + std::to_string(count_value) + " is out of range");
         }
         const bool keep = is_face && static_cast<int>(p) == indices;
         polygon.clear();
@@ -336,9 +400,9 @@ Result<RawMesh> read_ply(const std::string& path) {
           if (!reader.read(property.type, item, unused)) return body_error(where);
           if (!keep) continue;
           if (item < 0 || item >= static_cast<double>(vertex_count) || item != std::floor(item)) {
-            return make_error(ErrorCode::kInvalidMesh, where + " refers to vertex " + std::to_string(item) +
-                                                           " but there are only " +
-                                                           std::to_string(vertex_count));
+            return make_error(ErrorCode::kInvalidMesh,
+                              where + " refers to vertex " + std::to_string(item) +
+                                  " but there are only " + std::to_string(vertex_count));
           }
           polygon.push_back(static_cast<uint32_t>(item));
         }
@@ -347,7 +411,8 @@ Result<RawMesh> read_ply(const std::string& path) {
             return make_error(ErrorCode::kParse, where + " has " + std::to_string(polygon.size()) +
                                                      " vertices; a polygon needs at least 3");
           }
-          for (size_t i = 2; i < polygon.size(); ++i) mesh.triangles.push_back({polygon[0], polygon[i - 1], polygon[i]});
+          for (size_t i = 2; i < polygon.size(); ++i)
+            mesh.triangles.push_back({polygon[0], polygon[i - 1], polygon[i]});
         }
       }
       if (is_vertex) {
@@ -357,7 +422,8 @@ Result<RawMesh> read_ply(const std::string& path) {
           auto channel = [&](int index) {
             const Property& prop = element.properties[index];
             const bool integer = prop.type != Scalar::kFloat32 && prop.type != Scalar::kFloat64;
-            return integer ? static_cast<float>(values[index] / integer_range(prop.type)) : floats[index];
+            return integer ? static_cast<float>(values[index] / integer_range(prop.type))
+                           : floats[index];
           };
           mesh.colors[k] = {channel(r), channel(g), channel(b), a >= 0 ? channel(a) : 1.0f};
         }

@@ -27,18 +27,30 @@ uint32_t hash3(int32_t x, int32_t y, int32_t z) {
 double gradient(uint32_t h, double x, double y, double z) {
   // The 12 edge directions of a cube, as in Perlin 2002.
   switch (h % 12) {
-    case 0: return x + y;
-    case 1: return -x + y;
-    case 2: return x - y;
-    case 3: return -x - y;
-    case 4: return x + z;
-    case 5: return -x + z;
-    case 6: return x - z;
-    case 7: return -x - z;
-    case 8: return y + z;
-    case 9: return -y + z;
-    case 10: return y - z;
-    default: return -y - z;
+    case 0:
+      return x + y;
+    case 1:
+      return -x + y;
+    case 2:
+      return x - y;
+    case 3:
+      return -x - y;
+    case 4:
+      return x + z;
+    case 5:
+      return -x + z;
+    case 6:
+      return x - z;
+    case 7:
+      return -x - z;
+    case 8:
+      return y + z;
+    case 9:
+      return -y + z;
+    case 10:
+      return y - z;
+    default:
+      return -y - z;
   }
 }
 
@@ -48,7 +60,8 @@ double lerp(double a, double b, double t) { return a + t * (b - a); }
 // Roughly in [-1, 1].
 double noise(Vec3d p) {
   const double fx = std::floor(p.x), fy = std::floor(p.y), fz = std::floor(p.z);
-  const int32_t X = static_cast<int32_t>(fx), Y = static_cast<int32_t>(fy), Z = static_cast<int32_t>(fz);
+  const int32_t X = static_cast<int32_t>(fx), Y = static_cast<int32_t>(fy),
+                Z = static_cast<int32_t>(fz);
   const double x = p.x - fx, y = p.y - fy, z = p.z - fz;
   const double u = fade(x), v = fade(y), w = fade(z);
   auto g = [&](int dx, int dy, int dz) {
@@ -119,7 +132,8 @@ Mesh make_demo_mesh(uint32_t target_faces) {
   constexpr double kAspect = 11.0;
   uint32_t around = static_cast<uint32_t>(std::lround(std::sqrt(target_faces / (2 * kAspect))));
   around = std::max<uint32_t>(around, 8);
-  const uint32_t along = std::max<uint32_t>(24, static_cast<uint32_t>(std::lround(target_faces / (2.0 * around))));
+  const uint32_t along =
+      std::max<uint32_t>(24, static_cast<uint32_t>(std::lround(target_faces / (2.0 * around))));
 
   Mesh mesh;
   mesh.positions.reserve(static_cast<size_t>(along) * around);
@@ -145,11 +159,12 @@ Mesh make_icosahedron() {
   const float s = 1.0f / std::sqrt(1 + p * p);
   const float a = s, b = p * s;
   Mesh m;
-  m.positions = {{-a, b, 0}, {a, b, 0}, {-a, -b, 0}, {a, -b, 0}, {0, -a, b}, {0, a, b},
-                 {0, -a, -b}, {0, a, -b}, {b, 0, -a}, {b, 0, a}, {-b, 0, -a}, {-b, 0, a}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  m.positions = {{-a, b, 0},  {a, b, 0},  {-a, -b, 0}, {a, -b, 0}, {0, -a, b},  {0, a, b},
+                 {0, -a, -b}, {0, a, -b}, {b, 0, -a},  {b, 0, a},  {-b, 0, -a}, {-b, 0, a}};
+  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   return m;
 }
 
@@ -206,7 +221,8 @@ Mesh make_multi_component(uint32_t count) {
     const uint32_t offset = m.vertex_count();
     const float shift = 2.5f * static_cast<float>(k);
     for (const Vec3f& p : sphere.positions) m.positions.push_back({p.x + shift, p.y, p.z});
-    for (const Triangle& t : sphere.triangles) m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    for (const Triangle& t : sphere.triangles)
+      m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
   }
   return m;
 }

@@ -46,12 +46,14 @@ Result<RawMesh> read_ascii_stl(const std::string& path) {
     Vec3f p;
     for (int i = 0; i < 3; ++i) {
       std::string_view number;
-      if (!next_token(number)) return make_error(ErrorCode::kTruncated, "line " + std::to_string(line) + ": the file ends inside a vertex");
+      if (!next_token(number))
+        return make_error(ErrorCode::kTruncated,
+                          "line " + std::to_string(line) + ": the file ends inside a vertex");
       const char* first = number.data() + (number[0] == '+' ? 1 : 0);
       auto [ptr, ec] = std::from_chars(first, number.data() + number.size(), p[i]);
       if (ec != std::errc() || ptr != number.data() + number.size()) {
-        return make_error(ErrorCode::kParse, "line " + std::to_string(line) + ": '" + std::string(number) +
-                                                 "' is not a number");
+        return make_error(ErrorCode::kParse, "line " + std::to_string(line) + ": '" +
+                                                 std::string(number) + "' is not a number");
       }
     }
     mesh.positions.push_back(p);

@@ -83,8 +83,10 @@ MeshStats compute_stats(const Mesh& mesh) {
       ++s.orientation_conflicts;
     }
     for (uint32_t k = 1; k < count; ++k) {
-      corner_sets.unite(corner_at(uses[0].face, groups.lo[e]), corner_at(uses[k].face, groups.lo[e]));
-      corner_sets.unite(corner_at(uses[0].face, groups.hi[e]), corner_at(uses[k].face, groups.hi[e]));
+      corner_sets.unite(corner_at(uses[0].face, groups.lo[e]),
+                        corner_at(uses[k].face, groups.lo[e]));
+      corner_sets.unite(corner_at(uses[0].face, groups.hi[e]),
+                        corner_at(uses[k].face, groups.hi[e]));
     }
   }
   for (uint32_t v = 0; v < n; ++v) {

@@ -14,17 +14,17 @@ struct MeshStats {
   uint32_t referenced_vertices = 0;  // used by at least one face
   uint32_t isolated_vertices = 0;    // vertices - referenced_vertices
   uint32_t faces = 0;
-  uint32_t invalid_faces = 0;        // out-of-range or repeated index: ignored below
-  uint32_t duplicate_faces = 0;      // same vertex set as an earlier face
-  uint32_t edges = 0;                // distinct undirected edges
-  uint32_t boundary_edges = 0;       // edges with one face
-  uint32_t boundary_loops = 0;       // connected groups of boundary edges
-  uint32_t components = 0;           // face-connected parts (a shared vertex connects)
-  uint32_t nonmanifold_edges = 0;    // edges with more than two faces
-  uint32_t nonmanifold_vertices = 0; // vertices whose faces form more than one fan
+  uint32_t invalid_faces = 0;          // out-of-range or repeated index: ignored below
+  uint32_t duplicate_faces = 0;        // same vertex set as an earlier face
+  uint32_t edges = 0;                  // distinct undirected edges
+  uint32_t boundary_edges = 0;         // edges with one face
+  uint32_t boundary_loops = 0;         // connected groups of boundary edges
+  uint32_t components = 0;             // face-connected parts (a shared vertex connects)
+  uint32_t nonmanifold_edges = 0;      // edges with more than two faces
+  uint32_t nonmanifold_vertices = 0;   // vertices whose faces form more than one fan
   uint32_t orientation_conflicts = 0;  // two-face edges walked twice in the same direction
-  int64_t euler = 0;                 // referenced_vertices - edges + faces (valid faces)
-  bool manifold = false;             // no non-manifold edge and no non-manifold vertex
+  int64_t euler = 0;                   // referenced_vertices - edges + faces (valid faces)
+  bool manifold = false;               // no non-manifold edge and no non-manifold vertex
   // (2 * components - euler - boundary_loops) / 2: meaningful only when manifold
   // and consistently oriented; genus_valid says so.
   int64_t genus = 0;

@@ -32,24 +32,65 @@ using Vec3f = Vec3<float>;
 using Vec4f = Vec4<float>;
 using Vec3d = Vec3<double>;
 
-template <class T> constexpr Vec3<T> operator+(Vec3<T> a, Vec3<T> b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-template <class T> constexpr Vec3<T> operator-(Vec3<T> a, Vec3<T> b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-template <class T> constexpr Vec3<T> operator-(Vec3<T> a) { return {-a.x, -a.y, -a.z}; }
-template <class T> constexpr Vec3<T> operator*(Vec3<T> a, T s) { return {a.x * s, a.y * s, a.z * s}; }
-template <class T> constexpr Vec3<T> operator*(T s, Vec3<T> a) { return {a.x * s, a.y * s, a.z * s}; }
-template <class T> constexpr Vec3<T> operator/(Vec3<T> a, T s) { return {a.x / s, a.y / s, a.z / s}; }
-template <class T> constexpr Vec3<T>& operator+=(Vec3<T>& a, Vec3<T> b) { a = a + b; return a; }
-template <class T> constexpr Vec3<T>& operator-=(Vec3<T>& a, Vec3<T> b) { a = a - b; return a; }
-template <class T> constexpr Vec3<T>& operator*=(Vec3<T>& a, T s) { a = a * s; return a; }
+template <class T>
+constexpr Vec3<T> operator+(Vec3<T> a, Vec3<T> b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T>
+constexpr Vec3<T> operator-(Vec3<T> a, Vec3<T> b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T>
+constexpr Vec3<T> operator-(Vec3<T> a) {
+  return {-a.x, -a.y, -a.z};
+}
+template <class T>
+constexpr Vec3<T> operator*(Vec3<T> a, T s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+template <class T>
+constexpr Vec3<T> operator*(T s, Vec3<T> a) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+template <class T>
+constexpr Vec3<T> operator/(Vec3<T> a, T s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+template <class T>
+constexpr Vec3<T>& operator+=(Vec3<T>& a, Vec3<T> b) {
+  a = a + b;
+  return a;
+}
+template <class T>
+constexpr Vec3<T>& operator-=(Vec3<T>& a, Vec3<T> b) {
+  a = a - b;
+  return a;
+}
+template <class T>
+constexpr Vec3<T>& operator*=(Vec3<T>& a, T s) {
+  a = a * s;
+  return a;
+}
 
-template <class T> constexpr T dot(Vec3<T> a, Vec3<T> b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-template <class T> constexpr Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
+template <class T>
+constexpr T dot(Vec3<T> a, Vec3<T> b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <class T>
+constexpr Vec3<T> cross(Vec3<T> a, Vec3<T> b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-template <class T> inline T length(Vec3<T> a) { return std::sqrt(dot(a, a)); }
-template <class T> constexpr T squared_length(Vec3<T> a) { return dot(a, a); }
+template <class T>
+inline T length(Vec3<T> a) {
+  return std::sqrt(dot(a, a));
+}
+template <class T>
+constexpr T squared_length(Vec3<T> a) {
+  return dot(a, a);
+}
 // Returns the zero vector for a zero input instead of NaNs.
-template <class T> inline Vec3<T> normalized(Vec3<T> a) {
+template <class T>
+inline Vec3<T> normalized(Vec3<T> a) {
   T len = length(a);
   return len > T(0) ? a / len : Vec3<T>{};
 }

@@ -48,9 +48,9 @@ class TriangleBvh {
   ClosestHit closest(Vec3d query, uint32_t hint = kNoHint) const;
 
   struct Node {
-    Vec3d lo, hi;         // bounds, inflated a hair so rounding never escapes them
-    uint32_t first = 0;   // leaf: first slot in triangles_; inner: right child
-    uint32_t count = 0;   // leaf: number of triangles; inner: 0
+    Vec3d lo, hi;        // bounds, inflated a hair so rounding never escapes them
+    uint32_t first = 0;  // leaf: first slot in triangles_; inner: right child
+    uint32_t count = 0;  // leaf: number of triangles; inner: 0
   };
 
  private:
@@ -63,8 +63,8 @@ class TriangleBvh {
                       const std::vector<Vec3d>& centroids);
 
   std::vector<Node> nodes_;
-  std::vector<Slot> triangles_;         // in leaf order
-  std::vector<uint32_t> slot_of_;       // triangle index -> slot
+  std::vector<Slot> triangles_;    // in leaf order
+  std::vector<uint32_t> slot_of_;  // triangle index -> slot
   double inflate_ = 0;
   uint32_t depth_ = 0;
 };

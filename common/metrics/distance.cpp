@@ -29,16 +29,16 @@ Status check_mesh(const Mesh& mesh, const char* which) {
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
     for (uint32_t v : mesh.triangles[f]) {
       if (v >= n) {
-        return make_error(ErrorCode::kInvalidMesh,
-                          std::string("surface distance: ") + which + " triangle " +
-                              std::to_string(f) + " refers to vertex " + std::to_string(v) +
-                              " of " + std::to_string(n));
+        return make_error(ErrorCode::kInvalidMesh, std::string("surface distance: ") + which +
+                                                       " triangle " + std::to_string(f) +
+                                                       " refers to vertex " + std::to_string(v) +
+                                                       " of " + std::to_string(n));
       }
       const Vec3f& p = mesh.positions[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        return make_error(ErrorCode::kInvalidMesh,
-                          std::string("surface distance: ") + which + " vertex " +
-                              std::to_string(v) + " has a non-finite coordinate");
+        return make_error(ErrorCode::kInvalidMesh, std::string("surface distance: ") + which +
+                                                       " vertex " + std::to_string(v) +
+                                                       " has a non-finite coordinate");
       }
     }
   }
@@ -123,7 +123,8 @@ SurfaceDistance surface_distance(const PreparedSurface& a, const PreparedSurface
   return d;
 }
 
-Result<SurfaceDistance> surface_distance(const Mesh& a, const Mesh& b, const DistanceOptions& options) {
+Result<SurfaceDistance> surface_distance(const Mesh& a, const Mesh& b,
+                                         const DistanceOptions& options) {
   if (auto ok = check_mesh(a, "mesh A"); !ok) return tl::unexpected(ok.error());
   if (auto ok = check_mesh(b, "mesh B"); !ok) return tl::unexpected(ok.error());
   auto pa = PreparedSurface::prepare(a, options);

@@ -21,16 +21,16 @@ struct DistanceOptions {
 };
 
 struct OneSidedDistance {
-  double max = 0;   // Hausdorff from A to B
+  double max = 0;  // Hausdorff from A to B
   double mean = 0;
   double rms = 0;
 };
 
 struct SurfaceDistance {
   OneSidedDistance a_to_b, b_to_a;
-  double hausdorff = 0;       // max of both directions
-  double rms = 0;             // the larger of the two RMS values
-  double diagonal = 0;        // A's bounding-box diagonal
+  double hausdorff = 0;  // max of both directions
+  double rms = 0;        // the larger of the two RMS values
+  double diagonal = 0;   // A's bounding-box diagonal
   double relative_hausdorff() const { return diagonal > 0 ? hausdorff / diagonal : 0; }
   double relative_rms() const { return diagonal > 0 ? rms / diagonal : 0; }
 };
@@ -44,7 +44,8 @@ struct SurfaceDistance {
 // kInvalidArgument when either mesh has no triangle; kInvalidMesh for an
 // index out of range or a non-finite coordinate (degenerate triangles are
 // fine). Cost O((S + V + E) log F) per direction.
-Result<SurfaceDistance> surface_distance(const Mesh& a, const Mesh& b, const DistanceOptions& options = {});
+Result<SurfaceDistance> surface_distance(const Mesh& a, const Mesh& b,
+                                         const DistanceOptions& options = {});
 
 // A mesh prepared for repeated distance queries (e.g. one original against
 // many decoded prefixes): its samples and its hierarchy, built once.

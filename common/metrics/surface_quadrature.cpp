@@ -20,12 +20,13 @@ WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area) {
     const int k = static_cast<int>(std::clamp(std::ceil(std::sqrt(area / cell_area)), 1.0, 32.0));
     const double w = area / (double(k) * k);
     auto add = [&](double s, double r) {  // barycentric (1 - s - r, s, r)
-      out.points.push_back({a.x + s * u.x + r * v.x, a.y + s * u.y + r * v.y, a.z + s * u.z + r * v.z});
+      out.points.push_back(
+          {a.x + s * u.x + r * v.x, a.y + s * u.y + r * v.y, a.z + s * u.z + r * v.z});
       out.weights.push_back(w);
     };
     for (int i = 0; i < k; ++i) {
       for (int j = 0; i + j < k; ++j) {
-        add((i + 1.0 / 3) / k, (j + 1.0 / 3) / k);                  // upward sub-triangle
+        add((i + 1.0 / 3) / k, (j + 1.0 / 3) / k);                     // upward sub-triangle
         if (i + j < k - 1) add((i + 2.0 / 3) / k, (j + 2.0 / 3) / k);  // downward neighbour
       }
     }

@@ -14,9 +14,9 @@ AsaOptions asa(int levels, float t) {
 
 TEST(AsaAdaptive, RealMeshesStayConformingManifolds) {
   MESHSTREAM_REQUIRE_TEST_MESHES();
-  for (auto [name, levels] : {std::pair{"fandisk.off", 3}, std::pair{"hemisphere.off", 3},
-                              std::pair{"mask.off", 2}, std::pair{"bunny.off", 2},
-                              std::pair{"casting.off", 3}}) {
+  for (auto [name, levels] :
+       {std::pair{"fandisk.off", 3}, std::pair{"hemisphere.off", 3}, std::pair{"mask.off", 2},
+        std::pair{"bunny.off", 2}, std::pair{"casting.off", 3}}) {
     Mesh m = asa_test::load(name);
     // hemisphere's finest dihedral angles are below 18 degrees: only t very
     // close to 1 refines it.
@@ -83,7 +83,8 @@ TEST(AsaAdaptive, FlatRegionsAreNotRefined) {
   int far_untouched = 0;
   for (uint32_t f = 0; f < r->mesh.face_count(); ++f) {
     const Triangle& t = r->mesh.triangles[f];
-    const Vec3f c = (r->mesh.positions[t[0]] + r->mesh.positions[t[1]] + r->mesh.positions[t[2]]) / 3.0f;
+    const Vec3f c =
+        (r->mesh.positions[t[0]] + r->mesh.positions[t[1]] + r->mesh.positions[t[2]]) / 3.0f;
     if (std::abs(c.x - 6) > 4.5f || std::abs(c.y - 6) > 4.5f) {
       EXPECT_EQ(r->face_kind[f], FaceKind::kUntouched);
       ++far_untouched;

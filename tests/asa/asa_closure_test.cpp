@@ -2,12 +2,11 @@
 // target, targets propagate, and a green half is never bisected again (its
 // pair is merged back and the parent split 1-to-4). Works on the internal
 // level structures so that targets can be chosen exactly.
-#include "tests/asa/asa_test_support.h"
-
 #include "common/asa/butterfly_stencils.h"
 #include "common/asa/closure.h"
 #include "common/asa/flatness.h"
 #include "common/asa/split.h"
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -34,7 +33,8 @@ struct Level {
     LevelView v = lm.view();
     count_vertex_faces(v, lm.valence);
     weights.configure(0);
-    weights.add_valences(lm.valence.data(), lm.vertex_features.data(), static_cast<uint32_t>(lm.valence.size()));
+    weights.add_valences(lm.valence.data(), lm.vertex_features.data(),
+                         static_cast<uint32_t>(lm.valence.size()));
   }
   void finish() {
     std::vector<Vec3f> normals;
@@ -45,7 +45,8 @@ struct Level {
     count_vertex_features(v, lm.vertex_features);
     count_vertex_faces(v, lm.valence);
     weights.configure(0);
-    weights.add_valences(lm.valence.data(), lm.vertex_features.data(), static_cast<uint32_t>(lm.valence.size()));
+    weights.add_valences(lm.valence.data(), lm.vertex_features.data(),
+                         static_cast<uint32_t>(lm.valence.size()));
   }
   // Splits with the given closure; returns the next level.
   LevelMesh split(const ClosureBuffers& closure) {
@@ -74,7 +75,8 @@ void expect_topology_consistent(const LevelMesh& out, bool with_across = false) 
   auto adj = Adjacency::build(m);
   ASSERT_TRUE(adj.has_value()) << adj.error().message;
   ASSERT_EQ(out.opposite.size(), 3 * m.triangles.size());
-  for (uint32_t c = 0; c < out.opposite.size(); ++c) ASSERT_EQ(out.opposite[c], adj->opposite(c)) << c;
+  for (uint32_t c = 0; c < out.opposite.size(); ++c)
+    ASSERT_EQ(out.opposite[c], adj->opposite(c)) << c;
   for (uint32_t c = 0; c < out.opposite.size(); ++c)
     ASSERT_EQ(out.feature_edge[c] != 0, adj->opposite(c) == kNone) << c;
   // across (vertex of the opposite corner), derived by the split as well.
@@ -84,7 +86,9 @@ void expect_topology_consistent(const LevelMesh& out, bool with_across = false) 
   }
   ASSERT_EQ(out.across.size(), out.opposite.size());
   for (uint32_t c = 0; c < out.across.size(); ++c)
-    ASSERT_EQ(out.across[c], adj->opposite(c) == kNone ? kNone : m.triangles[adj->opposite(c) / 3][adj->opposite(c) % 3])
+    ASSERT_EQ(out.across[c], adj->opposite(c) == kNone
+                                 ? kNone
+                                 : m.triangles[adj->opposite(c) / 3][adj->opposite(c) % 3])
         << c;
 }
 
@@ -101,7 +105,8 @@ TEST(AsaClosure, OneTargetBisectsItsThreeNeighbours) {
   EXPECT_EQ(b.action[t], kRed);
   EXPECT_EQ(count_action(b, kRed), 1);
   EXPECT_EQ(count_action(b, kBisect), 3);
-  for (uint32_t n : {L.lm.opposite[3 * t] / 3, L.lm.opposite[3 * t + 1] / 3, L.lm.opposite[3 * t + 2] / 3})
+  for (uint32_t n :
+       {L.lm.opposite[3 * t] / 3, L.lm.opposite[3 * t + 1] / 3, L.lm.opposite[3 * t + 2] / 3})
     EXPECT_EQ(b.action[n], kBisect);
   LevelMesh out = L.split(b);
   EXPECT_EQ(out.triangles.size(), L.mesh.face_count() + 3 + 3);
@@ -171,7 +176,10 @@ TEST(AsaClosure, GreenHalfIsNeverBisectedAgain) {
   // Find a green pair.
   uint32_t first = kNone;
   for (uint32_t f = 0; f < L1.lm.green.size(); ++f)
-    if (L1.lm.green[f] == kGreenFirst) { first = f; break; }
+    if (L1.lm.green[f] == kGreenFirst) {
+      first = f;
+      break;
+    }
   ASSERT_NE(first, kNone);
   const uint32_t M = L1.lm.triangles[first][2];
   const size_t vertices_before = L1.lm.positions.size();

@@ -1,11 +1,10 @@
 // The fast corner-table builder agrees with Adjacency::build, accepts and
 // refuses the same meshes.
-#include "tests/asa/asa_test_support.h"
-
-#include "common/asa/corner_table.h"
-
 #include <cmath>
 #include <string>
+
+#include "common/asa/corner_table.h"
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -20,7 +19,8 @@ void expect_same_as_adjacency(const Mesh& m, const char* what) {
     EXPECT_EQ(adj.error().code, ours.error().code) << what << ": " << ours.error().message;
     return;
   }
-  for (uint32_t c = 0; c < opposite.size(); ++c) ASSERT_EQ(opposite[c], adj->opposite(c)) << what << " corner " << c;
+  for (uint32_t c = 0; c < opposite.size(); ++c)
+    ASSERT_EQ(opposite[c], adj->opposite(c)) << what << " corner " << c;
 }
 
 TEST(AsaCornerTable, MatchesAdjacencyOnProceduralMeshes) {
@@ -91,7 +91,9 @@ TEST(AsaCornerTable, AcrossIsTheOppositeCornersVertex) {
     ASSERT_TRUE(asa::build_opposites(m, opposite, across, scratch).has_value());
     ASSERT_EQ(across.size(), opposite.size());
     for (uint32_t c = 0; c < opposite.size(); ++c)
-      ASSERT_EQ(across[c], opposite[c] == kNone ? kNone : m.triangles[opposite[c] / 3][opposite[c] % 3]) << c;
+      ASSERT_EQ(across[c],
+                opposite[c] == kNone ? kNone : m.triangles[opposite[c] / 3][opposite[c] % 3])
+          << c;
   }
 }
 

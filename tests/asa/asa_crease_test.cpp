@@ -1,10 +1,10 @@
 // Creases: with --crease, points made on sharp edges stay on the original
 // sharp polyline (curve rule along the crease, corners fixed), while the
 // plain scheme rounds them off.
-#include "tests/asa/asa_test_support.h"
-
 #include <cstdio>
 #include <set>
+
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -54,7 +54,8 @@ std::pair<CreaseDeviation, CreaseDeviation> crease_deviation(const Mesh& m, floa
   EXPECT_TRUE(asa_test::conforming(m, *creased));
   // Points on sharp edges: level-1 midpoints of sharp edges and the level-2
   // points on their halves (same numbering with and without creases).
-  const uint32_t V0 = m.vertex_count(), V1 = one->mesh.vertex_count(), V2 = plain->mesh.vertex_count();
+  const uint32_t V0 = m.vertex_count(), V1 = one->mesh.vertex_count(),
+                 V2 = plain->mesh.vertex_count();
   auto p1 = asa_test::parents(one->mesh.triangles, V0, V1);
   std::set<std::pair<uint32_t, uint32_t>> sharp1;
   std::vector<uint32_t> points;
@@ -74,7 +75,8 @@ std::pair<CreaseDeviation, CreaseDeviation> crease_deviation(const Mesh& m, floa
     CreaseDeviation d;
     for (uint32_t v : points) {
       float best = 1e30f;
-      for (const Segment& s : segments) best = std::min(best, distance_to_segment(out.positions[v], s));
+      for (const Segment& s : segments)
+        best = std::min(best, distance_to_segment(out.positions[v], s));
       d.max = std::max(d.max, best);
       d.mean += best;
     }
@@ -90,10 +92,11 @@ TEST(AsaCrease, FandiskSharpEdgesStaySharp) {
   Mesh m = asa_test::load("fandisk.off");
   const float diagonal = bounding_box(m).diagonal();
   auto [creased, plain] = crease_deviation(m, 45.0f);
-  std::printf("fandisk, 2 levels, %zu crease points: distance to the sharp polyline / diagonal: "
-              "creased max %.2e mean %.2e, plain max %.2e mean %.2e\n",
-              creased.points, creased.max / diagonal, creased.mean / diagonal, plain.max / diagonal,
-              plain.mean / diagonal);
+  std::printf(
+      "fandisk, 2 levels, %zu crease points: distance to the sharp polyline / diagonal: "
+      "creased max %.2e mean %.2e, plain max %.2e mean %.2e\n",
+      creased.points, creased.max / diagonal, creased.mean / diagonal, plain.max / diagonal,
+      plain.mean / diagonal);
   EXPECT_GT(creased.points, 500u);
   EXPECT_LT(creased.max, 0.25f * plain.max);
   EXPECT_LT(creased.mean, 0.25f * plain.mean);
@@ -105,8 +108,8 @@ TEST(AsaCrease, ChamferCubeEdgesStayStraight) {
   Mesh m = asa_test::load("chamfer-cube.off");
   const float diagonal = bounding_box(m).diagonal();
   auto [creased, plain] = crease_deviation(m, 30.0f);
-  std::printf("chamfer-cube: creased max %.2e, plain max %.2e of the diagonal\n", creased.max / diagonal,
-              plain.max / diagonal);
+  std::printf("chamfer-cube: creased max %.2e, plain max %.2e of the diagonal\n",
+              creased.max / diagonal, plain.max / diagonal);
   EXPECT_LT(creased.max / diagonal, 1e-5f);
   EXPECT_GT(plain.max / diagonal, 1e-3f);
 }

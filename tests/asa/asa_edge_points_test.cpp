@@ -2,13 +2,12 @@
 // extraordinary centre's stencils from one gathered ring, fans cached across
 // uniform levels) give exactly the bits of the per-edge reference
 // butterfly_point on the level they subdivide.
-#include "tests/asa/asa_test_support.h"
-
 #include <cstring>
 
 #include "common/asa/butterfly_stencils.h"
 #include "common/asa/flatness.h"
 #include "common/asa/level_mesh.h"
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -34,14 +33,15 @@ struct Reference {
     count_vertex_features(v, lm.vertex_features);
     count_vertex_faces(v, lm.valence);
     weights.configure(tension);
-    weights.add_valences(lm.valence.data(), lm.vertex_features.data(), static_cast<uint32_t>(lm.valence.size()));
+    weights.add_valences(lm.valence.data(), lm.vertex_features.data(),
+                         static_cast<uint32_t>(lm.valence.size()));
   }
 };
 
 // Uniform level n's new vertices, in naming order (the first corner of each
 // edge in corner order), against butterfly_point on level n - 1.
-void expect_uniform_level_matches_reference(const Mesh& input, int level, ButterflyRule rule, float tension,
-                                            const char* what) {
+void expect_uniform_level_matches_reference(const Mesh& input, int level, ButterflyRule rule,
+                                            float tension, const char* what) {
   AsaOptions o;
   o.uniform = true;
   o.rule = rule;
@@ -63,8 +63,8 @@ void expect_uniform_level_matches_reference(const Mesh& input, int level, Butter
     ASSERT_LT(id, after->mesh.vertex_count()) << what;
     const Vec3f got = after->mesh.positions[id++];
     ASSERT_EQ(std::memcmp(&expected, &got, sizeof(Vec3f)), 0)
-        << what << " level " << level << " corner " << c << ": " << got.x << " " << got.y << " " << got.z
-        << " vs " << expected.x << " " << expected.y << " " << expected.z;
+        << what << " level " << level << " corner " << c << ": " << got.x << " " << got.y << " "
+        << got.z << " vs " << expected.x << " " << expected.y << " " << expected.z;
     ++checked;
   }
   EXPECT_EQ(id, after->mesh.vertex_count()) << what;
@@ -75,8 +75,10 @@ TEST(AsaEdgePoints, UniformLevelsMatchThePerEdgeStencilsBitForBit) {
   const Mesh ico = asa_test::icosahedron();
   for (int level = 1; level <= 3; ++level) {
     expect_uniform_level_matches_reference(ico, level, ButterflyRule::kZorin, 0, "icosahedron");
-    expect_uniform_level_matches_reference(ico, level, ButterflyRule::kProjection, 0, "icosahedron projection");
-    expect_uniform_level_matches_reference(ico, level, ButterflyRule::kZorin, 0.05f, "icosahedron tension");
+    expect_uniform_level_matches_reference(ico, level, ButterflyRule::kProjection, 0,
+                                           "icosahedron projection");
+    expect_uniform_level_matches_reference(ico, level, ButterflyRule::kZorin, 0.05f,
+                                           "icosahedron tension");
   }
 }
 

@@ -1,10 +1,9 @@
 // Incremental updates equal a full subdivision face for face, after records
 // that move vertices and insert vertices (as the decoder's refinements do).
-#include "tests/asa/asa_test_support.h"
-
 #include <random>
 
 #include "common/asa/incremental.h"
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -13,15 +12,20 @@ namespace {
 // vertex count, same face kinds.
 ::testing::AssertionResult same_output(const AsaResult& a, const AsaResult& b) {
   if (a.mesh.face_count() != b.mesh.face_count())
-    return ::testing::AssertionFailure() << "faces " << a.mesh.face_count() << " vs " << b.mesh.face_count();
+    return ::testing::AssertionFailure()
+           << "faces " << a.mesh.face_count() << " vs " << b.mesh.face_count();
   if (a.mesh.vertex_count() != b.mesh.vertex_count())
-    return ::testing::AssertionFailure() << "vertices " << a.mesh.vertex_count() << " vs " << b.mesh.vertex_count();
+    return ::testing::AssertionFailure()
+           << "vertices " << a.mesh.vertex_count() << " vs " << b.mesh.vertex_count();
   for (uint32_t f = 0; f < a.mesh.face_count(); ++f) {
     for (int i = 0; i < 3; ++i) {
-      const Vec3f p = a.mesh.positions[a.mesh.triangles[f][i]], q = b.mesh.positions[b.mesh.triangles[f][i]];
-      if (std::memcmp(&p, &q, sizeof p) != 0) return ::testing::AssertionFailure() << "face " << f << " corner " << i;
+      const Vec3f p = a.mesh.positions[a.mesh.triangles[f][i]],
+                  q = b.mesh.positions[b.mesh.triangles[f][i]];
+      if (std::memcmp(&p, &q, sizeof p) != 0)
+        return ::testing::AssertionFailure() << "face " << f << " corner " << i;
     }
-    if (a.face_kind[f] != b.face_kind[f]) return ::testing::AssertionFailure() << "face kind of " << f;
+    if (a.face_kind[f] != b.face_kind[f])
+      return ::testing::AssertionFailure() << "face kind of " << f;
   }
   return ::testing::AssertionSuccess();
 }

@@ -6,7 +6,6 @@
 
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/ModifiedButterFlyT.hh>
-
 #include <array>
 #include <cstdio>
 #include <map>
@@ -78,7 +77,8 @@ double compare_with_openmesh(const Mesh& input, int levels) {
       std::array<uint32_t, 2> key{om_to_ours[om_parents[i][0]], om_to_ours[om_parents[i][1]]};
       if (key[0] > key[1]) std::swap(key[0], key[1]);
       auto it = ours_by_parents.find(key);
-      EXPECT_NE(it, ours_by_parents.end()) << "OpenMesh vertex " << old_count + i << " has no match";
+      EXPECT_NE(it, ours_by_parents.end())
+          << "OpenMesh vertex " << old_count + i << " has no match";
       if (it == ours_by_parents.end()) return 1e30;
       next_map[old_count + i] = it->second;
     }
@@ -118,7 +118,8 @@ TEST_P(AsaOpenMeshReal, MatchesVertexForVertex) {
   ASSERT_FALSE(m.empty());
   const double worst = compare_with_openmesh(m, levels);
   EXPECT_LT(worst, 1e-5) << name;
-  std::printf("%s, %d levels: largest deviation from OpenMesh %.3g of the diagonal\n", name, levels, worst);
+  std::printf("%s, %d levels: largest deviation from OpenMesh %.3g of the diagonal\n", name, levels,
+              worst);
 }
 
 // Closed meshes, then meshes with boundaries (hemisphere: one loop; mask: a

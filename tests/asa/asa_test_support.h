@@ -21,18 +21,20 @@ namespace meshstream::asa_test {
 inline Mesh octahedron() {
   Mesh m;
   m.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                 {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   return m;
 }
 
 inline Mesh icosahedron() {
   const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
   Mesh m;
-  m.positions = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  m.positions = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   return m;
 }
 
@@ -73,11 +75,12 @@ inline Mesh load(const std::string& name) {
 inline ::testing::AssertionResult conforming(const Mesh& input, const AsaResult& result) {
   const Mesh& out = result.mesh;
   if (result.face_kind.size() != out.triangles.size())
-    return ::testing::AssertionFailure() << "face_kind has " << result.face_kind.size() << " entries for "
-                                         << out.triangles.size() << " faces";
+    return ::testing::AssertionFailure() << "face_kind has " << result.face_kind.size()
+                                         << " entries for " << out.triangles.size() << " faces";
   if (out.positions.size() < input.positions.size())
     return ::testing::AssertionFailure() << "lost vertices";
-  if (std::memcmp(out.positions.data(), input.positions.data(), sizeof(Vec3f) * input.positions.size()) != 0)
+  if (std::memcmp(out.positions.data(), input.positions.data(),
+                  sizeof(Vec3f) * input.positions.size()) != 0)
     return ::testing::AssertionFailure() << "old vertices moved";
   auto in_adj = Adjacency::build(input);
   auto adj = Adjacency::build(out);
@@ -89,9 +92,9 @@ inline ::testing::AssertionResult conforming(const Mesh& input, const AsaResult&
     if (v >= input.vertex_count() && adj->is_boundary_vertex(v)) ++new_boundary;
   }
   if (adj->boundary_edge_count() != in_adj->boundary_edge_count() + new_boundary)
-    return ::testing::AssertionFailure() << "boundary edges " << adj->boundary_edge_count() << " != "
-                                         << in_adj->boundary_edge_count() << " + " << new_boundary
-                                         << " (a T-junction or crack)";
+    return ::testing::AssertionFailure() << "boundary edges " << adj->boundary_edge_count()
+                                         << " != " << in_adj->boundary_edge_count() << " + "
+                                         << new_boundary << " (a T-junction or crack)";
   for (const Vec3f& p : out.positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       return ::testing::AssertionFailure() << "non-finite position";
@@ -100,8 +103,8 @@ inline ::testing::AssertionResult conforming(const Mesh& input, const AsaResult&
 
 // For every vertex >= old_count: its two neighbours below old_count (the
 // endpoints of the edge it was made on), kNone where missing.
-inline std::vector<std::array<uint32_t, 2>> parents(const std::vector<Triangle>& tris, uint32_t old_count,
-                                                    uint32_t count) {
+inline std::vector<std::array<uint32_t, 2>> parents(const std::vector<Triangle>& tris,
+                                                    uint32_t old_count, uint32_t count) {
   std::vector<std::array<uint32_t, 2>> p(count - old_count, {kNone, kNone});
   for (const Triangle& t : tris)
     for (int i = 0; i < 3; ++i) {
@@ -109,8 +112,10 @@ inline std::vector<std::array<uint32_t, 2>> parents(const std::vector<Triangle>&
       for (int pass = 0; pass < 2; ++pass, std::swap(a, b)) {
         if (a >= old_count && b < old_count) {
           auto& slot = p[a - old_count];
-          if (slot[0] == kNone) slot[0] = b;
-          else if (slot[0] != b) slot[1] = b;
+          if (slot[0] == kNone)
+            slot[0] = b;
+          else if (slot[0] != b)
+            slot[1] = b;
         }
       }
     }

@@ -1,10 +1,11 @@
 // `meshstream subdivide` follows its contract: output written with the
 // expected counts, usage errors exit 2, bad data exits 1.
-#include "tests/asa/asa_test_support.h"
+#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
-#include <sys/wait.h>
+
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -26,7 +27,8 @@ TEST(AsaTool, SubdivideCommand) {
   auto result = import_mesh(out);
   ASSERT_TRUE(result.has_value());
   EXPECT_EQ(result->mesh.face_count(), 16u * 12946u);
-  ASSERT_EQ(run("subdivide " + in + " -o " + out + " --levels 2 --flatness 0.8 --rule projection --crease 45 "
+  ASSERT_EQ(run("subdivide " + in + " -o " + out +
+                " --levels 2 --flatness 0.8 --rule projection --crease 45 "
                 "--tension 0.01"),
             0);
   EXPECT_EQ(run("subdivide " + in + " -o " + out + " --rule bogus"), 2);

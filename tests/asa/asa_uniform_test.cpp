@@ -1,8 +1,8 @@
 // Uniform modified Butterfly: counts, conformity, precision of the stencils,
 // attributes, options.
-#include "tests/asa/asa_test_support.h"
-
 #include <cmath>
+
+#include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
 namespace {
@@ -37,7 +37,8 @@ TEST(AsaUniform, RealMeshCountsAreVPlusEAndFourF) {
     for (int level = 1; level <= 2; ++level) {
       auto r = subdivide(m, uniform(level));
       ASSERT_TRUE(r.has_value()) << name;
-      EXPECT_EQ(r->mesh.vertex_count(), current.vertex_count() + asa_test::edge_count(current)) << name;
+      EXPECT_EQ(r->mesh.vertex_count(), current.vertex_count() + asa_test::edge_count(current))
+          << name;
       EXPECT_EQ(r->mesh.face_count(), 4 * current.face_count()) << name;
       EXPECT_TRUE(asa_test::conforming(m, *r)) << name;
       current = r->mesh;
@@ -109,8 +110,9 @@ TEST(AsaUniform, ColorsAndTexcoordsInterpolatedNormalsRecomputed) {
   for (uint32_t i = 0; i < par.size(); ++i) {
     const Vec4f a = level1->mesh.colors[par[i][0]], b = level1->mesh.colors[par[i][1]];
     EXPECT_FLOAT_EQ(out.colors[42 + i].x, (a.x + b.x) / 2);
-    EXPECT_FLOAT_EQ(out.texcoords[42 + i].x,
-                    (level1->mesh.texcoords[par[i][0]].x + level1->mesh.texcoords[par[i][1]].x) / 2);
+    EXPECT_FLOAT_EQ(
+        out.texcoords[42 + i].x,
+        (level1->mesh.texcoords[par[i][0]].x + level1->mesh.texcoords[par[i][1]].x) / 2);
   }
   for (uint32_t v = 0; v < out.vertex_count(); ++v) {
     // On this sphere-like shape the normal points away from the centre.
@@ -178,7 +180,8 @@ TEST(AsaUniform, BadInputAndOptionsAreErrors) {
 
 // Calls that reuse a workspace and a result give the same output as fresh ones.
 TEST(AsaUniform, WorkspaceReuseGivesSameResult) {
-  Mesh a = asa_test::icosahedron(), b = asa_test::grid(4, [](float x, float y) { return x * y * 0.1f; });
+  Mesh a = asa_test::icosahedron(),
+       b = asa_test::grid(4, [](float x, float y) { return x * y * 0.1f; });
   AsaWorkspace ws;
   AsaResult result;
   for (int round = 0; round < 2; ++round) {

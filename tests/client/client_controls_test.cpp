@@ -66,8 +66,8 @@ class ClientControlsTest : public ::testing::Test {
 
 TEST_F(ClientControlsTest, PauseStopsTheReadsAndResumeFinishesTheSameMesh) {
   Server server;
-  ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache", "--rate", "40000",
-                            "--max-chunk-bytes", "1024"},
+  ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache", "--rate",
+                            "40000", "--max-chunk-bytes", "1024"},
                            dir_.path()))
       << server.log();
   PipelineSettings settings;
@@ -133,8 +133,9 @@ TEST_F(ClientControlsTest, SetAsaReRunsOnTheCurrentMesh) {
 // the pipeline shows the newest mesh, merging the records in between.
 TEST_F(ClientControlsTest, NetworkNeverWaitsForASlowPipeline) {
   Server server;
-  ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache", "--max-chunk-bytes", "1024"},
-                           dir_.path()))
+  ASSERT_TRUE(server.start(
+      {"--models", dir_ / "models", "--cache", dir_ / "cache", "--max-chunk-bytes", "1024"},
+      dir_.path()))
       << server.log();
   PipelineSettings settings;
   settings.asa.levels = 3;  // tens of ms per update on this mesh

@@ -17,14 +17,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <tuple>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "common/mesh/mesh.h"
 #include "common/mesh/mesh_readers.h"
@@ -35,8 +34,12 @@ using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
-inline std::string server_bin() { return std::string(MESHSTREAM_BINARY_DIR) + "/server/meshstream-server"; }
-inline std::string client_bin() { return std::string(MESHSTREAM_BINARY_DIR) + "/client/meshstream-client"; }
+inline std::string server_bin() {
+  return std::string(MESHSTREAM_BINARY_DIR) + "/server/meshstream-server";
+}
+inline std::string client_bin() {
+  return std::string(MESHSTREAM_BINARY_DIR) + "/client/meshstream-client";
+}
 inline std::string tool_bin() { return std::string(MESHSTREAM_BINARY_DIR) + "/tools/meshstream"; }
 
 // A fresh directory under the system temp dir, removed at the end.
@@ -121,7 +124,8 @@ inline std::string read_text(const std::string& path) {
 }
 
 // Runs a command to completion (60 s at most); its exit status.
-inline int run(const std::vector<std::string>& argv, const std::string& out, const std::string& err) {
+inline int run(const std::vector<std::string>& argv, const std::string& out,
+               const std::string& err) {
   Child child;
   if (!child.start(argv, out, err)) return -1000;
   auto status = child.wait(60s);
@@ -197,7 +201,8 @@ inline std::vector<nlohmann::json> parse_events(const std::string& text) {
   return events;
 }
 
-inline std::vector<nlohmann::json> of_kind(const std::vector<nlohmann::json>& events, const std::string& kind) {
+inline std::vector<nlohmann::json> of_kind(const std::vector<nlohmann::json>& events,
+                                           const std::string& kind) {
   std::vector<nlohmann::json> out;
   for (const auto& e : events) {
     if (e.is_object() && e.value("event", "") == kind) out.push_back(e);

@@ -27,7 +27,8 @@ std::vector<uint8_t> demo_stream() {
 
 bool same_mesh(const Mesh& a, const Mesh& b) {
   return a.triangles == b.triangles && a.positions.size() == b.positions.size() &&
-         std::memcmp(a.positions.data(), b.positions.data(), sizeof(Vec3f) * a.positions.size()) == 0;
+         std::memcmp(a.positions.data(), b.positions.data(), sizeof(Vec3f) * a.positions.size()) ==
+             0;
 }
 
 // The decoded mesh of the stream's first `bytes` bytes (a record boundary).
@@ -77,7 +78,8 @@ TEST(DecodedStream, MirrorCopiesOnlyChangesAndStaysEqualToTheDecoder) {
       unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
       partial += unique.size() < mirror.triangles.size() / 2;
     }
-    ASSERT_TRUE(same_mesh(mirror, decode_prefix(stream, u.bytes_decoded))) << "after " << u.records_decoded;
+    ASSERT_TRUE(same_mesh(mirror, decode_prefix(stream, u.bytes_decoded)))
+        << "after " << u.records_decoded;
   }
   EXPECT_GT(takes, 3u);
   EXPECT_GT(partial, 1u) << "no take copied only a part of the mesh";
@@ -106,7 +108,8 @@ TEST(DecodedStream, BarrierHoldsTheNetworkSideUntilThatRecordIsTaken) {
     if (seen.size() > 1000) break;
   }
   network.join();
-  EXPECT_NE(std::find(seen.begin(), seen.end(), 3u), seen.end()) << "record 2 was never taken alone";
+  EXPECT_NE(std::find(seen.begin(), seen.end(), 3u), seen.end())
+      << "record 2 was never taken alone";
 }
 
 TEST(DisplayBuilder, IncrementalAndFullPathsGiveTheSameDisplayMesh) {
@@ -177,7 +180,8 @@ TEST(ParseHostPort, AcceptsHostPortAndRefusesTheRest) {
   ASSERT_TRUE(b);
   EXPECT_EQ(b->host, "::1");
   EXPECT_EQ(b->port, 9);
-  for (const char* bad : {"127.0.0.1", ":7878", "host:", "host:0", "host:65536", "host:12x", "host:-1"}) {
+  for (const char* bad :
+       {"127.0.0.1", ":7878", "host:", "host:0", "host:65536", "host:12x", "host:-1"}) {
     EXPECT_FALSE(parse_host_port(bad)) << bad;
   }
 }

@@ -29,10 +29,13 @@ class ClientStreamTest : public ::testing::Test {
                   *dir_ / "gen.out", *dir_ / "gen.err"),
               0)
         << read_text(*dir_ / "gen.err");
-    ASSERT_EQ(run({tool_bin(), "encode", *dir_ / "demo.ply", "-o", hcs()}, *dir_ / "enc.out", *dir_ / "enc.err"), 0)
+    ASSERT_EQ(run({tool_bin(), "encode", *dir_ / "demo.ply", "-o", hcs()}, *dir_ / "enc.out",
+                  *dir_ / "enc.err"),
+              0)
         << read_text(*dir_ / "enc.err");
     server_ = new Server();
-    ASSERT_TRUE(server_->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, dir_->path()))
+    ASSERT_TRUE(
+        server_->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, dir_->path()))
         << server_->log();
   }
   static void TearDownTestSuite() {
@@ -102,8 +105,8 @@ void expect_monotone_events(const std::vector<nlohmann::json>& events) {
     EXPECT_FALSE(a["final"].get<bool>());
   }
   for (const auto& r : refinements) {
-    for (const char* key : {"index", "bytes", "vertices", "faces", "display_vertices", "display_faces",
-                            "decode_ms", "asa_ms", "elapsed_ms"}) {
+    for (const char* key : {"index", "bytes", "vertices", "faces", "display_vertices",
+                            "display_faces", "decode_ms", "asa_ms", "elapsed_ms"}) {
       EXPECT_TRUE(r.contains(key)) << key;
     }
     EXPECT_GE(r["display_faces"].get<int64_t>(), r["faces"].get<int64_t>());
@@ -138,8 +141,8 @@ TEST_F(ClientStreamTest, FinalDecodedMeshEqualsOfflineDecode) {
 
 TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
   TempDir out;
-  const std::vector<std::string> asa{"--asa-levels", "2", "--flatness", "0.8", "--rule", "projection",
-                                     "--crease", "60"};
+  const std::vector<std::string> asa{"--asa-levels", "2",          "--flatness", "0.8",
+                                     "--rule",       "projection", "--crease",   "60"};
   std::vector<std::string> args{"demo", "--json", "--out", out.path()};
   args.insert(args.end(), asa.begin(), asa.end());
   const ClientRun r = client(server_->address(), args);
@@ -159,9 +162,10 @@ TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
     const std::string prefix = "prefix" + std::to_string(index) + ".ply";
     const Mesh decoded = tool_decode(e["bytes"].get<uint64_t>(), prefix);
     EXPECT_EQ(decoded.vertex_count(), e["vertices"].get<uint32_t>());
-    const Mesh expected = tool_subdivide(*dir_ / prefix, {"--levels", "2", "--flatness", "0.8", "--rule",
-                                                          "projection", "--crease", "60"},
-                                         "sub" + std::to_string(index) + ".ply");
+    const Mesh expected = tool_subdivide(
+        *dir_ / prefix,
+        {"--levels", "2", "--flatness", "0.8", "--rule", "projection", "--crease", "60"},
+        "sub" + std::to_string(index) + ".ply");
     EXPECT_TRUE(same_geometry(display, expected)) << "record " << index;
   }
   EXPECT_EQ(read_text(out / "final.ply"), read_text(out / [&] {
@@ -177,14 +181,14 @@ TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
 TEST_F(ClientStreamTest, IncrementalAsaEqualsOfflineSubdivideAtEachRecord) {
   TempDir out;
   Server paced;  // paced so that most records get their own display update
-  ASSERT_TRUE(paced.start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate", "150000",
-                           "--max-chunk-bytes", "1024"},
+  ASSERT_TRUE(paced.start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate",
+                           "150000", "--max-chunk-bytes", "1024"},
                           out.path()))
       << paced.log();
   const std::vector<std::string> asa{"--levels", "1", "--flatness", "0.8", "--crease", "50"};
-  const ClientRun r = client(paced.address(), {"demo", "--json", "--out", out.path(), "--asa-levels", "1",
-                                               "--flatness", "0.8", "--crease", "50", "--asa-path",
-                                               "incremental"});
+  const ClientRun r =
+      client(paced.address(), {"demo", "--json", "--out", out.path(), "--asa-levels", "1",
+                               "--flatness", "0.8", "--crease", "50", "--asa-path", "incremental"});
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
   std::vector<nlohmann::json> incremental;
@@ -200,14 +204,16 @@ TEST_F(ClientStreamTest, IncrementalAsaEqualsOfflineSubdivideAtEachRecord) {
     const Mesh display = load_ply(out / name);
     const std::string prefix = "iprefix" + std::to_string(index) + ".ply";
     tool_decode(e["bytes"].get<uint64_t>(), prefix);
-    const Mesh expected = tool_subdivide(*dir_ / prefix, asa, "isub" + std::to_string(index) + ".ply");
+    const Mesh expected =
+        tool_subdivide(*dir_ / prefix, asa, "isub" + std::to_string(index) + ".ply");
     EXPECT_TRUE(same_geometry(display, expected)) << "record " << index;
   }
 }
 
 TEST_F(ClientStreamTest, NoAsaShowsTheDecodedMesh) {
   TempDir out;
-  const ClientRun r = client(server_->address(), {"demo", "--json", "--no-asa", "--out", out.path()});
+  const ClientRun r =
+      client(server_->address(), {"demo", "--json", "--no-asa", "--out", out.path()});
   ASSERT_EQ(r.status, 0) << r.err;
   for (const auto& e : of_kind(r.events, "refinement")) {
     EXPECT_EQ(e["display_faces"], e["faces"]);
@@ -221,8 +227,9 @@ TEST_F(ClientStreamTest, BudgetsStopOnTheLastRecordBoundaryWithinThem) {
   {
     TempDir out;
     const uint64_t budget = total / 3;
-    const ClientRun r = client(server_->address(), {"demo", "--json", "--bytes", std::to_string(budget),
-                                                    "--no-asa", "--out", out.path()});
+    const ClientRun r = client(
+        server_->address(),
+        {"demo", "--json", "--bytes", std::to_string(budget), "--no-asa", "--out", out.path()});
     ASSERT_EQ(r.status, 0) << r.err;
     expect_monotone_events(r.events);
     const auto& done = r.events.back();
@@ -236,7 +243,8 @@ TEST_F(ClientStreamTest, BudgetsStopOnTheLastRecordBoundaryWithinThem) {
     }());
   }
   {
-    const ClientRun r = client(server_->address(), {"demo", "--json", "--vertices", "3000", "--no-asa"});
+    const ClientRun r =
+        client(server_->address(), {"demo", "--json", "--vertices", "3000", "--no-asa"});
     ASSERT_EQ(r.status, 0) << r.err;
     const auto& done = r.events.back();
     EXPECT_LE(done["vertices"].get<uint32_t>(), 3000u);
@@ -246,7 +254,8 @@ TEST_F(ClientStreamTest, BudgetsStopOnTheLastRecordBoundaryWithinThem) {
   {
     // --percent counts vertices (client_percent_test.cpp); --percent-bytes
     // is the wire's percent of the stream's bytes.
-    const ClientRun r = client(server_->address(), {"demo", "--json", "--percent-bytes", "50", "--no-asa"});
+    const ClientRun r =
+        client(server_->address(), {"demo", "--json", "--percent-bytes", "50", "--no-asa"});
     ASSERT_EQ(r.status, 0) << r.err;
     const auto& done = r.events.back();
     EXPECT_LE(done["bytes"].get<uint64_t>(), total / 2);
@@ -271,15 +280,15 @@ TEST_F(ClientStreamTest, PercentMeansTheSameVerticesAsTheDecodeTool) {
   ASSERT_GT(full.vertex_count(), 0u);
   for (const char* p : {"12.5", "50", "80", "100"}) {
     TempDir out;
-    const ClientRun r =
-        client(server_->address(), {"demo", "--json", "--percent", p, "--no-asa", "--out", out.path()});
+    const ClientRun r = client(server_->address(),
+                               {"demo", "--json", "--percent", p, "--no-asa", "--out", out.path()});
     ASSERT_EQ(r.status, 0) << p << ": " << r.err;
     const auto& done = r.events.back();
     ASSERT_EQ(done["event"], "done") << p;
 
     const std::string name = std::string("pdec") + p + ".ply";
-    ASSERT_EQ(run({tool_bin(), "decode", hcs(), "-o", *dir_ / name, "--percent", p}, *dir_ / "pdec.out",
-                  *dir_ / "pdec.err"),
+    ASSERT_EQ(run({tool_bin(), "decode", hcs(), "-o", *dir_ / name, "--percent", p},
+                  *dir_ / "pdec.out", *dir_ / "pdec.err"),
               0)
         << read_text(*dir_ / "pdec.err");
     // "IN: decoded R of N records (...)"
@@ -293,8 +302,12 @@ TEST_F(ClientStreamTest, PercentMeansTheSameVerticesAsTheDecodeTool) {
     EXPECT_EQ(done["vertices"].get<uint32_t>(), tool_mesh.vertex_count()) << p;
     EXPECT_EQ(done["faces"].get<uint32_t>(), tool_mesh.face_count()) << p;
     EXPECT_EQ(read_text(out / "final.decoded.ply"), read_text(*dir_ / name)) << p;
-    EXPECT_LE(double(tool_mesh.vertex_count()), std::stod(p) / 100.0 * double(full.vertex_count()) + 1e-9) << p;
-    EXPECT_EQ(done["reason"], tool_records == done["records_total"].get<int>() ? "complete" : "budget") << p;
+    EXPECT_LE(double(tool_mesh.vertex_count()),
+              std::stod(p) / 100.0 * double(full.vertex_count()) + 1e-9)
+        << p;
+    EXPECT_EQ(done["reason"],
+              tool_records == done["records_total"].get<int>() ? "complete" : "budget")
+        << p;
   }
 }
 
@@ -303,24 +316,26 @@ TEST_F(ClientStreamTest, KilledAndRestartedServerGivesTheIdenticalFinalMesh) {
   const uint16_t port = free_port();
   auto server = std::make_unique<Server>();
   // Throttled so the kill lands mid-stream.
-  ASSERT_TRUE(server->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate", "20000",
-                             "--max-chunk-bytes", "1024"},
+  ASSERT_TRUE(server->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate",
+                             "20000", "--max-chunk-bytes", "1024"},
                             out.path(), port))
       << server->log();
   Child c;
   const std::string events_path = out / "events.txt";
-  ASSERT_TRUE(c.start({client_bin(), server->address(), "demo", "--json", "--out", out / "snaps"}, events_path,
-                      out / "client.err"));
+  ASSERT_TRUE(c.start({client_bin(), server->address(), "demo", "--json", "--out", out / "snaps"},
+                      events_path, out / "client.err"));
   // Wait for a few refinements, then kill the server without warning.
   const auto deadline = Clock::now() + 20s;
-  while (Clock::now() < deadline && of_kind(parse_events(read_text(events_path)), "refinement").size() < 3) {
+  while (Clock::now() < deadline &&
+         of_kind(parse_events(read_text(events_path)), "refinement").size() < 3) {
     std::this_thread::sleep_for(10ms);
   }
   ASSERT_GE(of_kind(parse_events(read_text(events_path)), "refinement").size(), 3u);
   server->kill_hard();
   std::this_thread::sleep_for(300ms);
   server = std::make_unique<Server>();
-  ASSERT_TRUE(server->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, out.path(), port))
+  ASSERT_TRUE(
+      server->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, out.path(), port))
       << server->log();
   const auto status = c.wait(60s);
   ASSERT_TRUE(status.has_value());
@@ -337,8 +352,8 @@ TEST_F(ClientStreamTest, KilledAndRestartedServerGivesTheIdenticalFinalMesh) {
 TEST_F(ClientStreamTest, ThrottledStreamShowsSeveralRefinementsBeforeTheEnd) {
   TempDir out;
   Server slow;
-  ASSERT_TRUE(slow.start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate", "40000",
-                          "--max-chunk-bytes", "2048"},
+  ASSERT_TRUE(slow.start({"--models", *dir_ / "models", "--cache", *dir_ / "cache", "--rate",
+                          "40000", "--max-chunk-bytes", "2048"},
                          out.path()))
       << slow.log();
   const ClientRun r = client(slow.address(), {"demo", "--json"});
@@ -366,14 +381,17 @@ TEST_F(ClientStreamTest, RealMeshFinalMeshesEqualOfflineDecodeAndSubdivide) {
   ASSERT_EQ(run({tool_bin(), "encode", input, "-o", hcs}, out / "enc.out", out / "enc.err"), 0)
       << read_text(out / "enc.err");
   Server server;
-  ASSERT_TRUE(server.start({"--models", models.path(), "--cache", out / "cache"}, out.path())) << server.log();
+  ASSERT_TRUE(server.start({"--models", models.path(), "--cache", out / "cache"}, out.path()))
+      << server.log();
   const ClientRun r = client(server.address(), {"bunny", "--json", "--out", out / "snaps"});
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
-  ASSERT_EQ(run({tool_bin(), "decode", hcs, "-o", out / "decoded.ply"}, out / "dec.out", out / "dec.err"), 0);
+  ASSERT_EQ(
+      run({tool_bin(), "decode", hcs, "-o", out / "decoded.ply"}, out / "dec.out", out / "dec.err"),
+      0);
   EXPECT_EQ(read_text(out / "snaps/final.decoded.ply"), read_text(out / "decoded.ply"));
-  ASSERT_EQ(run({tool_bin(), "subdivide", out / "decoded.ply", "-o", out / "sub.ply"}, out / "sub.out",
-                out / "sub.err"),
+  ASSERT_EQ(run({tool_bin(), "subdivide", out / "decoded.ply", "-o", out / "sub.ply"},
+                out / "sub.out", out / "sub.err"),
             0);
   EXPECT_TRUE(same_geometry(load_ply(out / "snaps/final.ply"), load_ply(out / "sub.ply")));
 }
@@ -403,15 +421,16 @@ TEST_F(ClientStreamTest, ServerErrorsExitOneWithTheirMessage) {
 }
 
 TEST_F(ClientStreamTest, UsageErrorsExitTwo) {
-  EXPECT_EQ(client("127.0.0.1", {"demo"}).status, 2);                      // no port
-  EXPECT_EQ(client(server_->address(), {}).status, 2);                     // no model
+  EXPECT_EQ(client("127.0.0.1", {"demo"}).status, 2);   // no port
+  EXPECT_EQ(client(server_->address(), {}).status, 2);  // no model
   EXPECT_EQ(client(server_->address(), {"demo", "--bytes", "10", "--vertices", "5"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--rule", "loop"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--percent", "0"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--percent", "nan"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--percent", "101"}).status, 2);
   EXPECT_EQ(client(server_->address(), {"demo", "--percent-bytes", "0"}).status, 2);
-  EXPECT_EQ(client(server_->address(), {"demo", "--percent", "5", "--percent-bytes", "5"}).status, 2);
+  EXPECT_EQ(client(server_->address(), {"demo", "--percent", "5", "--percent-bytes", "5"}).status,
+            2);
   EXPECT_EQ(client(server_->address(), {"demo", "--frobnicate"}).status, 2);
 }
 

@@ -40,7 +40,8 @@ bool is_plane_record(const StreamIndex& index, size_t r) {
          index.records[r].faces == index.records[r - 1].faces;
 }
 
-std::span<const uint8_t> record_bytes(const std::vector<uint8_t>& stream, const StreamIndex& index, size_t r) {
+std::span<const uint8_t> record_bytes(const std::vector<uint8_t>& stream, const StreamIndex& index,
+                                      size_t r) {
   // Record 0 comes with the container prefix.
   const uint64_t begin = r == 0 ? 0 : index.records[r].offset;
   const uint64_t end = index.records[r].offset + index.records[r].size;
@@ -56,7 +57,7 @@ double median(std::vector<double> v) {
 struct ReplayTimes {
   std::vector<double> plane_ms;   // take + frame copy + display build, per plane record
   std::vector<double> insert_ms;  // the same for the other records after the base
-  std::vector<double> decode_ms;     // per plane record: the decoder's time (network side, for scale)
+  std::vector<double> decode_ms;  // per plane record: the decoder's time (network side, for scale)
   std::vector<double> moved_share;   // per plane record: moved vertices / vertices
   std::vector<double> region_share;  // per plane record: ASA region faces / faces (0 = full run)
 };
@@ -92,8 +93,8 @@ ReplayTimes replay(const std::vector<uint8_t>& stream, bool asa, AsaPath path) {
       times.decode_ms.push_back(taken.decode_ms);
       times.moved_share.push_back(double(side.last_deltas().at(0).moved_vertices.size()) /
                                   double(side.mesh().vertex_count()));
-      times.region_share.push_back(report.incremental ? double(report.region_faces) / double(frame->face_count())
-                                                      : 0.0);
+      times.region_share.push_back(
+          report.incremental ? double(report.region_faces) / double(frame->face_count()) : 0.0);
     }
   }
   return times;
@@ -101,7 +102,8 @@ ReplayTimes replay(const std::vector<uint8_t>& stream, bool asa, AsaPath path) {
 
 bool same_positions_and_faces(const Mesh& a, const Mesh& b) {
   return a.triangles == b.triangles && a.positions.size() == b.positions.size() &&
-         std::memcmp(a.positions.data(), b.positions.data(), sizeof(Vec3f) * a.positions.size()) == 0;
+         std::memcmp(a.positions.data(), b.positions.data(), sizeof(Vec3f) * a.positions.size()) ==
+             0;
 }
 
 // Same faces in the same order with bit-identical corner positions (ASA's
@@ -110,7 +112,8 @@ bool same_faces_by_corners(const Mesh& a, const Mesh& b) {
   if (a.face_count() != b.face_count()) return false;
   for (uint32_t f = 0; f < a.face_count(); ++f) {
     for (int c = 0; c < 3; ++c) {
-      if (std::memcmp(&a.positions[a.triangles[f][c]], &b.positions[b.triangles[f][c]], sizeof(Vec3f)) != 0) {
+      if (std::memcmp(&a.positions[a.triangles[f][c]], &b.positions[b.triangles[f][c]],
+                      sizeof(Vec3f)) != 0) {
         return false;
       }
     }
@@ -147,7 +150,8 @@ TEST(PlaneRecordUpdate, PositionUpdatesEqualAFullRefreshAfterEveryRecord) {
       // Taken as a position update of exactly the vertices the record moved.
       EXPECT_FALSE(changes.full) << "record " << r;
       EXPECT_TRUE(changes.vertices.empty() && changes.faces.empty()) << "record " << r;
-      std::vector<uint32_t> moved = changes.moved, expected = reference.last_deltas().at(0).moved_vertices;
+      std::vector<uint32_t> moved = changes.moved,
+                            expected = reference.last_deltas().at(0).moved_vertices;
       std::sort(moved.begin(), moved.end());
       std::sort(expected.begin(), expected.end());
       EXPECT_EQ(moved, expected) << "record " << r;
@@ -164,9 +168,11 @@ TEST(PlaneRecordUpdate, PositionUpdatesEqualAFullRefreshAfterEveryRecord) {
       auto display = builder->build(frame, changes, true, options, r == 0, report);
       ASSERT_TRUE(display) << display.error().message;
       ASSERT_TRUE(same_faces_by_corners(*display->mesh, want->mesh))
-          << (builder == &automatic ? "auto" : "incremental") << " display differs after record " << r;
+          << (builder == &automatic ? "auto" : "incremental") << " display differs after record "
+          << r;
       ASSERT_EQ(*display->face_kind, want->face_kind) << "record " << r;
-      if (builder == &incremental && is_plane_record(*index, r)) plane_incremental += report.incremental;
+      if (builder == &incremental && is_plane_record(*index, r))
+        plane_incremental += report.incremental;
     }
   }
   EXPECT_GT(plane_records, 10u) << "the demo stream was expected to hold plane records";
@@ -180,7 +186,8 @@ TEST(PlaneRecordUpdate, PositionUpdatesEqualAFullRefreshAfterEveryRecord) {
 // MS_MEASURE_FACES sets the demo model's size (default 20000), MS_MEASURE_RUNS
 // the runs (default 5).
 TEST(PlaneRecordUpdate, DISABLED_MeasurePlaneRecordTime) {
-  const uint32_t faces = std::getenv("MS_MEASURE_FACES") ? std::atoi(std::getenv("MS_MEASURE_FACES")) : 20000;
+  const uint32_t faces =
+      std::getenv("MS_MEASURE_FACES") ? std::atoi(std::getenv("MS_MEASURE_FACES")) : 20000;
   const int runs = std::getenv("MS_MEASURE_RUNS") ? std::atoi(std::getenv("MS_MEASURE_RUNS")) : 5;
   const auto stream = demo_stream(faces);
   ASSERT_FALSE(stream.empty());
@@ -206,7 +213,8 @@ TEST(PlaneRecordUpdate, DISABLED_MeasurePlaneRecordTime) {
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       ASSERT_EQ(normals.size(), whole->positions.size());
     }
-    std::printf("  normals of the whole decoded mesh (%u vertices): %.4f ms\n", whole->vertex_count(), median(ms));
+    std::printf("  normals of the whole decoded mesh (%u vertices): %.4f ms\n",
+                whole->vertex_count(), median(ms));
   }
   for (const Config& c : configs) {
     std::vector<double> plane, insert, decode;
@@ -218,10 +226,11 @@ TEST(PlaneRecordUpdate, DISABLED_MeasurePlaneRecordTime) {
       insert.push_back(median(t.insert_ms));
       decode.push_back(median(t.decode_ms));
     }
-    std::printf("  %-16s plane records (%zu): %.4f ms (decoding one: %.4f ms)   other records: %.4f ms   "
-                "moved %.1f %% of vertices, ASA region %.1f %% of faces (0 = full run)\n",
-                c.name, t.plane_ms.size(), median(plane), median(decode), median(insert), 100 * median(t.moved_share),
-                100 * median(t.region_share));
+    std::printf(
+        "  %-16s plane records (%zu): %.4f ms (decoding one: %.4f ms)   other records: %.4f ms   "
+        "moved %.1f %% of vertices, ASA region %.1f %% of faces (0 = full run)\n",
+        c.name, t.plane_ms.size(), median(plane), median(decode), median(insert),
+        100 * median(t.moved_share), 100 * median(t.region_share));
   }
 }
 

@@ -6,11 +6,12 @@
 // mesh's counts) is refused with an error naming the problem. Hostile
 // inputs (random bytes, huge counts) end in an error, never a crash or a
 // huge allocation.
+#include "client/stream_facts.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "client/stream_facts.h"
 #include "common/codec/container.h"
 #include "common/codec/record_index_coder.h"
 
@@ -89,7 +90,8 @@ class StreamFactsTest : public ::testing::Test {
     ASSERT_FALSE(f) << "accepted: " << named;
     EXPECT_TRUE(f.error().code == ErrorCode::kParse || f.error().code == ErrorCode::kCorrupt)
         << f.error().message;
-    EXPECT_NE(f.error().message.find("compact record index"), std::string::npos) << f.error().message;
+    EXPECT_NE(f.error().message.find("compact record index"), std::string::npos)
+        << f.error().message;
     EXPECT_NE(f.error().message.find("'sample'"), std::string::npos) << f.error().message;
     EXPECT_NE(f.error().message.find(named), std::string::npos) << f.error().message;
   }
@@ -151,7 +153,8 @@ TEST_F(StreamFactsTest, TruncatedCodedIndexIsRefused) {
               uint32_t(records_.size()));
     auto f = facts_from_header(h);
     ASSERT_FALSE(f);
-    EXPECT_NE(f.error().message.find("compact record index"), std::string::npos) << f.error().message;
+    EXPECT_NE(f.error().message.find("compact record index"), std::string::npos)
+        << f.error().message;
   }
 }
 
@@ -164,7 +167,8 @@ TEST_F(StreamFactsTest, WrongCountIsRefused) {
     set_coded(h, coded_, count);
     auto f = facts_from_header(h);
     ASSERT_FALSE(f);
-    EXPECT_NE(f.error().message.find("compact record index"), std::string::npos) << f.error().message;
+    EXPECT_NE(f.error().message.find("compact record index"), std::string::npos)
+        << f.error().message;
   }
   v1::StreamHeader none = compact_;
   none.mutable_records()->set_count(0);

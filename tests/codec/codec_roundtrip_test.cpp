@@ -1,9 +1,9 @@
 // Exact round trips, valid prefixes, incremental feeding and budgets on
 // procedural meshes (real meshes: real_mesh_test.cpp).
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
@@ -148,7 +148,8 @@ TEST_P(ProceduralRoundTrip, DeltasCoverEveryChange) {
       std::sort(touched.begin(), touched.end());
       for (uint32_t f = 0; f < after.face_count(); ++f) {
         const bool changed = f >= before.face_count() || before.triangles[f] != after.triangles[f];
-        if (changed) EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), f)) << "face " << f;
+        if (changed)
+          EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), f)) << "face " << f;
       }
       for (uint32_t f : touched) EXPECT_LT(f, after.face_count());
       ASSERT_EQ(d.added_vertices.size(), after.vertex_count() - before.vertex_count());
@@ -160,7 +161,8 @@ TEST_P(ProceduralRoundTrip, DeltasCoverEveryChange) {
       if (!moved.empty()) EXPECT_TRUE(d.added_vertices.empty());
       for (uint32_t v = 0; v < before.vertex_count(); ++v) {
         if (!(before.positions[v] == after.positions[v]))
-          EXPECT_TRUE(std::binary_search(moved.begin(), moved.end(), v)) << "vertex " << v << " moved unnamed";
+          EXPECT_TRUE(std::binary_search(moved.begin(), moved.end(), v))
+              << "vertex " << v << " moved unnamed";
       }
       for (uint32_t v : moved) EXPECT_LT(v, before.vertex_count());
     }
@@ -180,7 +182,8 @@ TEST(Codec, LayersRemoveAFifthOrMore) {
   const StreamHeader& h = index->header;
   EXPECT_LE(h.base_vertex_count, 2 * opt.target_base_vertices);
   // log n layers: each keeps at most ~4/5 of the vertices on average.
-  const double per_layer = std::pow(double(h.base_vertex_count) / h.vertex_count, 1.0 / h.layer_count);
+  const double per_layer =
+      std::pow(double(h.base_vertex_count) / h.vertex_count, 1.0 / h.layer_count);
   EXPECT_LT(per_layer, 0.8) << h.layer_count << " layers";
 }
 
@@ -287,11 +290,13 @@ TEST(Codec, BudgetsSelectTheRightPrefix) {
       if (rec[i].vertices <= vertices) best = end(i);
     return best;
   };
-  EXPECT_EQ(prefix_for_budget(*index, {K::kVertices, double(rec[2].vertices)}), last_with_at_most(rec[2].vertices));
+  EXPECT_EQ(prefix_for_budget(*index, {K::kVertices, double(rec[2].vertices)}),
+            last_with_at_most(rec[2].vertices));
   EXPECT_EQ(prefix_for_budget(*index, {K::kVertices, double(rec[2].vertices + 1)}),
             last_with_at_most(rec[2].vertices + 1));
   const double pct = 100.0 * rec[3].vertices / index->header.vertex_count;
-  EXPECT_EQ(prefix_for_budget(*index, {K::kPercentVertices, pct}), last_with_at_most(rec[3].vertices));
+  EXPECT_EQ(prefix_for_budget(*index, {K::kPercentVertices, pct}),
+            last_with_at_most(rec[3].vertices));
   EXPECT_EQ(prefix_for_budget(*index, {K::kPercentVertices, 100}), bytes->size());
   // Ratio 20: the largest boundary within 1/20 of the stream.
   const uint64_t limit = bytes->size() / 20;

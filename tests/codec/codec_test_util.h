@@ -18,11 +18,12 @@ namespace meshstream::testing {
 inline Mesh icosphere(int levels, float bump = 0.0f) {
   const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
   Mesh m;
-  m.positions = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  m.positions = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (int l = 0; l < levels; ++l) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
     auto midpoint = [&](uint32_t a, uint32_t b) {
@@ -35,7 +36,8 @@ inline Mesh icosphere(int levels, float bump = 0.0f) {
     };
     std::vector<Triangle> next;
     for (const Triangle& tri : m.triangles) {
-      uint32_t ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]), ca = midpoint(tri[2], tri[0]);
+      uint32_t ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]),
+               ca = midpoint(tri[2], tri[0]);
       next.push_back({tri[0], ab, ca});
       next.push_back({tri[1], bc, ab});
       next.push_back({tri[2], ca, bc});
@@ -56,8 +58,8 @@ inline Mesh torus(int nu, int nv, float R = 1.0f, float r = 0.35f) {
   for (int i = 0; i < nu; ++i) {
     for (int j = 0; j < nv; ++j) {
       float a = 2 * float(M_PI) * i / nu, b = 2 * float(M_PI) * j / nv;
-      m.positions.push_back({(R + r * std::cos(b)) * std::cos(a), (R + r * std::cos(b)) * std::sin(a),
-                             r * std::sin(b)});
+      m.positions.push_back({(R + r * std::cos(b)) * std::cos(a),
+                             (R + r * std::cos(b)) * std::sin(a), r * std::sin(b)});
     }
   }
   auto id = [&](int i, int j) { return uint32_t(((i + nu) % nu) * nv + (j + nv) % nv); };
@@ -100,7 +102,8 @@ inline Mesh combine(const std::vector<Mesh>& parts, float spacing = 3.0f) {
   for (size_t i = 0; i < parts.size(); ++i) {
     const uint32_t base = out.vertex_count();
     for (Vec3f p : parts[i].positions) out.positions.push_back(p + Vec3f{spacing * float(i), 0, 0});
-    for (Triangle t : parts[i].triangles) out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    for (Triangle t : parts[i].triangles)
+      out.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   }
   return out;
 }

@@ -2,10 +2,10 @@
 // CRC-32 trailers (container.h, record_index_coder.h). Round trips of random
 // record lists, and hostile indexes and records: clear errors, never a
 // crash, a hang or a large allocation.
+#include <gtest/gtest.h>
+
 #include <chrono>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "common/codec/container.h"
 #include "common/codec/container_reseal.h"
@@ -85,7 +85,8 @@ TEST(ContainerV3, RandomRecordListsRoundTrip) {
       EXPECT_EQ(r.crc32, crc32(0, l.payloads[i].data(), l.payloads[i].size())) << "record " << i;
       EXPECT_TRUE(record_intact(r, bytes_of(written->bytes, r)));
       const auto payload = record_payload(r, bytes_of(written->bytes, r));
-      EXPECT_TRUE(std::equal(payload.begin(), payload.end(), l.payloads[i].begin(), l.payloads[i].end()));
+      EXPECT_TRUE(
+          std::equal(payload.begin(), payload.end(), l.payloads[i].begin(), l.payloads[i].end()));
       at += r.size;
     }
   }
@@ -100,7 +101,8 @@ TEST(ContainerV3, ExtremeEntriesRoundTrip) {
     uint64_t v = 0, f = 0;
     for (size_t i = 0; i < records.size(); ++i) {
       const uint32_t shift = rng() % 31;
-      records[i].size = std::max<uint32_t>(kRecordTrailerBytes, (rng() >> shift) % kMaxRecordBytes + 1);
+      records[i].size =
+          std::max<uint32_t>(kRecordTrailerBytes, (rng() >> shift) % kMaxRecordBytes + 1);
       const uint64_t dv = i > 0 && rng() % 3 == 0 ? 0 : (rng() >> (rng() % 32)) % (1u << 26);
       v += dv;
       f += dv + rng() % (dv + 1);
@@ -125,8 +127,9 @@ TEST(ContainerV3, ExtremeEntriesRoundTrip) {
 TEST(ContainerV3, WriterRefusesWhatTheReaderWould) {
   std::mt19937 rng(3);
   RecordList l = random_records(rng, 5);
-  EXPECT_FALSE(write_container(l.header, l.payloads, std::span(l.counts).first(4)));  // lengths differ
-  EXPECT_FALSE(write_container(l.header, {}, {}));                                    // no records
+  EXPECT_FALSE(
+      write_container(l.header, l.payloads, std::span(l.counts).first(4)));  // lengths differ
+  EXPECT_FALSE(write_container(l.header, {}, {}));                           // no records
   RecordList bad = l;
   bad.header.vertex_count += 1;  // last counts differ from the header's
   EXPECT_FALSE(write_container(bad.header, bad.payloads, bad.counts));
@@ -194,7 +197,8 @@ IndexAt index_at(const std::vector<uint8_t>& s) {
   const size_t header_size = s[8] | s[9] << 8 | s[10] << 16 | size_t(s[11]) << 24;
   a.count_at = 12 + header_size + 4;
   a.coded_at = a.count_at + 8;
-  a.length = s[a.count_at + 4] | s[a.count_at + 5] << 8 | s[a.count_at + 6] << 16 | size_t(s[a.count_at + 7]) << 24;
+  a.length = s[a.count_at + 4] | s[a.count_at + 5] << 8 | s[a.count_at + 6] << 16 |
+             size_t(s[a.count_at + 7]) << 24;
   return a;
 }
 void put_u32(std::vector<uint8_t>& s, size_t at, uint32_t v) {
@@ -251,7 +255,8 @@ TEST(ContainerV3, DamagedPayloadOrTrailerIsARecoverableChecksumError) {
     auto fed = dec.feed(bad);
     ASSERT_FALSE(fed) << "trial " << trial;
     EXPECT_EQ(fed.error().code, ErrorCode::kCorrupt);
-    EXPECT_NE(fed.error().message.find("record " + std::to_string(victim) + " of"), std::string::npos)
+    EXPECT_NE(fed.error().message.find("record " + std::to_string(victim) + " of"),
+              std::string::npos)
         << fed.error().message;
     EXPECT_NE(fed.error().message.find("checksum"), std::string::npos) << fed.error().message;
     EXPECT_TRUE(dec.error_is_recoverable());
@@ -280,10 +285,12 @@ TEST(ContainerV3, ResealedGarbageIndexIsAClearParseError) {
         for (size_t i = 0; i < a.length; ++i) s[a.coded_at + i] = uint8_t(rng());
         break;
       case 1:  // a few flipped bits
-        for (int k = 0; k < 1 + trial % 4; ++k) s[a.coded_at + rng() % a.length] ^= uint8_t(1u << (rng() % 8));
+        for (int k = 0; k < 1 + trial % 4; ++k)
+          s[a.coded_at + rng() % a.length] ^= uint8_t(1u << (rng() % 8));
         break;
       default:  // all zero or all 0xFF
-        std::fill(s.begin() + a.coded_at, s.begin() + a.coded_at + a.length, trial % 2 ? 0x00 : 0xFF);
+        std::fill(s.begin() + a.coded_at, s.begin() + a.coded_at + a.length,
+                  trial % 2 ? 0x00 : 0xFF);
         break;
     }
     reseal_checksums(s);
@@ -318,13 +325,15 @@ TEST(ContainerV3, ImplausibleCountAndLengthAreRefusedUpFront) {
   };
   // Too many records for the bytes; too many bytes a record; empty index;
   // the maximal count with a length that would need megabytes.
-  for (Case c : {Case{kMaxRecords, 10}, Case{3, 49}, Case{1, 0}, Case{kMaxRecords, 1u << 30}, Case{0, 10}}) {
+  for (Case c :
+       {Case{kMaxRecords, 10}, Case{3, 49}, Case{1, 0}, Case{kMaxRecords, 1u << 30}, Case{0, 10}}) {
     std::vector<uint8_t> s = clean;
     put_u32(s, a.count_at, c.count);
     put_u32(s, a.count_at + 4, c.length);
     auto index = read_stream_index(s);
     ASSERT_FALSE(index);
-    EXPECT_EQ(index.error().code, ErrorCode::kParse) << c.count << " / " << c.length << ": " << index.error().message;
+    EXPECT_EQ(index.error().code, ErrorCode::kParse)
+        << c.count << " / " << c.length << ": " << index.error().message;
   }
   // Coded bytes decoding to a huge count: 65536 zero bytes for 2^22 records.
   std::vector<uint8_t> s(clean.begin(), clean.begin() + a.coded_at);
@@ -400,7 +409,8 @@ TEST(ContainerV3, HugeClaimedRecordReservesNothingForIt) {
   const auto base = record_payload(r0, bytes_of(clean, r0));
   payloads[0].assign(base.begin(), base.end());
   payloads[1] = {1};
-  std::vector<RecordCounts> counts = {{r0.vertices, r0.faces}, {entries[1].vertices, entries[1].faces}};
+  std::vector<RecordCounts> counts = {{r0.vertices, r0.faces},
+                                      {entries[1].vertices, entries[1].faces}};
   auto shell = write_container(h, payloads, counts);
   ASSERT_TRUE(shell);
   const IndexAt a = index_at(shell->bytes);

@@ -2,13 +2,13 @@
 // cost's preference for removals that do not change the surface.
 #include "common/codec/decimate.h"
 
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cmath>
 #include <map>
 #include <optional>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "common/codec/quantize.h"
 
@@ -37,7 +37,8 @@ Mesh subdivided_cube(int s) {
             c[w] = j + dj;
             return vertex(c);
           };
-          const uint32_t p00 = corner(0, 0), p10 = corner(1, 0), p11 = corner(1, 1), p01 = corner(0, 1);
+          const uint32_t p00 = corner(0, 0), p10 = corner(1, 0), p11 = corner(1, 1),
+                         p01 = corner(0, 1);
           if (side == s) {
             m.triangles.push_back({p00, p10, p11});
             m.triangles.push_back({p00, p11, p01});
@@ -93,11 +94,11 @@ std::optional<GridDecimation> decimate_on_grid(const Mesh& mesh, const DecimateO
 TEST(Decimate, BaseTargetShrinksForSmallMeshesOnly) {
   DecimateOptions share;
   share.max_base_share = 1.0 / 16;
-  EXPECT_EQ(base_target(100000, share), 300u);  // large: the fixed target
-  EXPECT_EQ(base_target(4800, share), 300u);    // 1/16 of it is exactly 300
-  EXPECT_EQ(base_target(1861, share), 116u);    // hemisphere.off: 1/16
+  EXPECT_EQ(base_target(100000, share), 300u);         // large: the fixed target
+  EXPECT_EQ(base_target(4800, share), 300u);           // 1/16 of it is exactly 300
+  EXPECT_EQ(base_target(1861, share), 116u);           // hemisphere.off: 1/16
   EXPECT_EQ(base_target(300, share), kMinBaseTarget);  // never below the floor
-  const DecimateOptions off;  // the default (see DecimateOptions)
+  const DecimateOptions off;                           // the default (see DecimateOptions)
   EXPECT_EQ(base_target(1861, off), 300u);
   share.target_vertices = 50;
   EXPECT_EQ(base_target(1861, share), 50u);

@@ -1,9 +1,9 @@
 // The decoder's fast paths compute exactly what the encoder's shared steps
 // compute (the stream would desynchronise otherwise): select_patch_start
 // against the full ranking, with ties, boundaries and taken faces.
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 #include "common/codec/editable_mesh.h"
 #include "common/codec/quantize.h"

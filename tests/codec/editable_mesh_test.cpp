@@ -2,9 +2,9 @@
 // table identical to one built from scratch.
 #include "common/codec/editable_mesh.h"
 
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 #include "common/codec/base_coder.h"
 #include "common/codec/decimate.h"
@@ -46,7 +46,8 @@ TEST(EditableMesh, RemoveThenInsertRestoresTheStar) {
       m->star(ring[apex], ring2, corners2);
       bool clash = false;
       for (uint32_t j = 2; j + 2 <= ring.size(); ++j)
-        if (std::find(ring2.begin(), ring2.end(), ring[(apex + j) % ring.size()]) != ring2.end()) clash = true;
+        if (std::find(ring2.begin(), ring2.end(), ring[(apex + j) % ring.size()]) != ring2.end())
+          clash = true;
       if (m->is_boundary(v)) {
         m->star(ring.back(), ring2, corners2);
         if (std::find(ring2.begin(), ring2.end(), ring[0]) != ring2.end()) clash = true;
@@ -62,11 +63,13 @@ TEST(EditableMesh, RemoveThenInsertRestoresTheStar) {
       m->star(rotated[0], ring2, corners2);
       std::vector<uint8_t> used(corners2.size(), 0);
       std::vector<uint32_t> candidates;
-      rank_patch_starts(*m, rotated[0], ring2, used, static_cast<uint32_t>(rotated.size()), candidates);
+      rank_patch_starts(*m, rotated[0], ring2, used, static_cast<uint32_t>(rotated.size()),
+                        candidates);
       ResolvedPatch patch;
       bool found = false;
       for (uint32_t r : candidates) {
-        if (resolve_patch(*m, rotated[0], ring2, corners2, r, static_cast<uint32_t>(rotated.size()), patch) &&
+        if (resolve_patch(*m, rotated[0], ring2, corners2, r, static_cast<uint32_t>(rotated.size()),
+                          patch) &&
             patch.ring == rotated) {
           found = true;
           break;

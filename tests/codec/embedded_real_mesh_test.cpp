@@ -38,7 +38,9 @@ Encoded encode_real(const std::string& name) {
   return e;
 }
 
-uint64_t end_of(const StreamIndex& index, size_t i) { return index.records[i].offset + index.records[i].size; }
+uint64_t end_of(const StreamIndex& index, size_t i) {
+  return index.records[i].offset + index.records[i].size;
+}
 
 class EmbeddedRealMesh : public ::testing::TestWithParam<const char*> {};
 class EmbeddedRealMeshDistance : public ::testing::TestWithParam<const char*> {};
@@ -46,11 +48,10 @@ class EmbeddedRealMeshDistance : public ::testing::TestWithParam<const char*> {}
 // Distance to the original after every record, on every real model: the
 // symmetric RMS as the encoder measures it (RdMeasure::relative_rms, 8000
 // samples): fixed area samples on the original and fixed per-triangle
-// quadrature points on the decoded prefix (surface_quadrature.h). Plain area sampling of the prefix moves every
-// sample when one triangle changes; on CAD parts its RMS then jumps by
-// 10-20 % between records that barely differ (crank.off, 8000 samples),
-// which would hide or fake rises. With the quadrature a record's effect is
-// measured, not the sampler's.
+// quadrature points on the decoded prefix (surface_quadrature.h). Plain area sampling of the prefix
+// moves every sample when one triangle changes; on CAD parts its RMS then jumps by 10-20 % between
+// records that barely differ (crank.off, 8000 samples), which would hide or fake rises. With the
+// quadrature a record's effect is measured, not the sampler's.
 //
 // A plane record only sharpens positions: at most 2 % above the previous
 // RMS (a plane step can move a vertex whose true position was near the old
@@ -65,7 +66,8 @@ TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
   MESHSTREAM_REQUIRE_TEST_MESHES();
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   if (std::string(GetParam()) != "fandisk.off" && std::string(GetParam()) != "casting.off") {
-    GTEST_SKIP() << "sanitizer build: distances after every record on the two small CAD parts only (time)";
+    GTEST_SKIP()
+        << "sanitizer build: distances after every record on the two small CAD parts only (time)";
   }
 #endif
   const Encoded e = encode_real(GetParam());
@@ -88,7 +90,8 @@ TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
       const bool plane = e.report.records[i].plane;
       if (plane) {
         worst_plane = std::max(worst_plane, rms / previous - 1);
-        EXPECT_LE(rms, previous * 1.02 + 1e-9) << "plane record " << i << " of " << e.index.records.size();
+        EXPECT_LE(rms, previous * 1.02 + 1e-9)
+            << "plane record " << i << " of " << e.index.records.size();
       } else {
         worst_structure = std::max(worst_structure, rms / best - 1);
       }
@@ -98,8 +101,10 @@ TEST_P(EmbeddedRealMeshDistance, RmsNeverRisesAlongRecordBoundaries) {
     best = i == 0 ? rms : std::min(best, rms);
   }
   EXPECT_LT(previous, 1e-5);  // the full stream: the quantized original itself
-  std::printf("%s: %zu records, worst RMS rise: plane records %.2f %% over the previous, structure records %.2f %% over the best so far\n",
-              GetParam(), e.index.records.size(), 100 * worst_plane, 100 * worst_structure);
+  std::printf(
+      "%s: %zu records, worst RMS rise: plane records %.2f %% over the previous, structure records "
+      "%.2f %% over the best so far\n",
+      GetParam(), e.index.records.size(), 100 * worst_plane, 100 * worst_structure);
 }
 
 // At least min(n / 50, 200) record boundaries and no refinement record above
@@ -120,7 +125,8 @@ TEST_P(EmbeddedRealMesh, GranularModelMatchingExactStream) {
     const uint64_t end = end_of(e.index, i);
     ASSERT_TRUE(dec.feed(std::span<const uint8_t>(e.bytes.data() + fed, end - fed)));
     fed = end;
-    ASSERT_EQ(position_hash(dec.mesh().positions), e.report.records[i].position_hash) << "record " << i;
+    ASSERT_EQ(position_hash(dec.mesh().positions), e.report.records[i].position_hash)
+        << "record " << i;
   }
   auto reference = quantized_reference(e.mesh, 12);
   ASSERT_TRUE(reference);
@@ -149,7 +155,8 @@ TEST_P(EmbeddedRealMesh, BudgetsSelectTheLargestBoundaryWithin) {
   };
   for (double ratio : {2.0, 5.0, 20.0, 100.0}) {
     const uint64_t got = prefix_for_budget(index, {K::kRatio, ratio});
-    EXPECT_EQ(got, brute([&](size_t i) { return double(end_of(index, i)) <= total / ratio + 1e-9; }));
+    EXPECT_EQ(got,
+              brute([&](size_t i) { return double(end_of(index, i)) <= total / ratio + 1e-9; }));
     EXPECT_LE(got, std::max<double>(end_of(index, 0), total / ratio));
   }
   for (double fraction : {0.01, 0.1, 0.5}) {
@@ -179,11 +186,14 @@ std::string test_name(const ::testing::TestParamInfo<const char*>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, EmbeddedRealMesh,
-                         ::testing::Values("fandisk.off", "casting.off", "hemisphere.off", "bunny.off"), test_name);
+                         ::testing::Values("fandisk.off", "casting.off", "hemisphere.off",
+                                           "bunny.off"),
+                         test_name);
 // Distances after every record: every real model of the manifest.
 INSTANTIATE_TEST_SUITE_P(Shared, EmbeddedRealMeshDistance,
-                         ::testing::Values("bun_zipper.ply", "bunny.off", "bunny.stl", "armadillo.obj", "fandisk.off",
-                                           "crank.off", "casting.off", "mask.off", "hemisphere.off", "skull.obj",
+                         ::testing::Values("bun_zipper.ply", "bunny.off", "bunny.stl",
+                                           "armadillo.obj", "fandisk.off", "crank.off",
+                                           "casting.off", "mask.off", "hemisphere.off", "skull.obj",
                                            "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"),
                          test_name);
 

@@ -27,58 +27,58 @@ TEST(EmbeddedStream, EveryPrefixEqualsTheEncoderModel) {
     // The automatic ordering, then each distortion estimate alone (a fixed
     // balance encodes once), with either base coder.
     for (int estimate : {0, 1, 2})
-    for (bool draco : {true, false}) {
-      SCOPED_TRACE("mesh " + std::to_string(which) + (draco ? ", Draco base" : ", own base") + ", estimate " +
-                   std::to_string(estimate));
-      EncodeOptions options;
-      options.allow_draco_base = draco;
-      if (estimate != 0) {
-        options.plane_calibration = 1;
-        options.distortion_estimate = estimate;
-      }
-      EncodeReport report;
-      auto bytes = encode_hcs(mesh, options, &report);
-      ASSERT_TRUE(bytes) << bytes.error().message;
-      auto index = read_stream_index(*bytes);
-      ASSERT_TRUE(index);
-      ASSERT_EQ(report.records.size(), index->records.size());
-      IncrementalDecoder dec;
-      uint64_t fed = 0;
-      size_t planes = 0, moving_planes = 0;
-      std::vector<Vec3f> before;
-      for (size_t i = 0; i < index->records.size(); ++i) {
-        const uint64_t end = index->records[i].offset + index->records[i].size;
-        auto r = dec.feed(std::span<const uint8_t>(bytes->data() + fed, end - fed));
-        fed = end;
-        ASSERT_TRUE(r) << "record " << i << ": " << r.error().message;
-        ASSERT_EQ(dec.mesh().vertex_count(), report.records[i].vertices) << "record " << i;
-        ASSERT_EQ(position_hash(dec.mesh().positions), report.records[i].position_hash)
-            << "record " << i << (report.records[i].plane ? " (plane)" : " (structure)");
-        if (report.records[i].plane) {
-          ++planes;
-          ASSERT_EQ(dec.last_deltas().size(), 1u);
-          EXPECT_TRUE(dec.last_deltas()[0].added_vertices.empty());
-          EXPECT_TRUE(dec.last_deltas()[0].touched_faces.empty());
-          // Exactly the vertices whose positions changed are reported. A
-          // plane record may move none: at shift 1 a vertex sits at the low
-          // end of its interval, so a last plane of zero bits keeps it.
-          std::vector<uint32_t> moved;
-          for (uint32_t v = 0; v < before.size(); ++v)
-            if (!(before[v] == dec.mesh().positions[v])) moved.push_back(v);
-          std::vector<uint32_t> reported = dec.last_deltas()[0].moved_vertices;
-          std::sort(reported.begin(), reported.end());
-          EXPECT_EQ(reported, moved) << "record " << i;
-          EXPECT_EQ(dec.last_deltas()[0].full_rebuild, !moved.empty());
-          if (!moved.empty()) ++moving_planes;
+      for (bool draco : {true, false}) {
+        SCOPED_TRACE("mesh " + std::to_string(which) + (draco ? ", Draco base" : ", own base") +
+                     ", estimate " + std::to_string(estimate));
+        EncodeOptions options;
+        options.allow_draco_base = draco;
+        if (estimate != 0) {
+          options.plane_calibration = 1;
+          options.distortion_estimate = estimate;
         }
-        before = dec.mesh().positions;
+        EncodeReport report;
+        auto bytes = encode_hcs(mesh, options, &report);
+        ASSERT_TRUE(bytes) << bytes.error().message;
+        auto index = read_stream_index(*bytes);
+        ASSERT_TRUE(index);
+        ASSERT_EQ(report.records.size(), index->records.size());
+        IncrementalDecoder dec;
+        uint64_t fed = 0;
+        size_t planes = 0, moving_planes = 0;
+        std::vector<Vec3f> before;
+        for (size_t i = 0; i < index->records.size(); ++i) {
+          const uint64_t end = index->records[i].offset + index->records[i].size;
+          auto r = dec.feed(std::span<const uint8_t>(bytes->data() + fed, end - fed));
+          fed = end;
+          ASSERT_TRUE(r) << "record " << i << ": " << r.error().message;
+          ASSERT_EQ(dec.mesh().vertex_count(), report.records[i].vertices) << "record " << i;
+          ASSERT_EQ(position_hash(dec.mesh().positions), report.records[i].position_hash)
+              << "record " << i << (report.records[i].plane ? " (plane)" : " (structure)");
+          if (report.records[i].plane) {
+            ++planes;
+            ASSERT_EQ(dec.last_deltas().size(), 1u);
+            EXPECT_TRUE(dec.last_deltas()[0].added_vertices.empty());
+            EXPECT_TRUE(dec.last_deltas()[0].touched_faces.empty());
+            // Exactly the vertices whose positions changed are reported. A
+            // plane record may move none: at shift 1 a vertex sits at the low
+            // end of its interval, so a last plane of zero bits keeps it.
+            std::vector<uint32_t> moved;
+            for (uint32_t v = 0; v < before.size(); ++v)
+              if (!(before[v] == dec.mesh().positions[v])) moved.push_back(v);
+            std::vector<uint32_t> reported = dec.last_deltas()[0].moved_vertices;
+            std::sort(reported.begin(), reported.end());
+            EXPECT_EQ(reported, moved) << "record " << i;
+            EXPECT_EQ(dec.last_deltas()[0].full_rebuild, !moved.empty());
+            if (!moved.empty()) ++moving_planes;
+          }
+          before = dec.mesh().positions;
+        }
+        EXPECT_GT(moving_planes, 0u) << "an embedded stream refines positions in plane records";
+        auto reference = quantized_reference(mesh, 12);
+        ASSERT_TRUE(reference);
+        EXPECT_EQ(sorted_positions(dec.mesh()), sorted_positions(*reference));
+        EXPECT_EQ(canonical_faces(dec.mesh()), canonical_faces(*reference));
       }
-      EXPECT_GT(moving_planes, 0u) << "an embedded stream refines positions in plane records";
-      auto reference = quantized_reference(mesh, 12);
-      ASSERT_TRUE(reference);
-      EXPECT_EQ(sorted_positions(dec.mesh()), sorted_positions(*reference));
-      EXPECT_EQ(canonical_faces(dec.mesh()), canonical_faces(*reference));
-    }
   }
 }
 
@@ -97,8 +97,10 @@ TEST(EmbeddedStream, CandidatesOnThreadsGiveTheSameStream) {
     EXPECT_EQ(*a, *b);
     ASSERT_EQ(serial_report.records.size(), threaded_report.records.size());
     for (size_t i = 0; i < serial_report.records.size(); ++i)
-      EXPECT_EQ(serial_report.records[i].position_hash, threaded_report.records[i].position_hash) << i;
-    EXPECT_EQ(serial_report.ordering.distortion_estimate, threaded_report.ordering.distortion_estimate);
+      EXPECT_EQ(serial_report.records[i].position_hash, threaded_report.records[i].position_hash)
+          << i;
+    EXPECT_EQ(serial_report.ordering.distortion_estimate,
+              threaded_report.ordering.distortion_estimate);
   }
 }
 

@@ -1,18 +1,18 @@
 // Truncated, bit-flipped, re-checksummed and random streams: errors, never
 // crashes, and the decoder keeps the last good mesh.
+#include <gtest/gtest.h>
+
 #include <chrono>
 #include <fstream>
 #include <iterator>
 #include <random>
 
-#include <gtest/gtest.h>
-
 #include "common/codec/base_coder.h"
 #include "common/codec/container_reseal.h"
-#include "common/codec/quantize.h"
-#include "common/codec/refinement_codec.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
+#include "common/codec/quantize.h"
+#include "common/codec/refinement_codec.h"
 #include "common/mesh/adjacency.h"
 #include "tests/codec/codec_test_util.h"
 
@@ -32,7 +32,8 @@ std::vector<uint8_t> sample_stream(bool draco_base = true) {
 }
 
 // The record payloads of a stream (without version-3 trailers).
-std::vector<std::vector<uint8_t>> payloads_of(const std::vector<uint8_t>& stream, const StreamIndex& index) {
+std::vector<std::vector<uint8_t>> payloads_of(const std::vector<uint8_t>& stream,
+                                              const StreamIndex& index) {
   std::vector<std::vector<uint8_t>> payloads;
   for (const RecordEntry& e : index.records) {
     const auto p = record_payload(e, std::span<const uint8_t>(stream).subspan(e.offset, e.size));
@@ -42,7 +43,8 @@ std::vector<std::vector<uint8_t>> payloads_of(const std::vector<uint8_t>& stream
 }
 
 // A stream of `payloads` with the counts of `index` and valid checksums.
-std::vector<uint8_t> rebuild(const StreamIndex& index, const std::vector<std::vector<uint8_t>>& payloads) {
+std::vector<uint8_t> rebuild(const StreamIndex& index,
+                             const std::vector<std::vector<uint8_t>>& payloads) {
   std::vector<RecordCounts> counts;
   for (const RecordEntry& e : index.records) counts.push_back({e.vertices, e.faces});
   auto written = write_container(index.header, payloads, counts);
@@ -54,8 +56,9 @@ std::vector<uint8_t> rebuild(const StreamIndex& index, const std::vector<std::ve
 Mesh mesh_after(const std::vector<uint8_t>& clean, uint32_t records) {
   IncrementalDecoder dec;
   auto index = read_stream_index(clean);
-  const uint64_t end = records == 0 ? index->payload_offset
-                                    : index->records[records - 1].offset + index->records[records - 1].size;
+  const uint64_t end = records == 0
+                           ? index->payload_offset
+                           : index->records[records - 1].offset + index->records[records - 1].size;
   EXPECT_TRUE(dec.feed(std::span<const uint8_t>(clean.data(), end)));
   return dec.mesh();
 }
@@ -69,7 +72,8 @@ TEST(HostileStream, TruncatedPrefixesDecodeWhatIsComplete) {
     const size_t cut = rng() % clean.size();
     IncrementalDecoder dec;
     auto r = dec.feed(std::span<const uint8_t>(clean.data(), cut));
-    ASSERT_TRUE(r) << "a truncated stream is not an error while more may come: " << r.error().message;
+    ASSERT_TRUE(r) << "a truncated stream is not an error while more may come: "
+                   << r.error().message;
     EXPECT_FALSE(dec.finished());
     auto whole = decode_hcs(std::span<const uint8_t>(clean.data(), cut));
     if (cut < index->records[0].offset + index->records[0].size) {
@@ -158,7 +162,8 @@ TEST(HostileStream, RandomBytesAreRefused) {
   for (int trial = 0; trial < 300; ++trial) {
     std::vector<uint8_t> junk(rng() % 600);
     for (auto& b : junk) b = static_cast<uint8_t>(rng());
-    if (trial % 2 == 0 && junk.size() >= 4) std::copy(kContainerMagic, kContainerMagic + 4, junk.begin());
+    if (trial % 2 == 0 && junk.size() >= 4)
+      std::copy(kContainerMagic, kContainerMagic + 4, junk.begin());
     IncrementalDecoder dec;
     auto r = dec.feed(junk);
     if (r) {
@@ -188,9 +193,15 @@ TEST(HostileStream, ResealedPlaneRecordCorruption) {
     const size_t victim = planes[rng() % planes.size()];
     std::vector<uint8_t>& p = payloads[victim];
     switch (trial % 4) {
-      case 0: p.resize(1 + rng() % p.size()); break;                        // cut short
-      case 1: p[1 + rng() % 3 % (p.size() - 1)] ^= uint8_t(1u << (rng() % 8)); break;  // range header
-      default: p[rng() % p.size()] ^= uint8_t(1u << (rng() % 8)); break;
+      case 0:
+        p.resize(1 + rng() % p.size());
+        break;  // cut short
+      case 1:
+        p[1 + rng() % 3 % (p.size() - 1)] ^= uint8_t(1u << (rng() % 8));
+        break;  // range header
+      default:
+        p[rng() % p.size()] ^= uint8_t(1u << (rng() % 8));
+        break;
     }
     const std::vector<uint8_t> stream = rebuild(*index, payloads);
     IncrementalDecoder dec;
@@ -204,7 +215,8 @@ TEST(HostileStream, ResealedPlaneRecordCorruption) {
     }
     // The grid spans the box's largest extent on every axis.
     const BoundingBox box = index->header.bounds;
-    const float extent = std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
+    const float extent =
+        std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
     for (const Vec3f& v : dec.mesh().positions) {
       for (int a = 0; a < 3; ++a) {
         const float lo = (&box.min.x)[a], hi = lo + extent;
@@ -285,8 +297,9 @@ TEST(HostileStream, ResealMakesEveryChecksumMatch) {
       EXPECT_TRUE(record_intact(r, std::span<const uint8_t>(damaged.data() + r.offset, r.size)));
   }
   // A version-1 stream from issue I's encoder.
-  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/issue1_components3_own.hcs",
-                   std::ios::binary);
+  std::ifstream in(
+      std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/issue1_components3_own.hcs",
+      std::ios::binary);
   ASSERT_TRUE(in);
   std::vector<uint8_t> v1{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   ASSERT_GT(v1.size(), 6u);
@@ -295,12 +308,14 @@ TEST(HostileStream, ResealMakesEveryChecksumMatch) {
   ASSERT_TRUE(index);
   v1[index->records.back().offset] ^= 0x01;
   EXPECT_FALSE(record_intact(index->records.back(),
-                             std::span<const uint8_t>(v1.data() + index->records.back().offset, index->records.back().size)));
+                             std::span<const uint8_t>(v1.data() + index->records.back().offset,
+                                                      index->records.back().size)));
   reseal_checksums(v1);
   auto resealed = read_stream_index(v1);
   ASSERT_TRUE(resealed);
-  EXPECT_TRUE(record_intact(resealed->records.back(), std::span<const uint8_t>(v1.data() + resealed->records.back().offset,
-                                                                                 resealed->records.back().size)));
+  EXPECT_TRUE(record_intact(resealed->records.back(),
+                            std::span<const uint8_t>(v1.data() + resealed->records.back().offset,
+                                                     resealed->records.back().size)));
   // Random bytes: never out of bounds (run under the sanitizer builds).
   for (int trial = 0; trial < 300; ++trial) {
     std::vector<uint8_t> junk(rng() % 300);
@@ -317,14 +332,16 @@ TEST(HostileStream, ResealMakesEveryChecksumMatch) {
 // The fuzzer's reproducer (tests/fuzz/regressions/hcs_decoder): refused
 // quickly, no multi-gigabyte reservation.
 TEST(HostileStream, DracoReservationReproducerIsRefusedQuickly) {
-  const std::string path =
-      std::string(MESHSTREAM_SOURCE_DIR) + "/tests/fuzz/regressions/hcs_decoder/draco-base-reserves-5.7GB";
+  const std::string path = std::string(MESHSTREAM_SOURCE_DIR) +
+                           "/tests/fuzz/regressions/hcs_decoder/draco-base-reserves-5.7GB";
   std::ifstream in(path, std::ios::binary);
   ASSERT_TRUE(in) << path;
-  const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in),
+                                   std::istreambuf_iterator<char>()};
   const auto start = std::chrono::steady_clock::now();
   auto r = decode_hcs(bytes);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_FALSE(r);
   EXPECT_LT(seconds, 0.5) << "the Draco guard should refuse it before decoding";
 }

@@ -5,11 +5,11 @@
 //                 written by the encoder just before container 3 (kEncoderVersion 4).
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <iterator>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "common/codec/container.h"
 #include "common/codec/container_reseal.h"
@@ -20,7 +20,8 @@ namespace meshstream {
 namespace {
 
 std::vector<uint8_t> read_sample(const std::string& name) {
-  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/" + name, std::ios::binary);
+  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/" + name,
+                   std::ios::binary);
   EXPECT_TRUE(in) << name;
   return std::vector<uint8_t>{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
@@ -63,7 +64,8 @@ TEST(LegacyStreams, DecodeToTheSameMeshAsWhenWritten) {
     for (const RecordEntry& r : index->records) {
       EXPECT_FALSE(r.crc_trailer);
       EXPECT_TRUE(record_intact(r, std::span<const uint8_t>(bytes).subspan(r.offset, r.size)));
-      EXPECT_EQ(record_payload(r, std::span<const uint8_t>(bytes).subspan(r.offset, r.size)).size(), r.size);
+      EXPECT_EQ(record_payload(r, std::span<const uint8_t>(bytes).subspan(r.offset, r.size)).size(),
+                r.size);
     }
     // Record by record, as a client receives it.
     IncrementalDecoder dec;
@@ -75,7 +77,8 @@ TEST(LegacyStreams, DecodeToTheSameMeshAsWhenWritten) {
       EXPECT_EQ(dec.mesh().face_count(), r.faces) << s.name;
     }
     EXPECT_TRUE(dec.finished()) << s.name;
-    EXPECT_EQ(mesh_hash(dec.mesh()), s.hash) << s.name << " hash 0x" << std::hex << mesh_hash(dec.mesh());
+    EXPECT_EQ(mesh_hash(dec.mesh()), s.hash)
+        << s.name << " hash 0x" << std::hex << mesh_hash(dec.mesh());
     auto whole = decode_hcs(bytes);
     ASSERT_TRUE(whole) << s.name;
     EXPECT_EQ(mesh_hash(*whole), s.hash) << s.name;
@@ -90,7 +93,8 @@ TEST(LegacyStreams, VersionTwoChecksumsAndReseal) {
   ASSERT_TRUE(index);
   const RecordEntry victim = index->records[3];
   bytes[victim.offset + victim.size / 2] ^= 0x08;
-  EXPECT_FALSE(record_intact(victim, std::span<const uint8_t>(bytes).subspan(victim.offset, victim.size)));
+  EXPECT_FALSE(
+      record_intact(victim, std::span<const uint8_t>(bytes).subspan(victim.offset, victim.size)));
   IncrementalDecoder dec;
   auto fed = dec.feed(bytes);
   ASSERT_FALSE(fed);
@@ -99,7 +103,8 @@ TEST(LegacyStreams, VersionTwoChecksumsAndReseal) {
   reseal_checksums(bytes);
   auto resealed = read_stream_index(bytes);
   ASSERT_TRUE(resealed);
-  EXPECT_TRUE(record_intact(resealed->records[3], std::span<const uint8_t>(bytes).subspan(victim.offset, victim.size)));
+  EXPECT_TRUE(record_intact(resealed->records[3],
+                            std::span<const uint8_t>(bytes).subspan(victim.offset, victim.size)));
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 #include "common/codec/range_coder.h"
 
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 namespace meshstream {
 namespace {

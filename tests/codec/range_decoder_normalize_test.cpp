@@ -3,9 +3,9 @@
 // 2048 (then a range >= 2^24 before a bit is > 2^16 after it). These tests
 // hold the models to that bound under the most skewed inputs and check that
 // such runs, where the range shrinks fastest, still decode exactly.
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <random>
 
 #include "common/codec/range_coder.h"
 
@@ -65,9 +65,13 @@ void check_bound_and_round_trip() {
   }
 }
 
-TEST(RangeDecoderNormalize, BitModelStaysInBoundAndDecodes) { check_bound_and_round_trip<BitModel>(); }
+TEST(RangeDecoderNormalize, BitModelStaysInBoundAndDecodes) {
+  check_bound_and_round_trip<BitModel>();
+}
 
-TEST(RangeDecoderNormalize, BitModelVStaysInBoundAndDecodes) { check_bound_and_round_trip<BitModelV>(); }
+TEST(RangeDecoderNormalize, BitModelVStaysInBoundAndDecodes) {
+  check_bound_and_round_trip<BitModelV>();
+}
 
 // Every state a BitModelV can reach from its start, by exhaustive search
 // over the (probability, count) pairs: the bound holds for all of them.

@@ -15,12 +15,33 @@ namespace {
 using namespace meshstream::testing;
 
 const char* kRealMeshes[] = {
-    "bun_zipper.ply", "bunny.off",      "bunny.stl",       "armadillo.obj",  "fandisk.off",
-    "crank.off",      "casting.off",    "mask.off",        "hemisphere.off", "skull.obj",
-    "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply", "sphere.obj",     "sphere_low.off",
-    "chamfer-cube.off", "cube_att.obj", "cube_quads.obj",  "octagon.obj",    "suzanne.obj",
-    "multiple_isolated_triangles.obj", "multiple_tetrahedrons.obj", "test_nm.obj",
-    "extra_vertex.obj", "eof_test.obj", "deg_faces.obj", "non_manifold_wrap.obj",
+    "bun_zipper.ply",
+    "bunny.off",
+    "bunny.stl",
+    "armadillo.obj",
+    "fandisk.off",
+    "crank.off",
+    "casting.off",
+    "mask.off",
+    "hemisphere.off",
+    "skull.obj",
+    "maneki-neko.off",
+    "dragon_res2.ply",
+    "dragon_res3.ply",
+    "sphere.obj",
+    "sphere_low.off",
+    "chamfer-cube.off",
+    "cube_att.obj",
+    "cube_quads.obj",
+    "octagon.obj",
+    "suzanne.obj",
+    "multiple_isolated_triangles.obj",
+    "multiple_tetrahedrons.obj",
+    "test_nm.obj",
+    "extra_vertex.obj",
+    "eof_test.obj",
+    "deg_faces.obj",
+    "non_manifold_wrap.obj",
 };
 
 class RealMesh : public ::testing::TestWithParam<const char*> {};
@@ -48,13 +69,12 @@ TEST_P(RealMesh, ExactRoundTrip) {
   EXPECT_EQ(adj_out->edge_count(), adj_in->edge_count());
 }
 
-INSTANTIATE_TEST_SUITE_P(Shared, RealMesh, ::testing::ValuesIn(kRealMeshes),
-                         [](const auto& info) {
-                           std::string name = info.param;
-                           for (char& c : name)
-                             if (!isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return name;
-                         });
+INSTANTIATE_TEST_SUITE_P(Shared, RealMesh, ::testing::ValuesIn(kRealMeshes), [](const auto& info) {
+  std::string name = info.param;
+  for (char& c : name)
+    if (!isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
+});
 
 // Every record boundary of a few real streams: a valid manifold mesh with
 // the index's counts, no combinatorially degenerate face, and the same Euler
@@ -71,8 +91,8 @@ TEST_P(RealMeshPrefixes, EveryRecordBoundaryIsValid) {
   ASSERT_TRUE(index);
   auto full = Adjacency::build(imported->mesh);
   ASSERT_TRUE(full);
-  const int64_t euler_full = int64_t(imported->mesh.vertex_count()) - full->edge_count() +
-                             imported->mesh.face_count();
+  const int64_t euler_full =
+      int64_t(imported->mesh.vertex_count()) - full->edge_count() + imported->mesh.face_count();
   IncrementalDecoder dec;
   uint64_t fed = 0;
   for (size_t i = 0; i < index->records.size(); ++i) {
@@ -93,8 +113,8 @@ TEST_P(RealMeshPrefixes, EveryRecordBoundaryIsValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, RealMeshPrefixes,
-                         ::testing::Values("fandisk.off", "mask.off", "casting.off", "dragon_res3.ply",
-                                           "suzanne.obj"),
+                         ::testing::Values("fandisk.off", "mask.off", "casting.off",
+                                           "dragon_res3.ply", "suzanne.obj"),
                          [](const auto& info) {
                            std::string name = info.param;
                            for (char& c : name)

@@ -82,7 +82,8 @@ TEST(RefinementFormat, BitModelVRoundTripsAndFollowsItsSchedule) {
 
   std::mt19937 rng(7);
   std::vector<uint32_t> symbols(5000);
-  for (uint32_t& s : symbols) s = std::min<uint32_t>(15, std::geometric_distribution<uint32_t>(0.4)(rng));
+  for (uint32_t& s : symbols)
+    s = std::min<uint32_t>(15, std::geometric_distribution<uint32_t>(0.4)(rng));
   RangeEncoder enc;
   BitTreeModel<4, BitModelV> tree_v[3];
   BitTreeModel<4> tree[3];

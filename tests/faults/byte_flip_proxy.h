@@ -23,7 +23,8 @@ namespace meshstream::faulttest {
 
 class ByteFlipProxy {
  public:
-  ByteFlipProxy(uint16_t server_port, int corrupt_chunk) : server_port_(server_port), corrupt_chunk_(corrupt_chunk) {
+  ByteFlipProxy(uint16_t server_port, int corrupt_chunk)
+      : server_port_(server_port), corrupt_chunk_(corrupt_chunk) {
     listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     int one = 1;
     ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
@@ -97,7 +98,8 @@ class ByteFlipProxy {
           auto m = reader.next();
           if (!m || !*m) break;
           v1::ServerMessage message = std::move(**m);
-          if (corrupt && message.has_chunk() && !message.chunk().data().empty() && ++chunks == corrupt_chunk_) {
+          if (corrupt && message.has_chunk() && !message.chunk().data().empty() &&
+              ++chunks == corrupt_chunk_) {
             std::string& data = *message.mutable_chunk()->mutable_data();
             data[data.size() / 2] ^= 0x5a;
             flipped_ = true;

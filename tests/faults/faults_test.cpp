@@ -31,7 +31,8 @@ class FaultTest : public ::testing::Test {
     dir_ = new ct::TempDir();
     fs::create_directories(*dir_ / "models");
     // A mesh file (not .hcs), so the server encodes it into its cache.
-    ASSERT_EQ(ct::run({ct::tool_bin(), "generate", "demo", "--size", "20000", "-o", *dir_ / "models/demo.ply"},
+    ASSERT_EQ(ct::run({ct::tool_bin(), "generate", "demo", "--size", "20000", "-o",
+                       *dir_ / "models/demo.ply"},
                       *dir_ / "gen.out", *dir_ / "gen.err"),
               0)
         << ct::read_text(*dir_ / "gen.err");
@@ -42,7 +43,8 @@ class FaultTest : public ::testing::Test {
   }
 
   // Starts a server on the shared models and its own cache folder.
-  static std::unique_ptr<ct::Server> start_server(const std::string& cache, std::vector<std::string> extra = {},
+  static std::unique_ptr<ct::Server> start_server(const std::string& cache,
+                                                  std::vector<std::string> extra = {},
                                                   uint16_t port = 0) {
     std::vector<std::string> args{"--models", *dir_ / "models", "--cache", cache};
     args.insert(args.end(), extra.begin(), extra.end());
@@ -80,8 +82,10 @@ class FaultTest : public ::testing::Test {
   }
 
   // meshstream-client HOST:PORT demo --out DIR; exit status.
-  static int run_client(const std::string& address, const std::string& out, std::vector<std::string> extra = {}) {
-    std::vector<std::string> argv{ct::client_bin(), address, "demo", "--json", "--quiet", "--out", out};
+  static int run_client(const std::string& address, const std::string& out,
+                        std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{ct::client_bin(), address, "demo", "--json",
+                                  "--quiet",        "--out", out};
     argv.insert(argv.end(), extra.begin(), extra.end());
     return ct::run(argv, out + ".events", out + ".err");
   }
@@ -103,7 +107,9 @@ TEST_F(FaultTest, VanishingAndStallingClientsLeaveOthersByteExact) {
   request.mutable_stream()->set_model("demo");
   const std::vector<uint8_t> hello_frame = meshstream::proto::encode_frame(hello);
   const std::vector<uint8_t> request_frame = meshstream::proto::encode_frame(request);
-  auto half = [](const std::vector<uint8_t>& f) { return std::vector<uint8_t>(f.begin(), f.begin() + f.size() / 2); };
+  auto half = [](const std::vector<uint8_t>& f) {
+    return std::vector<uint8_t>(f.begin(), f.begin() + f.size() / 2);
+  };
 
   // 40 clients vanish: half a Hello, half a request, or mid-stream; every
   // other one resets the connection (SO_LINGER 0) instead of closing.
@@ -142,7 +148,8 @@ TEST_F(FaultTest, VanishingAndStallingClientsLeaveOthersByteExact) {
     EXPECT_EQ(r.bytes, expected) << "stream " << i << " differs from the cached stream";
   }
   // The stallers are closed by the server's deadlines (not left hanging).
-  EXPECT_TRUE(stall_hello.wait_closed(5s)) << "half a Hello: not closed after the handshake timeout";
+  EXPECT_TRUE(stall_hello.wait_closed(5s))
+      << "half a Hello: not closed after the handshake timeout";
   EXPECT_TRUE(stall_request.wait_closed(5s)) << "half a request: not closed after the idle timeout";
   const nt::StreamResult after = stream_all(server->port());
   ASSERT_TRUE(after.ok) << after.problem;
@@ -166,10 +173,18 @@ TEST_F(FaultTest, FloodsAndGarbageAreRefusedWhileOthersStream) {
   for (int i = 0; i < 5000; ++i) {
     v1::ClientMessage m;
     switch (i % 4) {
-      case 0: m.mutable_stream()->set_model("demo"); break;
-      case 1: m.mutable_list_models(); break;
-      case 2: m.mutable_cancel(); break;
-      default: m.mutable_stream()->set_model("no-such-model-" + std::to_string(i)); break;
+      case 0:
+        m.mutable_stream()->set_model("demo");
+        break;
+      case 1:
+        m.mutable_list_models();
+        break;
+      case 2:
+        m.mutable_cancel();
+        break;
+      default:
+        m.mutable_stream()->set_model("no-such-model-" + std::to_string(i));
+        break;
     }
     meshstream::proto::append_frame(m, burst);
   }
@@ -215,7 +230,8 @@ TEST_F(FaultTest, ServerKilledMidStreamClientResumesToTheSameFinalMesh) {
   auto reference_server = start_server(cache);
   ASSERT_TRUE(reference_server);
   const std::string reference = *dir_ / "uninterrupted";
-  ASSERT_EQ(run_client(reference_server->address(), reference), 0) << ct::read_text(reference + ".err");
+  ASSERT_EQ(run_client(reference_server->address(), reference), 0)
+      << ct::read_text(reference + ".err");
   reference_server.reset();
 
   const uint16_t port = ct::free_port();
@@ -223,23 +239,28 @@ TEST_F(FaultTest, ServerKilledMidStreamClientResumesToTheSameFinalMesh) {
   ASSERT_TRUE(server);
   const std::string out = *dir_ / "killed";
   ct::Child client;
-  ASSERT_TRUE(client.start({ct::client_bin(), server->address(), "demo", "--json", "--quiet", "--out", out},
-                           out + ".events", out + ".err"));
+  ASSERT_TRUE(
+      client.start({ct::client_bin(), server->address(), "demo", "--json", "--quiet", "--out", out},
+                   out + ".events", out + ".err"));
   for (int kill = 0; kill < 2; ++kill) {
     // Wait for some progress, then SIGKILL the server and restart it.
-    const size_t before = ct::of_kind(ct::parse_events(ct::read_text(out + ".events")), "refinement").size();
+    const size_t before =
+        ct::of_kind(ct::parse_events(ct::read_text(out + ".events")), "refinement").size();
     const auto deadline = ct::Clock::now() + 20s;
     while (ct::Clock::now() < deadline &&
-           ct::of_kind(ct::parse_events(ct::read_text(out + ".events")), "refinement").size() < before + 3) {
+           ct::of_kind(ct::parse_events(ct::read_text(out + ".events")), "refinement").size() <
+               before + 3) {
       std::this_thread::sleep_for(10ms);
     }
     ASSERT_TRUE(ct::of_kind(ct::parse_events(ct::read_text(out + ".events")), "done").empty())
         << "the stream finished before kill " << kill << " (not mid-stream)";
     server->kill_hard();
     std::this_thread::sleep_for(300ms);
-    server = start_server(cache, kill == 0 ? std::vector<std::string>{"--rate", "30000", "--max-chunk-bytes", "1024"}
-                                           : std::vector<std::string>{},
-                          port);
+    server = start_server(
+        cache,
+        kill == 0 ? std::vector<std::string>{"--rate", "30000", "--max-chunk-bytes", "1024"}
+                  : std::vector<std::string>{},
+        port);
     ASSERT_TRUE(server);
   }
   const auto status = client.wait(60s);
@@ -262,13 +283,15 @@ TEST_F(FaultTest, ByteFlippedInTransitIsCaughtAndReRequested) {
 
   meshstream::faulttest::ByteFlipProxy proxy(server->port(), 6);
   const std::string out = *dir_ / "flipped";
-  const int status = run_client("127.0.0.1:" + std::to_string(proxy.port()), out, {"--max-chunk-bytes", "2048"});
+  const int status =
+      run_client("127.0.0.1:" + std::to_string(proxy.port()), out, {"--max-chunk-bytes", "2048"});
   ASSERT_TRUE(proxy.flipped()) << "the proxy never corrupted a chunk (stream too short?)";
   const std::string err = ct::read_text(out + ".err");
-  ASSERT_EQ(status, 0) << "CLIENT LACKS RE-REQUEST ON CHECKSUM FAILURE: a record whose CRC-32 does not match "
-                          "should make meshstream-client reconnect and resume from the last good record; "
-                          "instead it exited "
-                       << status << ": " << err;
+  ASSERT_EQ(status, 0)
+      << "CLIENT LACKS RE-REQUEST ON CHECKSUM FAILURE: a record whose CRC-32 does not match "
+         "should make meshstream-client reconnect and resume from the last good record; "
+         "instead it exited "
+      << status << ": " << err;
   EXPECT_GE(proxy.connections(), 2) << "the client finished without re-requesting";
   EXPECT_EQ(ct::read_text(out + "/final.ply"), ct::read_text(reference + "/final.ply"));
 }

@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "common/codec/container.h"
-#include "common/codec/record_index_coder.h"
 #include "common/codec/encoder.h"
+#include "common/codec/record_index_coder.h"
 #include "common/mesh/export.h"
 #include "common/mesh/procedural.h"
 #include "proto/framing.h"
@@ -82,8 +82,8 @@ std::vector<uint8_t> ascii_stl(const Mesh& mesh) {
   for (const Triangle& t : mesh.triangles) {
     s += " facet normal 0 0 0\n  outer loop\n";
     for (uint32_t v : t) {
-      s += "   vertex " + std::to_string(mesh.positions[v].x) + " " + std::to_string(mesh.positions[v].y) +
-           " " + std::to_string(mesh.positions[v].z) + "\n";
+      s += "   vertex " + std::to_string(mesh.positions[v].x) + " " +
+           std::to_string(mesh.positions[v].y) + " " + std::to_string(mesh.positions[v].z) + "\n";
     }
     s += "  endloop\n endfacet\n";
   }
@@ -110,12 +110,9 @@ int main(int argc, char** argv) {
     Mesh mesh;
   };
   const std::vector<Named> meshes = {
-      {"icosahedron", make_icosahedron()},
-      {"icosphere2", make_icosphere(2)},
-      {"icosphere3", make_icosphere(3)},
-      {"grid8", make_open_grid(8)},
-      {"components3", make_multi_component(3)},
-      {"torus", make_torus(16, 8)},
+      {"icosahedron", make_icosahedron()},      {"icosphere2", make_icosphere(2)},
+      {"icosphere3", make_icosphere(3)},        {"grid8", make_open_grid(8)},
+      {"components3", make_multi_component(3)}, {"torus", make_torus(16, 8)},
   };
 
   // ---- hcs_decoder: whole streams, several coders and sizes.
@@ -268,9 +265,14 @@ int main(int argc, char** argv) {
       for (const auto& entry : fs::directory_iterator(argv[2])) {
         const std::string ext = entry.path().extension().string();
         if (entry.file_size() > 16 * 1024) continue;
-        const uint8_t selector = ext == ".obj" ? 0 : ext == ".ply" ? 1 : ext == ".off" ? 2 : ext == ".stl" ? 3 : 255;
+        const uint8_t selector = ext == ".obj"   ? 0
+                                 : ext == ".ply" ? 1
+                                 : ext == ".off" ? 2
+                                 : ext == ".stl" ? 3
+                                                 : 255;
         if (selector == 255) continue;
-        write(out / "mesh_import" / entry.path().filename(), prefixed(selector, read(entry.path())));
+        write(out / "mesh_import" / entry.path().filename(),
+              prefixed(selector, read(entry.path())));
       }
     }
   }

@@ -3,9 +3,9 @@
 // then the client's handling of each message as in
 // client/stream_client.cpp (StreamClient::attempt): a header's facts are
 // read (facts_from_header: either record index form, the compact one
-// range-decoded) and it sets the resume point of the DecodedStream, a chunk at the expected offset is fed
-// to it (the decoder that turns network bytes into the displayed mesh).
-// StreamClient itself owns a socket, so the same calls are made directly.
+// range-decoded) and it sets the resume point of the DecodedStream, a chunk at the expected offset
+// is fed to it (the decoder that turns network bytes into the displayed mesh). StreamClient itself
+// owns a socket, so the same calls are made directly.
 //
 // Input: the front is the byte stream from the "server", integers from the
 // back choose the read sizes. Checked (trap on violation): no crash, no
@@ -68,8 +68,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         }
         const std::string& bytes = m.chunk().data();
         const uint32_t before = decoded.records_decoded();
-        auto fed = decoded.feed(std::span<const uint8_t>(
-            reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
+        auto fed = decoded.feed(
+            std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
         if (!fed) {
           // Records completed before the bad one stay applied (last good state).
           check(decoded.records_decoded() >= before);

@@ -17,8 +17,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace meshstream;
   if (size < 1) return 0;
   static const char* const kExtensions[] = {".obj", ".ply", ".off", ".stl"};
-  const std::string path = "/tmp/meshstream-fuzz-import-" + std::to_string(::getpid()) +
-                           kExtensions[data[0] % 4];
+  const std::string path =
+      "/tmp/meshstream-fuzz-import-" + std::to_string(::getpid()) + kExtensions[data[0] % 4];
   if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
     if (size > 1) std::fwrite(data + 1, 1, size - 1, f);
     std::fclose(f);

@@ -50,10 +50,17 @@ void handle_stream(const v1::StreamRequest& request) {
   if (request.has_budget()) {
     const v1::Budget& b = request.budget();
     switch (b.limit_case()) {
-      case v1::Budget::kBytes: budget = server::ByteBudget{b.bytes()}; break;
-      case v1::Budget::kVertices: budget = server::VertexBudget{b.vertices()}; break;
-      case v1::Budget::kPercent: budget = server::PercentBudget{b.percent()}; break;
-      default: break;
+      case v1::Budget::kBytes:
+        budget = server::ByteBudget{b.bytes()};
+        break;
+      case v1::Budget::kVertices:
+        budget = server::VertexBudget{b.vertices()};
+        break;
+      case v1::Budget::kPercent:
+        budget = server::PercentBudget{b.percent()};
+        break;
+      default:
+        break;
     }
   }
   auto plan = server::plan_stream(index, request.resume_offset(), budget);

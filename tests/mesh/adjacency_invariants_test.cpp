@@ -10,13 +10,33 @@
 namespace meshstream {
 namespace {
 
-const char* kImportable[] = {
-    "bun_zipper.ply", "bunny.off", "bunny.stl", "armadillo.obj", "fandisk.off", "crank.off",
-    "casting.off", "mask.off", "hemisphere.off", "skull.obj", "maneki-neko.off", "dragon_res2.ply",
-    "dragon_res3.ply", "sphere.obj", "sphere_low.off", "chamfer-cube.off", "cube_att.obj",
-    "cube_quads.obj", "octagon.obj", "multiple_isolated_triangles.obj", "multiple_tetrahedrons.obj",
-    "suzanne.obj", "test_nm.obj", "non_manifold_wrap.obj", "deg_faces.obj", "extra_vertex.obj",
-    "eof_test.obj"};
+const char* kImportable[] = {"bun_zipper.ply",
+                             "bunny.off",
+                             "bunny.stl",
+                             "armadillo.obj",
+                             "fandisk.off",
+                             "crank.off",
+                             "casting.off",
+                             "mask.off",
+                             "hemisphere.off",
+                             "skull.obj",
+                             "maneki-neko.off",
+                             "dragon_res2.ply",
+                             "dragon_res3.ply",
+                             "sphere.obj",
+                             "sphere_low.off",
+                             "chamfer-cube.off",
+                             "cube_att.obj",
+                             "cube_quads.obj",
+                             "octagon.obj",
+                             "multiple_isolated_triangles.obj",
+                             "multiple_tetrahedrons.obj",
+                             "suzanne.obj",
+                             "test_nm.obj",
+                             "non_manifold_wrap.obj",
+                             "deg_faces.obj",
+                             "extra_vertex.obj",
+                             "eof_test.obj"};
 
 TEST(AdjacencyInvariants, EveryImportedRealMesh) {
   MESHSTREAM_REQUIRE_TEST_MESHES();

@@ -1,8 +1,8 @@
 #include "common/mesh/adjacency.h"
 
-#include <algorithm>
-
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 namespace meshstream {
 namespace {

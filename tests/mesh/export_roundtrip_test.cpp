@@ -1,12 +1,12 @@
 // export -> import gives back the same mesh: positions bit-identical, the
 // same triangles in the same order, attributes preserved (colours up to the
 // 8-bit quantization PLY stores).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cstring>
 #include <filesystem>
 #include <functional>
-
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include "common/mesh/export.h"
 #include "common/mesh/import.h"
@@ -27,8 +27,9 @@ bool same_bits(const Vec3f& a, const Vec3f& b) { return std::memcmp(&a, &b, size
 // tiny and huge magnitudes, negative zero.
 Mesh awkward_octahedron() {
   Mesh m;
-  m.positions = {{1.0f / 3.0f, 0, 0},      {-0.1f, -0.0f, 1e-30f}, {0, 123456.789f, 0},
-                 {3.4e38f, -1.17549435e-38f, 7e-8f}, {0.3f, 0.7f, 2.0f / 7.0f}, {-5, -6, -7.000001f}};
+  m.positions = {{1.0f / 3.0f, 0, 0},       {-0.1f, -0.0f, 1e-30f},
+                 {0, 123456.789f, 0},       {3.4e38f, -1.17549435e-38f, 7e-8f},
+                 {0.3f, 0.7f, 2.0f / 7.0f}, {-5, -6, -7.000001f}};
   m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                  {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   return m;
@@ -148,7 +149,8 @@ TEST(Export, RefusesInvalidMeshesAndUnknownExtensions) {
   bad.triangles[0][0] = 99;
   EXPECT_FALSE(write_ply(bad, temp_path("bad.ply")));
   EXPECT_FALSE(write_mesh(awkward_octahedron(), temp_path("mesh.stl")));
-  EXPECT_EQ(write_mesh(awkward_octahedron(), "/nonexistent/dir/x.ply").error().code, ErrorCode::kIo);
+  EXPECT_EQ(write_mesh(awkward_octahedron(), "/nonexistent/dir/x.ply").error().code,
+            ErrorCode::kIo);
 }
 
 }  // namespace

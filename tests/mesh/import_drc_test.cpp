@@ -1,14 +1,14 @@
 // .drc files go through Draco's decoder: an icosahedron encoded with
 // Draco's own encoder (no quantization, so positions are exact) imports
 // with the same vertices and the same triangles up to Draco's reordering.
-#include <algorithm>
-#include <filesystem>
-#include <fstream>
-
 #include <draco/compression/encode.h>
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 
 #include "common/mesh/import.h"
 #include "common/mesh/procedural.h"
@@ -39,7 +39,8 @@ TEST(ImportDrc, LosslessDracoFileImportsExactly) {
   const Mesh mesh = make_icosphere(2);
   draco::TriangleSoupMeshBuilder builder;
   builder.Start(static_cast<int>(mesh.face_count()));
-  const int position = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  const int position =
+      builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     const Triangle& t = mesh.triangles[f];
     builder.SetAttributeValuesForFace(position, draco::FaceIndex(f), &mesh.positions[t[0]],
@@ -53,7 +54,8 @@ TEST(ImportDrc, LosslessDracoFileImportsExactly) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("meshstream_drc_" + std::to_string(::getpid()) + ".drc"))
                                .string();
-  std::ofstream(path, std::ios::binary).write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
   auto imported = import_mesh(path);
   std::filesystem::remove(path);
   ASSERT_TRUE(imported) << imported.error().message;

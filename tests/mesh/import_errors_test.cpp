@@ -1,18 +1,18 @@
 // Broken and awkward input: a clear error naming the file and the problem,
 // or a visible repair — never a crash.
-#include <filesystem>
-#include <fstream>
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/import.h"
 #include "common/mesh/topology.h"
-#include "tests/test_meshes.h"
 #include "tests/mesh/temp_file.h"
+#include "tests/test_meshes.h"
 
 namespace meshstream {
 namespace {
@@ -176,8 +176,7 @@ TEST(ImportErrors, StlWithAnInconsistentFaceIsFlipped) {
 
 TEST(ImportErrors, BowtieVertexIsSplit) {
   // Two triangles touching at one vertex: one vertex, two fans.
-  TempFile file("bowtie.obj",
-               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n");
+  TempFile file("bowtie.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n");
   auto imported = import_mesh(file.path());
   ASSERT_TRUE(imported) << imported.error().message;
   EXPECT_EQ(imported->report.nonmanifold_vertices, 1u);
@@ -189,8 +188,8 @@ TEST(ImportErrors, BowtieVertexIsSplit) {
 TEST(ImportErrors, ThreeSheetsOnOneEdgeAreDetached) {
   // Three triangles on edge (1,2): the third cannot stay.
   TempFile file("fin.obj",
-               "v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0.5 -1 0\nv 0.5 0 1\n"
-               "f 1 2 3\nf 2 1 4\nf 1 2 5\n");
+                "v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0.5 -1 0\nv 0.5 0 1\n"
+                "f 1 2 3\nf 2 1 4\nf 1 2 5\n");
   auto imported = import_mesh(file.path());
   ASSERT_TRUE(imported) << imported.error().message;
   EXPECT_EQ(imported->report.nonmanifold_edges, 1u);

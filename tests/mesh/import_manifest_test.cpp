@@ -1,9 +1,9 @@
 // Every mesh of ../shared/meshes imports with the counts its MANIFEST.md
 // gives (computed there by an independent tool), and the repaired result is
 // a mesh the corner table accepts.
-#include <ostream>
-
 #include <gtest/gtest.h>
+
+#include <ostream>
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/import.h"
@@ -15,9 +15,9 @@ namespace {
 
 struct ManifestRow {
   const char* file;
-  uint32_t vertices;     // welded
+  uint32_t vertices;  // welded
   uint32_t in_file;
-  uint32_t faces;        // after dropping degenerate faces, duplicates included
+  uint32_t faces;  // after dropping degenerate faces, duplicates included
   uint32_t duplicates;
   uint32_t degenerate;
   uint32_t boundary_edges;

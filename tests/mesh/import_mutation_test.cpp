@@ -3,12 +3,12 @@
 // fixed pseudo-random pattern, and every result must be a mesh that passes
 // validate_arrays and Adjacency::build, or an error with a message. Run
 // under scripts/test --sanitize this is a small deterministic fuzzer.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <random>
-
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/export.h"
@@ -27,10 +27,14 @@ void write_all(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
 
-const char* kOff = "OFF\n# tetra\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n4 2 0 3 1\n";
-const char* kObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvt 0.5 0.5\nf 1/1/1 3/1/1 2/1/1\nf 1 2 4\nf 2 3 4\nf 3 1 4 2\n";
+const char* kOff =
+    "OFF\n# tetra\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n4 2 0 3 1\n";
+const char* kObj =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 1\nvt 0.5 0.5\nf 1/1/1 3/1/1 2/1/1\nf 1 2 4\nf 2 3 "
+    "4\nf 3 1 4 2\n";
 
-void check_every_mutation(const std::string& original, const std::string& extension, uint32_t seed) {
+void check_every_mutation(const std::string& original, const std::string& extension,
+                          uint32_t seed) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("meshstream_mutation_" + std::to_string(::getpid()) + extension))
                                .string();
@@ -46,7 +50,8 @@ void check_every_mutation(const std::string& original, const std::string& extens
       const int edits = 1 + static_cast<int>(random() % 4);
       for (int e = 0; e < edits && !bytes.empty(); ++e) {
         const size_t at = random() % bytes.size();
-        bytes[at] = kind == 1 ? kInteresting[random() % sizeof(kInteresting)] : static_cast<char>(random());
+        bytes[at] =
+            kind == 1 ? kInteresting[random() % sizeof(kInteresting)] : static_cast<char>(random());
       }
     }
     write_all(path, bytes);
@@ -117,7 +122,8 @@ TEST(ImportMutation, AsciiStl) {
     text += "  facet normal 0 0 0\n    outer loop\n";
     for (uint32_t v : t) {
       const Vec3f& p = mesh.positions[v];
-      text += "      vertex " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.z) + "\n";
+      text += "      vertex " + std::to_string(p.x) + " " + std::to_string(p.y) + " " +
+              std::to_string(p.z) + "\n";
     }
     text += "    endloop\n  endfacet\n";
   }

@@ -1,14 +1,14 @@
 // The two mesh subcommands as a user runs them: `meshstream generate` and
 // `meshstream info` on a mesh file (exit codes 0 / 1 / 2, JSON fields).
 // Skipped when the meshstream binary has not been built.
-#include <cstdio>
-#include <filesystem>
-#include <string>
-
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
 
 #include "tests/test_meshes.h"
 

@@ -2,11 +2,11 @@
 // independent statistics of topology.h.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/topology.h"
@@ -57,7 +57,8 @@ inline void expect_adjacency_invariants(const Mesh& mesh, const std::string& lab
   EXPECT_EQ(boundary, stats.boundary_edges) << label;
   EXPECT_EQ(adj.edge_count(), stats.edges) << label;
   EXPECT_EQ(adj.boundary_edge_count(), stats.boundary_edges) << label;
-  const int64_t euler = static_cast<int64_t>(stats.referenced_vertices) - adj.edge_count() + adj.face_count();
+  const int64_t euler =
+      static_cast<int64_t>(stats.referenced_vertices) - adj.edge_count() + adj.face_count();
   EXPECT_EQ(euler, stats.euler) << label;
 
   uint32_t bad_neighbors = 0;
@@ -99,7 +100,8 @@ inline void expect_adjacency_invariants(const Mesh& mesh, const std::string& lab
       ok = ok && !has_face(v, ring.back(), ring.front());
     } else {
       ok = ok && ring.size() >= 3;
-      for (size_t i = 0; ok && i < ring.size(); ++i) ok = has_face(v, ring[i], ring[(i + 1) % ring.size()]);
+      for (size_t i = 0; ok && i < ring.size(); ++i)
+        ok = has_face(v, ring[i], ring[(i + 1) % ring.size()]);
     }
     bad_rings += !ok;
   }

@@ -2,22 +2,22 @@
 // the real well-formed OBJ files, exact round trips of what write_obj
 // writes, every corner form, and malformed input refused with the line and
 // the token — including the face that corrupted Draco's heap.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
-
 #include "common/mesh/export.h"
 #include "common/mesh/import.h"
 #include "common/mesh/mesh_readers.h"
 #include "common/mesh/procedural.h"
-#include "tests/test_meshes.h"
 #include "tests/mesh/temp_file.h"
+#include "tests/test_meshes.h"
 
 namespace meshstream {
 namespace {
@@ -28,7 +28,8 @@ using testing::TempFile;
 
 template <class T>
 bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 // Positions, triangles and attributes identical, bit for bit.
@@ -46,11 +47,21 @@ void expect_same_mesh(const Mesh& ours, const Mesh& peer, const std::string& lab
 
 // Every OBJ of ../shared/meshes that Draco reads correctly (inf_nan.obj is
 // refused by ours at the line, by the Draco path only later in clean_mesh).
-const char* const kRealObjFiles[] = {
-    "armadillo.obj",  "skull.obj",       "sphere.obj",      "cube_att.obj",
-    "cube_quads.obj", "octagon.obj",     "suzanne.obj",     "multiple_isolated_triangles.obj",
-    "multiple_tetrahedrons.obj",         "test_nm.obj",     "non_manifold_wrap.obj",
-    "deg_faces.obj",  "degenerate_mesh.obj", "extra_vertex.obj", "eof_test.obj"};
+const char* const kRealObjFiles[] = {"armadillo.obj",
+                                     "skull.obj",
+                                     "sphere.obj",
+                                     "cube_att.obj",
+                                     "cube_quads.obj",
+                                     "octagon.obj",
+                                     "suzanne.obj",
+                                     "multiple_isolated_triangles.obj",
+                                     "multiple_tetrahedrons.obj",
+                                     "test_nm.obj",
+                                     "non_manifold_wrap.obj",
+                                     "deg_faces.obj",
+                                     "degenerate_mesh.obj",
+                                     "extra_vertex.obj",
+                                     "eof_test.obj"};
 
 TEST(ObjReader, SameMeshAsDracoOnTheRealFiles) {
   MESHSTREAM_REQUIRE_TEST_MESHES();
@@ -90,8 +101,9 @@ TEST(ObjReader, ArmadilloAndSkullMatchTheManifest) {
     const char* file;
     uint32_t in_file, vertices, faces;
   };
-  for (const Row& row : {Row{"armadillo.obj", 49990, 49990, 99976}, Row{"skull.obj", 40062, 40062, 80016},
-                         Row{"suzanne.obj", 507, 505, 968}, Row{"test_nm.obj", 114, 97, 170}}) {
+  for (const Row& row :
+       {Row{"armadillo.obj", 49990, 49990, 99976}, Row{"skull.obj", 40062, 40062, 80016},
+        Row{"suzanne.obj", 507, 505, 968}, Row{"test_nm.obj", 114, 97, 170}}) {
     ImportOptions analysis;
     analysis.drop_duplicate_faces = false;
     analysis.keep_nonmanifold = true;
@@ -148,8 +160,9 @@ Result<RawMesh> parse(const std::string& text) { return parse_obj_text(text); }
 
 TEST(ObjReader, EveryCornerFormGivesTheSameTriangle) {
   const std::string header = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n";
-  for (const char* face : {"f 1 2 3\n", "f 1/1 2/2 3/3\n", "f 1//1 2//1 3//1\n", "f 1/1/1 2/2/1 3/3/1\n",
-                           "f -3 -2 -1\n", "f -3/-3/-1 -2/-2/-1 -1/-1/-1\n", "f\t1  2\t 3 \r\n"}) {
+  for (const char* face :
+       {"f 1 2 3\n", "f 1/1 2/2 3/3\n", "f 1//1 2//1 3//1\n", "f 1/1/1 2/2/1 3/3/1\n",
+        "f -3 -2 -1\n", "f -3/-3/-1 -2/-2/-1 -1/-1/-1\n", "f\t1  2\t 3 \r\n"}) {
     auto raw = parse(header + face);
     ASSERT_TRUE(raw) << face << raw.error().message;
     ASSERT_EQ(raw->mesh.face_count(), 1u) << face;
@@ -255,12 +268,15 @@ TEST(ObjReader, MalformedFilesAreRefusedWithLineAndToken) {
       // The face that corrupted Draco's heap (tests/fuzz/regressions/mesh_import/).
       {"draco_heap", "v  1.0  1.0  1.0\nvn  1.0  0.0  0.0\nf  1/1/3  4/2/3 8/4/3  7/3-3",
        ErrorCode::kParse, "line 3: face corner '7/3-3' is malformed"},
-      {"letters", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", ErrorCode::kParse, "line 4: face corner 'x'"},
+      {"letters", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", ErrorCode::kParse,
+       "line 4: face corner 'x'"},
       {"triple_slash", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3///\n", ErrorCode::kParse, "'3///'"},
-      {"trailing_slash", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1 2 3/1/\n", ErrorCode::kParse, "'3/1/'"},
+      {"trailing_slash", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1 2 3/1/\n", ErrorCode::kParse,
+       "'3/1/'"},
       {"empty_parts", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 /\n", ErrorCode::kParse, "'/'"},
       {"plus_sign", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 +3\n", ErrorCode::kParse, "'+3'"},
-      {"zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", ErrorCode::kParse, "line 4: face corner '0' has index 0"},
+      {"zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", ErrorCode::kParse,
+       "line 4: face corner '0' has index 0"},
       {"range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n", ErrorCode::kInvalidMesh,
        "line 5: a face refers to vertex 9 but the file has 3 'v' lines"},
       {"huge", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", ErrorCode::kParse,
@@ -268,21 +284,29 @@ TEST(ObjReader, MalformedFilesAreRefusedWithLineAndToken) {
       {"beyond_uint32", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967296\n", ErrorCode::kInvalidMesh,
        "far beyond"},
       {"relative", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", ErrorCode::kInvalidMesh,
-       "line 4: face corner '-4': relative index -4 reaches before the first vertex (3 defined so far)"},
+       "line 4: face corner '-4': relative index -4 reaches before the first vertex (3 defined so "
+       "far)"},
       // Found by fuzz_mesh_import: negating INT64_MIN was undefined behaviour.
-      {"int64_min", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9223372036854775808\n", ErrorCode::kInvalidMesh,
+      {"int64_min", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9223372036854775808\n",
+       ErrorCode::kInvalidMesh,
        "relative index -9223372036854775808 reaches before the first vertex"},
-      {"texcoord_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n", ErrorCode::kInvalidMesh,
+      {"texcoord_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n",
+       ErrorCode::kInvalidMesh,
        "line 5: a face refers to texture coordinate 2 but the file has 1 'vt' lines"},
       {"normal_missing", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n", ErrorCode::kInvalidMesh,
        "refers to normal 1 but the file has 0 'vn' lines"},
-      {"no_vertices", "f 1 2 3\n", ErrorCode::kInvalidMesh, "refers to vertex 3 but the file has 0 'v'"},
-      {"two_corners", "v 0 0 0\nv 1 0 0\nf 1 2\n", ErrorCode::kParse, "line 3: a face needs at least 3 corners, found 2"},
+      {"no_vertices", "f 1 2 3\n", ErrorCode::kInvalidMesh,
+       "refers to vertex 3 but the file has 0 'v'"},
+      {"two_corners", "v 0 0 0\nv 1 0 0\nf 1 2\n", ErrorCode::kParse,
+       "line 3: a face needs at least 3 corners, found 2"},
       {"nan", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n", ErrorCode::kInvalidMesh,
        "line 2: vertex 1 has a non-finite coordinate (NaN/Inf): (1.000000, NaN, 0.000000)"},
-      {"inf", "v 0 0 0\nv 1 0 0\nv 0 1 -inf\nf 1 2 3\n", ErrorCode::kInvalidMesh, "vertex 2 has a non-finite"},
-      {"overflow", "v 0 0 0\nv 1 0 0\nv 0 1 1e39\nf 1 2 3\n", ErrorCode::kInvalidMesh, "(0.000000, 1.000000, Inf)"},
-      {"bad_number", "v 0 0 0\nv 1 0,5 0\n", ErrorCode::kParse, "line 2: vertex 1: '0,5' is not a number"},
+      {"inf", "v 0 0 0\nv 1 0 0\nv 0 1 -inf\nf 1 2 3\n", ErrorCode::kInvalidMesh,
+       "vertex 2 has a non-finite"},
+      {"overflow", "v 0 0 0\nv 1 0 0\nv 0 1 1e39\nf 1 2 3\n", ErrorCode::kInvalidMesh,
+       "(0.000000, 1.000000, Inf)"},
+      {"bad_number", "v 0 0 0\nv 1 0,5 0\n", ErrorCode::kParse,
+       "line 2: vertex 1: '0,5' is not a number"},
       {"two_numbers", "v 0 0\n", ErrorCode::kParse, "found 2 numbers"},
       {"five_numbers", "v 0 0 0 1 1\n", ErrorCode::kParse, "found 5 numbers"},
       {"many_numbers", "v 0 0 0 1 1 1 1 1 1\n", ErrorCode::kParse, "found more than 7 numbers"},
@@ -321,12 +345,14 @@ TEST(ObjReader, NumberSyntaxOfStrtofExceptHex) {
   EXPECT_EQ(ok->mesh.positions[2].z, 700.0f);
   // Beyond double range: tiny values become 0, huge ones Inf (refused).
   const std::string tiny = "0." + std::string(400, '0') + "1";
-  auto small = parse("v " + tiny + " 1000e-500 -1e-99999999999999999999\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  auto small =
+      parse("v " + tiny + " 1000e-500 -1e-99999999999999999999\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   ASSERT_TRUE(small) << small.error().message;
   EXPECT_EQ(small->mesh.positions[0].x, 0.0f);
   EXPECT_EQ(small->mesh.positions[0].y, 0.0f);
   EXPECT_TRUE(std::signbit(small->mesh.positions[0].z));
-  for (const std::string huge : {"1" + std::string(400, '0'), std::string("0.001e500"), std::string("1e99999999999999999999")}) {
+  for (const std::string huge : {"1" + std::string(400, '0'), std::string("0.001e500"),
+                                 std::string("1e99999999999999999999")}) {
     auto big = parse("v 0 0 " + huge + "\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     ASSERT_FALSE(big) << huge;
     EXPECT_THAT(big.error().message, HasSubstr("(0.000000, 0.000000, Inf)")) << huge;
@@ -334,7 +360,8 @@ TEST(ObjReader, NumberSyntaxOfStrtofExceptHex) {
 }
 
 TEST(ObjReader, FuzzRegressionInputsAreRefusedCleanly) {
-  const std::string dir = std::string(MESHSTREAM_SOURCE_DIR) + "/tests/fuzz/regressions/mesh_import";
+  const std::string dir =
+      std::string(MESHSTREAM_SOURCE_DIR) + "/tests/fuzz/regressions/mesh_import";
   int obj_inputs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     std::ifstream in(entry.path(), std::ios::binary);

@@ -1,12 +1,13 @@
 // Procedural meshes: the topology each promises, outward orientation, and
 // determinism.
+#include "common/mesh/procedural.h"
+
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
-#include <gtest/gtest.h>
-
-#include "common/mesh/procedural.h"
 #include "common/mesh/topology.h"
 #include "tests/mesh/mesh_invariants.h"
 
@@ -84,7 +85,8 @@ TEST(Procedural, DemoMeshIsAClosedKnottedTorusNearTheTargetSize) {
 TEST(Procedural, DemoMeshIsDeterministic) {
   const Mesh a = make_demo_mesh(10000), b = make_demo_mesh(10000);
   ASSERT_EQ(a.vertex_count(), b.vertex_count());
-  EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3f)), 0);
+  EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3f)),
+            0);
   EXPECT_TRUE(a.triangles == b.triangles);
 }
 
@@ -98,7 +100,8 @@ TEST(Procedural, DemoMeshHasNoSliversOrSpikes) {
     const Vec3d a = to_double(m.positions[t[0]]), b = to_double(m.positions[t[1]]),
                 c = to_double(m.positions[t[2]]);
     const double area = 0.5 * length(cross(b - a, c - a));
-    const double longest = std::max({squared_length(b - a), squared_length(c - b), squared_length(a - c)});
+    const double longest =
+        std::max({squared_length(b - a), squared_length(c - b), squared_length(a - c)});
     // 1 for the equilateral triangle, 0 for a degenerate one.
     min_ratio = std::min(min_ratio, area / (longest * std::sqrt(3.0) / 4));
   }

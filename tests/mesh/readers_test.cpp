@@ -1,13 +1,13 @@
 // The OFF and PLY readers on small hand-written files: variants of the
 // formats, and malformed input refused with the line and the problem.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include "common/mesh/import.h"
 #include "common/mesh/mesh_readers.h"
@@ -59,7 +59,8 @@ TEST(OffReader, PolygonsAreFanTriangulated) {
 }
 
 TEST(OffReader, ColoursAndNormals) {
-  TempFile coff("c.off", "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n");
+  TempFile coff("c.off",
+                "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n");
   auto a = read_off(coff.path());
   ASSERT_TRUE(a) << a.error().message;
   ASSERT_EQ(a->mesh.colors.size(), 3u);
@@ -107,7 +108,8 @@ TEST(OffReader, MalformedFilesAreRefusedWithTheLine) {
 }
 
 std::string binary_ply_triangle(bool big_endian) {
-  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+  std::string s = std::string("ply\nformat ") +
+                  (big_endian ? "binary_big_endian" : "binary_little_endian") +
                   " 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                   "property uchar red\nproperty uchar green\nproperty uchar blue\n"
                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
@@ -163,15 +165,20 @@ TEST(PlyReader, MalformedFilesAreRefused) {
       {"no_xyz", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
        ErrorCode::kParse, "no x, y, z"},
       {"index",
-       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+       "float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 "
+       "0 1 3\n",
        ErrorCode::kInvalidMesh, "face 0 refers to vertex 3"},
       {"truncated_ascii",
-       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty "
+       "float z\n"
+       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 "
+       "0 1\n",
        ErrorCode::kTruncated, "face 0"},
       {"bad_number",
-       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty "
+       "float z\n"
        "end_header\n0 zero 0\n",
        ErrorCode::kParse, "line 8, vertex 0: 'zero'"},
       {"lying_count",

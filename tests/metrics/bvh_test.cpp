@@ -1,10 +1,10 @@
 #include "common/metrics/bvh.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "common/metrics/closest_point.h"
 #include "tests/metrics/procedural_meshes.h"
@@ -15,9 +15,9 @@ namespace {
 double brute_force_squared_distance(const Mesh& m, Vec3d q) {
   double best = std::numeric_limits<double>::infinity();
   for (const Triangle& t : m.triangles) {
-    const Vec3d p = closest_point_on_triangle(q, to_double(m.positions[t[0]]),
-                                              to_double(m.positions[t[1]]),
-                                              to_double(m.positions[t[2]]));
+    const Vec3d p =
+        closest_point_on_triangle(q, to_double(m.positions[t[0]]), to_double(m.positions[t[1]]),
+                                  to_double(m.positions[t[2]]));
     best = std::min(best, squared_length(q - p));
   }
   return best;
@@ -60,9 +60,9 @@ void expect_matches_brute_force(const Mesh& m, const std::vector<Vec3d>& queries
     ASSERT_EQ(hit.squared_distance, want) << "query " << q.x << " " << q.y << " " << q.z;
     // The reported triangle really is at that distance.
     const Triangle& t = m.triangles[hit.triangle];
-    const Vec3d p = closest_point_on_triangle(q, to_double(m.positions[t[0]]),
-                                              to_double(m.positions[t[1]]),
-                                              to_double(m.positions[t[2]]));
+    const Vec3d p =
+        closest_point_on_triangle(q, to_double(m.positions[t[0]]), to_double(m.positions[t[1]]),
+                                  to_double(m.positions[t[2]]));
     EXPECT_EQ(squared_length(q - p), want);
     // A hint (right or wrong) never changes the answer.
     EXPECT_EQ(bvh.closest(q, hint).squared_distance, want);
@@ -112,9 +112,7 @@ TEST(TriangleBvh, DepthStaysBoundedWhenEveryCentroidCoincides) {
   expect_matches_brute_force(m, queries);
 }
 
-TEST(TriangleBvh, EmptyMeshGivesEmptyHierarchy) {
-  EXPECT_TRUE(TriangleBvh::build(Mesh{}).empty());
-}
+TEST(TriangleBvh, EmptyMeshGivesEmptyHierarchy) { EXPECT_TRUE(TriangleBvh::build(Mesh{}).empty()); }
 
 TEST(TriangleBvh, BuildIsDeterministic) {
   const Mesh m = testing::icosphere(3);

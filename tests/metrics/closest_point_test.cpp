@@ -1,8 +1,8 @@
 #include "common/metrics/closest_point.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace meshstream {
 namespace {
@@ -27,9 +27,9 @@ TEST(ClosestPointOnTriangle, EachVertexRegionGivesTheVertex) {
 }
 
 TEST(ClosestPointOnTriangle, EachEdgeRegionGivesThePerpendicularFoot) {
-  expect_point(closest_point_on_triangle({1, -3, 0}, a, b, c), {1, 0, 0});   // ab
-  expect_point(closest_point_on_triangle({-3, 1, 5}, a, b, c), {0, 1, 0});   // ac
-  expect_point(closest_point_on_triangle({2, 2, 0}, a, b, c), {1, 1, 0});    // bc
+  expect_point(closest_point_on_triangle({1, -3, 0}, a, b, c), {1, 0, 0});  // ab
+  expect_point(closest_point_on_triangle({-3, 1, 5}, a, b, c), {0, 1, 0});  // ac
+  expect_point(closest_point_on_triangle({2, 2, 0}, a, b, c), {1, 1, 0});   // bc
 }
 
 TEST(ClosestPointOnTriangle, DegenerateTrianglesBehaveLikeSegments) {

@@ -1,8 +1,8 @@
 #include "common/metrics/distance.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "common/metrics/surface_sampling.h"
 #include "tests/metrics/procedural_meshes.h"

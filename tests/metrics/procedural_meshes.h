@@ -43,13 +43,15 @@ inline Mesh icosphere(int levels, float radius = 1) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
     auto midpoint = [&](uint32_t a, uint32_t b) {
       auto key = std::minmax(a, b);
-      auto [it, inserted] = mid.try_emplace({key.first, key.second}, static_cast<uint32_t>(p.size()));
+      auto [it, inserted] =
+          mid.try_emplace({key.first, key.second}, static_cast<uint32_t>(p.size()));
       if (inserted) p.push_back(normalized(p[a] + p[b]));
       return it->second;
     };
     std::vector<Triangle> next;
     for (const Triangle& f : tris) {
-      const uint32_t ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]), ca = midpoint(f[2], f[0]);
+      const uint32_t ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]),
+                     ca = midpoint(f[2], f[0]);
       next.push_back({f[0], ab, ca});
       next.push_back({f[1], bc, ab});
       next.push_back({f[2], ca, bc});

@@ -16,7 +16,9 @@ TEST(SurfaceQuadrature, WeightsSumToTheArea) {
   const Mesh sphere = icosphere(3, 2.0f);
   double area = 0;
   for (const Triangle& t : sphere.triangles) {
-    auto d = [&](uint32_t v) { return Vec3d{sphere.positions[v].x, sphere.positions[v].y, sphere.positions[v].z}; };
+    auto d = [&](uint32_t v) {
+      return Vec3d{sphere.positions[v].x, sphere.positions[v].y, sphere.positions[v].z};
+    };
     const Vec3d n = cross(d(t[1]) - d(t[0]), d(t[2]) - d(t[0]));
     area += 0.5 * std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
   }

@@ -40,7 +40,8 @@ void expect_stream_equals_a_cache_file(uint16_t port, const std::string& model,
   const StreamResult r = read_stream(c);
   ASSERT_TRUE(r.ok) << r.problem;
   bool found = false;
-  for (const auto& entry : fs::directory_iterator(cache)) found |= read_file(entry.path()) == r.bytes;
+  for (const auto& entry : fs::directory_iterator(cache))
+    found |= read_file(entry.path()) == r.bytes;
   EXPECT_TRUE(found) << model << " is not byte-identical to any cached stream";
 }
 
@@ -83,7 +84,8 @@ TEST(NetCatalog, DemoServesProceduralModelsWithoutAFolder) {
   ServerProcess server;
   // The server encodes its three demo models before it listens: a few
   // seconds in a release build, up to a minute under the sanitizers.
-  ASSERT_TRUE(server.start({"--demo", "--cache", cache, "--threads", "2"}, cache + "/../demo.txt", 120s))
+  ASSERT_TRUE(
+      server.start({"--demo", "--cache", cache, "--threads", "2"}, cache + "/../demo.txt", 120s))
       << server.log();
   const v1::ModelList list = list_models(server.port());
   ASSERT_GE(list.models_size(), 1) << server.log();

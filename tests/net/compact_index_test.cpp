@@ -147,8 +147,8 @@ TEST_F(CompactIndexTest, CodedIndexDecodesToTheSameRecordsAsTheArrays) {
     EXPECT_EQ(coded.crc32_size(), 0);
     ASSERT_EQ(coded.count(), uint32_t(arrays.sizes_size()));
     const auto* data = reinterpret_cast<const uint8_t*>(coded.coded().data());
-    auto entries = decode_record_index(std::span<const uint8_t>(data, coded.coded().size()), coded.count(),
-                                       compact.header.payload_offset());
+    auto entries = decode_record_index(std::span<const uint8_t>(data, coded.coded().size()),
+                                       coded.count(), compact.header.payload_offset());
     ASSERT_TRUE(entries) << entries.error().message;
     for (int i = 0; i < arrays.sizes_size(); ++i) {
       EXPECT_EQ((*entries)[i].size, arrays.sizes(i)) << "record " << i;
@@ -195,9 +195,11 @@ TEST_F(CompactIndexTest, HeaderFrameIsAtLeastFourTimesSmallerOnARealModel) {
   ASSERT_FALSE(plain.empty());
   ASSERT_FALSE(compact.empty());
   EXPECT_GE(plain.size(), 4 * compact.size())
-      << index->records.size() << " records: " << plain.size() << " vs " << compact.size() << " bytes";
-  std::printf("[ demo model ] %zu records: StreamHeader frame %zu bytes (arrays) vs %zu (compact)\n",
-              index->records.size(), plain.size(), compact.size());
+      << index->records.size() << " records: " << plain.size() << " vs " << compact.size()
+      << " bytes";
+  std::printf(
+      "[ demo model ] %zu records: StreamHeader frame %zu bytes (arrays) vs %zu (compact)\n",
+      index->records.size(), plain.size(), compact.size());
 }
 
 TEST_F(CompactIndexTest, ResumedRequestStillGetsEveryRecordCoded) {
@@ -211,8 +213,8 @@ TEST_F(CompactIndexTest, ResumedRequestStillGetsEveryRecordCoded) {
   const v1::RecordIndex& coded = resumed.header.records();
   ASSERT_EQ(coded.count(), index->records.size());
   const auto* data = reinterpret_cast<const uint8_t*>(coded.coded().data());
-  auto entries = decode_record_index(std::span<const uint8_t>(data, coded.coded().size()), coded.count(),
-                                     resumed.header.payload_offset());
+  auto entries = decode_record_index(std::span<const uint8_t>(data, coded.coded().size()),
+                                     coded.count(), resumed.header.payload_offset());
   ASSERT_TRUE(entries) << entries.error().message;
   for (size_t i = 0; i < index->records.size(); ++i) {
     EXPECT_EQ((*entries)[i].offset, index->records[i].offset) << "record " << i;
@@ -225,7 +227,8 @@ TEST_F(CompactIndexTest, ResumedRequestStillGetsEveryRecordCoded) {
 TEST_F(CompactIndexTest, ModelTheCoderRefusesGetsTheArraysEvenWhenAsked) {
   auto index = read_stream_index(models_->tiny);
   ASSERT_TRUE(index);
-  ASSERT_FALSE(encode_record_index(index->records)) << "the tiny model was expected to be uncodable";
+  ASSERT_FALSE(encode_record_index(index->records))
+      << "the tiny model was expected to be uncodable";
   const StreamResult r = fetch(request("tiny", true));
   ASSERT_TRUE(r.ok) << r.problem;
   EXPECT_EQ(r.bytes, models_->tiny);
@@ -236,7 +239,8 @@ TEST_F(CompactIndexTest, ModelTheCoderRefusesGetsTheArraysEvenWhenAsked) {
   for (size_t i = 0; i < index->records.size(); ++i) {
     EXPECT_EQ(r.header.records().sizes(int(i)), index->records[i].size);
   }
-  EXPECT_NE(server_->log().find("tiny: its record index cannot be coded compactly"), std::string::npos)
+  EXPECT_NE(server_->log().find("tiny: its record index cannot be coded compactly"),
+            std::string::npos)
       << server_->log();
 }
 
@@ -247,8 +251,8 @@ TEST_F(CompactIndexTest, CapturedCompactHeaderDecodesWithRealProtoc) {
   const std::string txt = models_->dir + "/compact_header.txt";
   write_file(bin, frame);
   const std::string cmd = std::string(MESHSTREAM_PROTOC) + " -I " + MESHSTREAM_SOURCE_DIR +
-                          " --decode meshstream.v1.ServerMessage proto/meshstream.proto < " + bin + " > " +
-                          txt + " 2>&1";
+                          " --decode meshstream.v1.ServerMessage proto/meshstream.proto < " + bin +
+                          " > " + txt + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   std::ifstream in(txt);
   std::stringstream s;

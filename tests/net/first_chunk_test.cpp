@@ -121,10 +121,10 @@ const auto* const gate_cleanup = ::testing::AddGlobalTestEnvironment(new Cleanup
 // A server whose bulk hold is far longer than any test: a starting stream
 // that never released the gate would show as a stream taking >= 20 s.
 bool start_holding_server(ServerProcess& server, const std::string& log_name) {
-  return server.start({"--models", gate_models().dir, "--cache", "none", "--threads", "2",
-                       "--first-chunk-hold-ms", "10000", "--stall-timeout-ms", "1500",
-                       "--handshake-timeout-ms", "2000"},
-                      gate_models().dir + "/" + log_name + ".log");
+  return server.start(
+      {"--models", gate_models().dir, "--cache", "none", "--threads", "2", "--first-chunk-hold-ms",
+       "10000", "--stall-timeout-ms", "1500", "--handshake-timeout-ms", "2000"},
+      gate_models().dir + "/" + log_name + ".log");
 }
 
 // Streams `big` to the end; the seconds it took (byte-exact or a failure).

@@ -1,10 +1,10 @@
 // The shared framing: round trips, limits refused before allocation, the
 // zero-copy chunk head byte-identical to the generated serializer.
+#include "proto/framing.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
-
-#include "proto/framing.h"
 
 namespace meshstream::proto {
 namespace {

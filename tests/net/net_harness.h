@@ -233,7 +233,8 @@ class TestClient {
         out = std::move(**m);
         return ReadEnd::kMessage;
       }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       if (left.count() <= 0) return ReadEnd::kTimeout;
       pollfd p{fd_, POLLIN, 0};
       if (::poll(&p, 1, int(left.count())) <= 0) return ReadEnd::kTimeout;
@@ -246,11 +247,13 @@ class TestClient {
 
   // Reads until the server closes (true) or `timeout` (false); messages
   // read on the way are appended to `seen`.
-  bool wait_closed(std::chrono::milliseconds timeout, std::vector<v1::ServerMessage>* seen = nullptr) {
+  bool wait_closed(std::chrono::milliseconds timeout,
+                   std::vector<v1::ServerMessage>* seen = nullptr) {
     const auto deadline = Clock::now() + timeout;
     while (Clock::now() < deadline) {
       v1::ServerMessage m;
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       const ReadEnd end = read(m, std::max(left, 1ms));
       if (end == ReadEnd::kClosed) return true;
       if (end == ReadEnd::kMessage && seen) seen->push_back(std::move(m));
@@ -263,7 +266,6 @@ class TestClient {
   int fd_ = -1;
   proto::ServerFrameReader reader_;
 };
-
 
 // Everything one stream request produced.
 struct StreamResult {
@@ -284,7 +286,8 @@ inline StreamResult read_stream(TestClient& client, std::chrono::milliseconds ti
   uint64_t next = 0;
   while (true) {
     v1::ServerMessage m;
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
     if (left.count() <= 0 || client.read(m, left) != ReadEnd::kMessage) {
       r.problem = "stream did not finish";
       return r;
@@ -304,7 +307,8 @@ inline StreamResult read_stream(TestClient& client, std::chrono::milliseconds ti
         return r;
       }
       if (m.chunk().offset() != next) {
-        r.problem = "chunk at " + std::to_string(m.chunk().offset()) + ", expected " + std::to_string(next);
+        r.problem =
+            "chunk at " + std::to_string(m.chunk().offset()) + ", expected " + std::to_string(next);
         return r;
       }
       next += m.chunk().data().size();

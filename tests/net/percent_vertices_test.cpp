@@ -70,7 +70,8 @@ TEST(PercentVerticesPlan, EndsWhereTheDecoderBudgetEnds) {
   }
   EXPECT_TRUE(server::plan_stream(*index, 0, server::PercentVerticesBudget{100})->complete);
   // Resumed past the budget: nothing to send, as for every other budget.
-  auto late = server::plan_stream(*index, index->records[70].offset, server::PercentVerticesBudget{1e-6});
+  auto late =
+      server::plan_stream(*index, index->records[70].offset, server::PercentVerticesBudget{1e-6});
   ASSERT_TRUE(late);
   EXPECT_EQ(late->start, late->end);
 }
@@ -85,19 +86,21 @@ TEST(PercentVerticesPlan, RefusesValuesOutsideTheRangeNamingThem) {
   const struct {
     double value;
     const char* shown;
-  } cases[] = {{std::nan(""), "nan"}, {0, " 0 "}, {-0.0, " -0 "}, {-5, "-5"},
-               {101, "101"},         {100.0000001, "100.0000001"}, {inf, "inf"}, {-inf, "-inf"}};
+  } cases[] = {{std::nan(""), "nan"},        {0, " 0 "},   {-0.0, " -0 "}, {-5, "-5"}, {101, "101"},
+               {100.0000001, "100.0000001"}, {inf, "inf"}, {-inf, "-inf"}};
   for (const auto& c : cases) {
     auto plan = server::plan_stream(*index, 0, server::PercentVerticesBudget{c.value});
     ASSERT_FALSE(plan) << c.shown;
     EXPECT_EQ(plan.error().code, ErrorCode::kInvalidArgument);
-    EXPECT_NE(plan.error().message.find("percent_vertices"), std::string::npos) << plan.error().message;
+    EXPECT_NE(plan.error().message.find("percent_vertices"), std::string::npos)
+        << plan.error().message;
     EXPECT_NE(plan.error().message.find(c.shown), std::string::npos) << plan.error().message;
   }
   // The bytes percent names its value the same way.
   auto bytes_plan = server::plan_stream(*index, 0, server::PercentBudget{101});
   ASSERT_FALSE(bytes_plan);
-  EXPECT_NE(bytes_plan.error().message.find("101"), std::string::npos) << bytes_plan.error().message;
+  EXPECT_NE(bytes_plan.error().message.find("101"), std::string::npos)
+      << bytes_plan.error().message;
 }
 
 // The real server on loopback, serving the procedural demo model encoded
@@ -105,7 +108,8 @@ TEST(PercentVerticesPlan, RefusesValuesOutsideTheRangeNamingThem) {
 class PercentVerticesServerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new std::string((fs::temp_directory_path() / ("ms_pv_" + std::to_string(::getpid()))).string());
+    dir_ = new std::string(
+        (fs::temp_directory_path() / ("ms_pv_" + std::to_string(::getpid()))).string());
     fs::remove_all(*dir_);
     fs::create_directories(*dir_ + "/models");
     EncodeOptions options;
@@ -115,7 +119,8 @@ class PercentVerticesServerTest : public ::testing::Test {
     stream_ = new std::vector<uint8_t>(std::move(*encoded));
     write_file(*dir_ + "/models/demo.hcs", *stream_);
     server_ = new ServerProcess();
-    ASSERT_TRUE(server_->start({"--models", *dir_ + "/models", "--threads", "1"}, *dir_ + "/server.log"))
+    ASSERT_TRUE(
+        server_->start({"--models", *dir_ + "/models", "--threads", "1"}, *dir_ + "/server.log"))
         << server_->log();
   }
   static void TearDownTestSuite() {
@@ -164,15 +169,18 @@ TEST_F(PercentVerticesServerTest, StreamEndsOnTheDecodersRecordAndVertexCount) {
     EXPECT_EQ(expected, records_by_definition(*index, p)) << p;
     EXPECT_EQ(r.header.end_record(), expected) << p;
     EXPECT_EQ(r.end.records_complete(), expected) << p;
-    EXPECT_EQ(r.end.reason(), expected == index->records.size() ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET);
-    ASSERT_EQ(r.bytes.size(), prefix_for_budget(*index, {DecodeBudget::Kind::kPercentVertices, p})) << p;
+    EXPECT_EQ(r.end.reason(),
+              expected == index->records.size() ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET);
+    ASSERT_EQ(r.bytes.size(), prefix_for_budget(*index, {DecodeBudget::Kind::kPercentVertices, p}))
+        << p;
     EXPECT_TRUE(std::equal(r.bytes.begin(), r.bytes.end(), stream_->begin())) << p;
     // Decoding what arrived gives the decoder's own budgeted mesh.
     IncrementalDecoder decoder;
     ASSERT_TRUE(decoder.feed(r.bytes));
     EXPECT_EQ(decoder.records_decoded(), expected) << p;
     EXPECT_EQ(decoder.mesh().vertex_count(), index->records[expected - 1].vertices) << p;
-    EXPECT_LE(double(decoder.mesh().vertex_count()), p / 100.0 * double(index->header.vertex_count) + 1e-9)
+    EXPECT_LE(double(decoder.mesh().vertex_count()),
+              p / 100.0 * double(index->header.vertex_count) + 1e-9)
         << p;
   }
 }

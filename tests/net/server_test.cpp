@@ -62,9 +62,18 @@ const auto* const cleanup_registration = ::testing::AddGlobalTestEnvironment(new
 StreamIndex index_of(const std::vector<uint8_t>& bytes) { return *read_stream_index(bytes); }
 
 std::vector<std::string> base_args(const std::vector<std::string>& extra = {}) {
-  std::vector<std::string> args{"--models", models().dir, "--cache", "none", "--threads", "2",
-                                "--handshake-timeout-ms", "700", "--idle-timeout-ms", "3000",
-                                "--stall-timeout-ms", "1500"};
+  std::vector<std::string> args{"--models",
+                                models().dir,
+                                "--cache",
+                                "none",
+                                "--threads",
+                                "2",
+                                "--handshake-timeout-ms",
+                                "700",
+                                "--idle-timeout-ms",
+                                "3000",
+                                "--stall-timeout-ms",
+                                "1500"};
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
 }
@@ -150,7 +159,8 @@ TEST_F(NetTest, FullStreamIsByteIdenticalToTheFile) {
   for (size_t k = 0; k < r.chunks.size(); ++k) {
     const v1::Chunk& chunk = r.chunks[k];
     // Slow start: 8 KiB, doubling per chunk, up to max_chunk_bytes.
-    const size_t limit = std::min<size_t>(r.header.max_chunk_bytes(), size_t(8192) << std::min<size_t>(k, 20));
+    const size_t limit =
+        std::min<size_t>(r.header.max_chunk_bytes(), size_t(8192) << std::min<size_t>(k, 20));
     EXPECT_LE(chunk.data().size(), limit) << "chunk " << k;
     const uint64_t end = chunk.offset() + chunk.data().size();
     uint32_t complete = 0;
@@ -161,7 +171,8 @@ TEST_F(NetTest, FullStreamIsByteIdenticalToTheFile) {
     }
     EXPECT_EQ(chunk.records_complete(), complete);
     if (!boundary) {
-      const uint64_t unit = end < index.payload_offset ? index.payload_offset : index.records[complete].size;
+      const uint64_t unit =
+          end < index.payload_offset ? index.payload_offset : index.records[complete].size;
       EXPECT_GT(unit, limit) << "chunk " << k << " splits a record that would fit";
     }
   }
@@ -356,7 +367,8 @@ TEST_F(NetTest, TwoGibLengthPrefixIsRefusedWithoutAllocating) {
   proto::append_varint(over, proto::kDefaultMaxClientFrameBytes + 1);
   expect_error_and_close(server_->port(), over, false, v1::Error::FRAME_TOO_LARGE);
   const long after = server_->status_kib("RssAnon");
-  EXPECT_LT(after - before, 16 * 1024) << "RssAnon grew from " << before << " to " << after << " KiB";
+  EXPECT_LT(after - before, 16 * 1024)
+      << "RssAnon grew from " << before << " to " << after << " KiB";
 }
 
 TEST_F(NetTest, WrongProtocolVersionIsRefused) {
@@ -516,7 +528,8 @@ TEST_F(NetTest, CapturedFrameDecodesWithRealProtoc) {
 
 TEST(NetServer, MaxConnectionsTurnsAwayExtraClientsWithBusy) {
   ServerProcess server;
-  ASSERT_TRUE(server.start(base_args({"--max-connections", "2"}), log_path("busy"))) << server.log();
+  ASSERT_TRUE(server.start(base_args({"--max-connections", "2"}), log_path("busy")))
+      << server.log();
   std::vector<TestClient> kept;
   for (int i = 0; i < 2; ++i) {
     TestClient c;
@@ -589,9 +602,11 @@ TEST(NetServer, RatePacingChargesTheStreamHeader) {
   // Without the header charged this would arrive after (first chunk -
   // burst) / rate: the bound below tells the two apart.
   const double header_bytes = double(header.ByteSizeLong());
-  ASSERT_LT(paced - header_bytes, 0.8 * paced) << "test setup: the header must be a fair share of the paced bytes";
-  EXPECT_GT(seconds, 0.8 * paced / kRate) << "header " << header_bytes << " B and first chunk "
-                                           << chunk.chunk().data().size() << " B arrived faster than the rate";
+  ASSERT_LT(paced - header_bytes, 0.8 * paced)
+      << "test setup: the header must be a fair share of the paced bytes";
+  EXPECT_GT(seconds, 0.8 * paced / kRate)
+      << "header " << header_bytes << " B and first chunk " << chunk.chunk().data().size()
+      << " B arrived faster than the rate";
 }
 
 TEST(NetServer, SigtermMidStreamShutsDownCleanly) {
@@ -633,8 +648,8 @@ TEST(NetServer, SigintWithNoClientsExitsZero) {
 TEST(NetServer, UsageErrorsExitTwoWithOneLine) {
   for (const std::string args : {"", "--models /nonexistent/dir", "--models . --listen nope",
                                  "--models . --max-connections 0", "--bogus"}) {
-    const std::string cmd = server_binary() + " " + args + " > /dev/null 2> " + models().dir +
-                            "/usage.txt";
+    const std::string cmd =
+        server_binary() + " " + args + " > /dev/null 2> " + models().dir + "/usage.txt";
     const int status = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 2) << args;

@@ -1,8 +1,9 @@
 // Stream planning on a synthetic index: budgets and resume land on record
 // boundaries, chunks tile the range exactly and respect the size limit.
+#include "server/stream_plan.h"
+
 #include <gtest/gtest.h>
 
-#include "server/stream_plan.h"
 #include "server/synthetic_stream.h"
 #include "server/token_bucket.h"
 
@@ -108,8 +109,8 @@ TEST(StreamPlan, ChunksTileTheRangeOnBoundaries) {
       if (!boundary) {
         // Only inside a unit larger than the limit.
         const uint32_t r = records_complete_at(index, cut.end);
-        const uint64_t unit = cut.end < index.payload_offset ? index.payload_offset
-                                                             : index.records[r].size;
+        const uint64_t unit =
+            cut.end < index.payload_offset ? index.payload_offset : index.records[r].size;
         EXPECT_GT(unit, max_chunk);
       }
       position = cut.end;
@@ -148,7 +149,7 @@ TEST(TokenBucket, PacesToTheRate) {
   auto now = Clock::now();
   TokenBucket bucket(1000.0, 100.0, now);
   EXPECT_EQ(bucket.take(100, now), Clock::duration::zero());  // starts full
-  const auto wait = bucket.take(500, now);                     // 500 in debt
+  const auto wait = bucket.take(500, now);                    // 500 in debt
   EXPECT_NEAR(std::chrono::duration<double>(wait).count(), 0.5, 1e-6);
   now += std::chrono::seconds(10);  // refill caps at the burst
   EXPECT_EQ(bucket.take(100, now), Clock::duration::zero());

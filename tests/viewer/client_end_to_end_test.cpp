@@ -7,11 +7,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "client/viewer/rgba_image.h"
 #include "common/mesh/export.h"
@@ -26,8 +25,12 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-std::string server_binary() { return std::string(MESHSTREAM_BINARY_DIR) + "/server/meshstream-server"; }
-std::string client_binary() { return std::string(MESHSTREAM_BINARY_DIR) + "/client/meshstream-client"; }
+std::string server_binary() {
+  return std::string(MESHSTREAM_BINARY_DIR) + "/server/meshstream-server";
+}
+std::string client_binary() {
+  return std::string(MESHSTREAM_BINARY_DIR) + "/client/meshstream-client";
+}
 
 // Sets an environment variable for a scope (the children started in it
 // inherit it) and restores the old value on every exit, ASSERT included.
@@ -38,7 +41,10 @@ class ScopedEnv {
     ::setenv(name, value.c_str(), 1);
   }
   ~ScopedEnv() {
-    if (saved_) ::setenv(name_, saved_->c_str(), 1); else ::unsetenv(name_);
+    if (saved_)
+      ::setenv(name_, saved_->c_str(), 1);
+    else
+      ::unsetenv(name_);
   }
   ScopedEnv(const ScopedEnv&) = delete;
   ScopedEnv& operator=(const ScopedEnv&) = delete;
@@ -75,8 +81,12 @@ class ClientEndToEnd : public ::testing::Test {
 
   // Starts a server on a free port; "" on failure (log in the message).
   std::string start_server(testing::ChildProcess& server, const std::vector<std::string>& extra) {
-    std::vector<std::string> args{server_binary(), "--models", (*dir_ / "models").string(),
-                                  "--cache", (*dir_ / "cache").string(), "--listen",
+    std::vector<std::string> args{server_binary(),
+                                  "--models",
+                                  (*dir_ / "models").string(),
+                                  "--cache",
+                                  (*dir_ / "cache").string(),
+                                  "--listen",
                                   "127.0.0.1:0"};
     args.insert(args.end(), extra.begin(), extra.end());
     if (!server.start(args, (*dir_ / "server.log").string())) return {};
@@ -132,8 +142,9 @@ TEST_F(ClientEndToEnd, SnapshotsShowTheModelRefiningAndWhatAsaDoes) {
   ASSERT_EQ(run_client(with({"--snapshot", path("final.png")})), 0) << client_log();
   ASSERT_EQ(run_client(with({"--snapshot", path("final_no_asa.png"), "--no-asa"})), 0)
       << client_log();
-  ASSERT_EQ(run_client(with({"--snapshot", path("early_no_asa.png"), "--snapshot-at", "0",
-                             "--no-asa"})), 0)
+  ASSERT_EQ(
+      run_client(with({"--snapshot", path("early_no_asa.png"), "--snapshot-at", "0", "--no-asa"})),
+      0)
       << client_log();
 
   RgbaImage early = read_or_fail(path("early.png"));
@@ -186,8 +197,9 @@ TEST_F(ClientEndToEnd, ClosingTheWindowEarlyReportsWhatWasShown) {
   ScopedEnv on_xvfb("DISPLAY", display);
   // Close on a record count, not a frame count: the frame rate under Xvfb
   // varies tenfold (sanitizer builds), the stream's pace does not.
-  std::vector<std::string> args{client_binary(), address_, "knot", "--view", "--exit-after-records", "3",
-                                "--width", "200", "--height", "150", "--json"};
+  std::vector<std::string> args{
+      client_binary(), address_,   "knot", "--view", "--exit-after-records", "3", "--width",
+      "200",           "--height", "150",  "--json"};
   testing::ChildProcess client;
   ASSERT_TRUE(client.start(args, path("client.log")));
   std::string done_line;

@@ -119,7 +119,8 @@ TEST(Snapshot, WireframeAndDistanceModesChangeThePicture) {
 
   // Distance ramp: blue where the distance is 0, red at distance_max.
   std::vector<float> distance(mesh.vertex_count());
-  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) distance[v] = mesh.positions[v].y > 0 ? 1.0f : 0.0f;
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v)
+    distance[v] = mesh.positions[v].y > 0 ? 1.0f : 0.0f;
   OffscreenRequest ramp = small_request();
   ramp.style.coloring = ColorMode::kDistance;
   ramp.vertex_distance = &distance;

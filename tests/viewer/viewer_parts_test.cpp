@@ -84,7 +84,8 @@ TEST(FrameHistory, StaysBoundedAndSpreadOverTheStream) {
     ASSERT_LE(history.size(), 8u);
     ASSERT_EQ(history.newest().sequence, s);
     ASSERT_EQ(history[0].sequence, 1u);
-    for (size_t i = 1; i < history.size(); ++i) ASSERT_LT(history[i - 1].sequence, history[i].sequence);
+    for (size_t i = 1; i < history.size(); ++i)
+      ASSERT_LT(history[i - 1].sequence, history[i].sequence);
   }
   // Spread: evenly over the whole stream, not crowded at the end.
   ASSERT_GE(history.size(), 5u);
@@ -140,7 +141,8 @@ TEST(Png, RoundTripsExactly) {
   image.width = 7;
   image.height = 3;
   for (int i = 0; i < 7 * 3 * 4; ++i) image.rgba.push_back(static_cast<uint8_t>(i * 37 + 11));
-  std::string path = (std::filesystem::temp_directory_path() / "meshstream_viewer_roundtrip.png").string();
+  std::string path =
+      (std::filesystem::temp_directory_path() / "meshstream_viewer_roundtrip.png").string();
   ASSERT_TRUE(write_png(path, image).has_value());
   auto back = read_png(path);
   ASSERT_TRUE(back.has_value()) << back.error().message;
@@ -163,7 +165,8 @@ TEST(Png, RoundTripsExactly) {
 }
 
 TEST(Png, NotAPngIsAParseError) {
-  std::string path = (std::filesystem::temp_directory_path() / "meshstream_viewer_not.png").string();
+  std::string path =
+      (std::filesystem::temp_directory_path() / "meshstream_viewer_not.png").string();
   {
     std::FILE* f = std::fopen(path.c_str(), "wb");
     std::fputs("this is not a png file at all", f);

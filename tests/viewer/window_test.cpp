@@ -1,6 +1,8 @@
 // The live window under a virtual X display: it opens, draws frames while
 // another thread publishes a refining stream, shows the newest mesh and
 // closes cleanly after exit_after_frames. Skips visibly without Xvfb.
+#include "client/viewer/window.h"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -10,7 +12,6 @@
 #include <mutex>
 #include <thread>
 
-#include "client/viewer/window.h"
 #include "common/asa/subdivide.h"
 #include "common/mesh/procedural.h"
 #include "tests/viewer/image_checks.h"
@@ -187,10 +188,14 @@ TEST_F(WindowTest, CommandsSteerTheStreamAndTheView) {
   set_asa.asa_enabled = true;
   set_asa.asa = asa;
   std::vector<ScriptedCommand> script{
-      at(2, ViewerCommand::kTogglePause),     at(4, ViewerCommand::kTogglePause),
-      set_asa,                                at(6, ViewerCommand::kColorDistance),
-      at(7, ViewerCommand::kToggleWireframe), at(8, ViewerCommand::kScreenshot),
-      at(9, ViewerCommand::kFrameModel),      at(40, ViewerCommand::kClose),
+      at(2, ViewerCommand::kTogglePause),
+      at(4, ViewerCommand::kTogglePause),
+      set_asa,
+      at(6, ViewerCommand::kColorDistance),
+      at(7, ViewerCommand::kToggleWireframe),
+      at(8, ViewerCommand::kScreenshot),
+      at(9, ViewerCommand::kFrameModel),
+      at(40, ViewerCommand::kClose),
   };
   ViewerOptions options;
   options.width = 320;

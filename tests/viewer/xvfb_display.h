@@ -38,13 +38,14 @@ class XvfbDisplay {
       std::string socket = "/tmp/.X11-unix/X" + std::to_string(n);
       if (std::filesystem::exists(lock) || std::filesystem::exists(socket)) continue;
       std::string display = ":" + std::to_string(n);
-      const char* argv[] = {xvfb.c_str(), display.c_str(), "-screen", "0", "1024x768x24",
-                            "-nolisten", "tcp", "-noreset", nullptr};
+      const char* argv[] = {xvfb.c_str(), display.c_str(), "-screen",  "0",    "1024x768x24",
+                            "-nolisten",  "tcp",           "-noreset", nullptr};
       posix_spawn_file_actions_t actions;
       posix_spawn_file_actions_init(&actions);
       posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", 1 /*O_WRONLY*/, 0);
       posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", 1 /*O_WRONLY*/, 0);
-      int rc = posix_spawn(&pid_, xvfb.c_str(), &actions, nullptr, const_cast<char**>(argv), environ);
+      int rc =
+          posix_spawn(&pid_, xvfb.c_str(), &actions, nullptr, const_cast<char**>(argv), environ);
       posix_spawn_file_actions_destroy(&actions);
       if (rc != 0) return {};
       auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
