@@ -17,6 +17,7 @@ MESHSTREAM_PACKAGES=(
   libglfw3-dev libimgui-dev libosmesa6-dev libpng-dev  # viewer: window, panel, off-screen, PNG
   xvfb xauth  # viewer tests: a virtual X display for the window
   clang libclang-rt-14-dev  # fuzz targets (libFuzzer) in tests/fuzz
+  clang-format  # scripts/check-format, run by scripts/test
 )
 
 ms_install_packages() {
