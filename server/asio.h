@@ -3,14 +3,16 @@
 // ("exchange is not a member of std"); include only this header.
 #pragma once
 
-// clang-format off: <utility> must stay first (see above).
+// <utility> must stay first, so clang-format must not sort this block.
+// clang-format off
+#include <utility>
+
 #include <boost/asio.hpp>
 #include <boost/asio/awaitable.hpp>
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/use_awaitable.hpp>
-#include <utility>
 // clang-format on
 
 namespace meshstream::net {
