@@ -2,9 +2,11 @@
 // <utility> before the Asio headers ("exchange is not a member of std").
 #pragma once
 
-// clang-format off: <utility> must stay first (see above).
-#include <boost/asio.hpp>
+// <utility> must stay first (see above); clang-format 14 only honours a bare
+// "clang-format off" comment, so the reason sits on its own lines.
+// clang-format off
 #include <utility>
+#include <boost/asio.hpp>
 // clang-format on
 
 namespace meshstream::client {
