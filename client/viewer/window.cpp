@@ -187,7 +187,9 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
       return;
     }
     auto start = Clock::now();
-    renderer->upload(*mesh, frame.face_kind.get());
+    // Shading follows the panel's crease angle (the ASA control), so the
+    // edges ASA keeps sharp are also drawn sharp.
+    renderer->upload(*mesh, frame.face_kind.get(), panel.asa.crease_degrees);
     double ms = ms_since(start);
     panel.upload_ms = ms;
     report.max_upload_ms = std::max(report.max_upload_ms, ms);
