@@ -19,7 +19,7 @@ Result<GLuint> compile(const GlFunctions& gl, GLenum type, const char* source, c
     gl.GetShaderInfoLog(shader, sizeof log, nullptr, log);
     gl.DeleteShader(shader);
     return make_error(ErrorCode::kUnsupported,
-                      std::string("viewer: the ") + what + " shader does not compile: " + log);
+                      std::string("the ") + what + " shader does not compile: " + log);
   }
   return shader;
 }
@@ -56,7 +56,7 @@ Result<MeshRenderer> MeshRenderer::create(const GlFunctions& gl) {
     char log[2048] = {};
     gl.GetProgramInfoLog(program, sizeof log, nullptr, log);
     gl.DeleteProgram(program);
-    return make_error(ErrorCode::kUnsupported, std::string("viewer: shaders do not link: ") + log);
+    return make_error(ErrorCode::kUnsupported, std::string("the shaders do not link: ") + log);
   }
   r.program_ = program;
   r.created_ = true;
