@@ -2,10 +2,10 @@
 // <utility> before the Asio headers ("exchange is not a member of std").
 #pragma once
 
-// <utility> must stay first (see above); clang-format 14 only honours a bare
-// "clang-format off" comment, so the reason sits on its own lines.
+// <utility> must stay first, so clang-format must not sort this block.
 // clang-format off
 #include <utility>
+
 #include <boost/asio.hpp>
 // clang-format on
 
