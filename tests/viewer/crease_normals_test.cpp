@@ -16,32 +16,16 @@
 #include "common/mesh/import.h"
 #include "common/mesh/procedural.h"
 #include "tests/test_meshes.h"
+#include "tests/viewer/cube_edges.h"
 #include "tests/viewer/image_checks.h"
 
 namespace meshstream::client {
 namespace {
 
-// The unit cube, 8 shared corners, 12 outward-facing triangles.
-Mesh make_cube() {
-  Mesh m;
-  for (int i = 0; i < 8; ++i) {
-    m.positions.push_back(
-        {static_cast<float>(i & 1), static_cast<float>((i >> 1) & 1), static_cast<float>(i >> 2)});
-  }
-  // Each side as a quad (a, b, c, d) counter-clockwise seen from outside.
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    m.triangles.push_back({q[0], q[1], q[2]});
-    m.triangles.push_back({q[0], q[2], q[3]});
-  }
-  return m;
-}
-
 float distance(Vec3f a, Vec3f b) { return length(a - b); }
 
 TEST(CreaseNormals, EveryCubeCornerGetsItsFacesNormal) {
-  const Mesh cube = make_cube();
+  const Mesh cube = testing::make_cube();
   for (float degrees : {kDefaultShadingCreaseDegrees, 30.0f, 89.0f}) {
     ShadingMesh s = split_normals_at_creases(cube, degrees);
     // Three sides meet at each corner: three copies of every vertex.
@@ -66,7 +50,7 @@ TEST(CreaseNormals, EveryCubeCornerGetsItsFacesNormal) {
 }
 
 TEST(CreaseNormals, AboveTheEdgeAngleTheCubeStaysSmooth) {
-  const Mesh cube = make_cube();
+  const Mesh cube = testing::make_cube();
   for (float degrees : {91.0f, 180.0f}) {
     ShadingMesh s = split_normals_at_creases(cube, degrees);
     EXPECT_EQ(s.positions.size(), 8u) << degrees;
@@ -89,7 +73,7 @@ TEST(CreaseNormals, ASmoothSurfaceIsNotSplitAndKeepsItsOwnNormals) {
 }
 
 TEST(CreaseNormals, DegenerateFacesAndIsolatedVerticesDoNotSplitOrBreak) {
-  Mesh m = make_cube();
+  Mesh m = testing::make_cube();
   m.positions.push_back({5, 5, 5});  // isolated
   // A zero-area sliver on the top edge (vertices 4, 5 and the edge midpoint
   // would need a new vertex; use a repeated position instead).
@@ -111,11 +95,6 @@ TEST(CreaseNormals, DegenerateFacesAndIsolatedVerticesDoNotSplitOrBreak) {
   }
 }
 
-int luma(const RgbaImage& image, int x, int y) {
-  const uint8_t* p = image.pixel(x, y);
-  return (299 * p[0] + 587 * p[1] + 114 * p[2]) / 1000;
-}
-
 constexpr int kWidth = 320, kHeight = 240;
 
 RgbaImage render(const Mesh& mesh, float crease_degrees, const std::string& name) {
@@ -130,67 +109,18 @@ RgbaImage render(const Mesh& mesh, float crease_degrees, const std::string& name
   return *image;
 }
 
-// For every edge of the cube whose two sides both face the camera: the
-// brightness of the picture a little inside each side, next to the
-// edge's midpoint (the camera render_offscreen uses, rebuilt here).
-struct EdgeShades {
-  int side_a = 0, side_b = 0;
-};
-
-std::vector<EdgeShades> shades_beside_visible_edges(const Mesh& cube, const RgbaImage& image) {
-  const OffscreenRequest defaults;
-  OrbitCamera camera;
-  camera.yaw = defaults.yaw;
-  camera.pitch = defaults.pitch;
-  const float aspect = static_cast<float>(kWidth) / kHeight;
-  camera.frame(cube, aspect, defaults.fill);
-  const Mat4 m = mat4_multiply(camera.projection(aspect), camera.view());
-  auto pixel_of = [&](Vec3f p) {
-    const float x = m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12];
-    const float y = m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13];
-    const float w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
-    return std::pair<int, int>{static_cast<int>((x / w + 1) / 2 * kWidth),
-                               static_cast<int>((1 - y / w) / 2 * kHeight)};
-  };
-  std::vector<EdgeShades> shades;
-  for (uint32_t f = 0; f < cube.face_count(); ++f) {
-    for (uint32_t g = f + 1; g < cube.face_count(); ++g) {
-      const Vec3f nf = face_normal(cube, f), ng = face_normal(cube, g);
-      if (dot(nf, ng) > 0.5f) continue;  // same side of the cube
-      std::vector<uint32_t> shared;
-      for (uint32_t a : cube.triangles[f])
-        for (uint32_t b : cube.triangles[g])
-          if (a == b) shared.push_back(a);
-      if (shared.size() != 2) continue;
-      const Vec3f mid = (cube.positions[shared[0]] + cube.positions[shared[1]]) * 0.5f;
-      if (dot(nf, camera.eye() - mid) <= 0 || dot(ng, camera.eye() - mid) <= 0) continue;
-      // 3 % of the side into each face: on a cube, into face f is away
-      // from the other face's normal.
-      const auto [xa, ya] = pixel_of(mid - ng * 0.03f);
-      const auto [xb, yb] = pixel_of(mid - nf * 0.03f);
-      shades.push_back({luma(image, xa, ya), luma(image, xb, yb)});
-    }
-  }
-  return shades;
-}
-
 TEST(CreaseNormals, SnapshotOfACubeChangesShadeAtEveryEdgeOnlyWhenSplit) {
-  const Mesh cube = make_cube();
+  const Mesh cube = testing::make_cube();
   RgbaImage sharp = render(cube, 0.0f, "cube_default");  // the default angle
   RgbaImage smooth = render(cube, 180.0f, "cube_never_split");
   ASSERT_FALSE(sharp.rgba.empty());
   ASSERT_FALSE(smooth.rgba.empty());
-  const auto sharp_edges = shades_beside_visible_edges(cube, sharp);
-  const auto smooth_edges = shades_beside_visible_edges(cube, smooth);
+  const auto sharp_edges = testing::shades_beside_visible_edges(cube, sharp);
+  const auto smooth_edges = testing::shades_beside_visible_edges(cube, smooth);
   // Three sides visible, three edges between them.
   ASSERT_EQ(sharp_edges.size(), 3u);
-  int sharp_largest = 0, smooth_largest = 0;
-  for (const EdgeShades& e : sharp_edges) {
-    sharp_largest = std::max(sharp_largest, std::abs(e.side_a - e.side_b));
-  }
-  for (const EdgeShades& e : smooth_edges) {
-    smooth_largest = std::max(smooth_largest, std::abs(e.side_a - e.side_b));
-  }
+  const int sharp_largest = testing::largest_edge_step(sharp_edges);
+  const int smooth_largest = testing::largest_edge_step(smooth_edges);
   // Measured: split, two sides differ by 58 grey levels next to their edge;
   // with one normal per corner by at most 5.
   EXPECT_GE(sharp_largest, 25) << "the cube's edges are not drawn sharp";
