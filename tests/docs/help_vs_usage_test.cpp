@@ -164,7 +164,10 @@ TEST(HelpVsUsage, EveryFlagOfEveryProgramIsInItsSectionOfUsageMd) {
   EXPECT_GT(flags, 40u) << "the --help parser found too few flags: is it broken?";
   std::string list;
   for (const std::string& m : missing) list += "\n  " + m;
-  EXPECT_TRUE(missing.empty()) << missing.size() << " flags missing from docs/usage.md:" << list;
+  EXPECT_TRUE(missing.empty()) << missing.size()
+                               << " flags missing from their program's section of docs/usage.md "
+                                  "(say what each does and its default):"
+                               << list;
 }
 
 // Options with a value but no default, each for a reason: a required
@@ -193,8 +196,12 @@ TEST(HelpVsUsage, EveryOptionWithAValueShowsItsDefault) {
   }
   std::string list;
   for (const std::string& s : silent) list += "\n  " + s;
-  EXPECT_TRUE(silent.empty()) << silent.size()
-                              << " options show no default (->capture_default_str()):" << list;
+  EXPECT_TRUE(silent.empty())
+      << silent.size()
+      << " options show no default: add ->capture_default_str() (or say \"default ...\" in "
+         "the description); an option that has none belongs in "
+         "kNoDefault above, with the reason:"
+      << list;
 }
 
 // "issue I", "issue 5's target": names from the project's tracker mean
