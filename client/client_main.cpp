@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
     SnapshotOptions s;
     s.width = o.width;
     s.height = o.height;
+    s.crease_degrees = o.asa.crease_degrees;
     return render_snapshot(mesh, kinds, s, png);
   };
   return run_client(options, hooks);

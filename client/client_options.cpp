@@ -30,7 +30,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->check(CLI::IsMember({"zorin", "projection"}))
       ->capture_default_str();
   app.add_option("--crease", o.asa.crease_degrees,
-                 "edges bending more than DEG degrees stay sharp (0 = off)")
+                 "edges bending more than DEG degrees stay sharp (0 = off; the picture then "
+                 "keeps edges above 60 degrees sharp)")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   bool no_asa = false;
@@ -66,10 +67,15 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--snapshot-at", o.snapshot_at,
                  "snapshot the display mesh after record N (0 = base mesh)");
-  app.add_option("--exit-after", o.exit_after_frames, "close the window after N frames (tests)");
+  app.add_option("--exit-after", o.exit_after_frames,
+                 "close the window after N frames (0 = when the user closes it)")
+      ->capture_default_str();
   app.add_option("--exit-after-records", o.exit_after_records,
-                 "close the window once a frame with N decoded records is drawn (tests)");
-  app.add_option("--max-chunk-bytes", o.max_chunk_bytes, "largest chunk to ask the server for");
+                 "close the window once a frame with N decoded records is drawn (0 = off)")
+      ->capture_default_str();
+  app.add_option("--max-chunk-bytes", o.max_chunk_bytes,
+                 "largest chunk to ask the server for (0 = the server's --max-chunk-bytes)")
+      ->capture_default_str();
   app.add_option("--reconnect-attempts", reconnect_attempts,
                  "consecutive reconnects before giving up")
       ->check(CLI::Range(0, 1000))

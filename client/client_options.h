@@ -1,4 +1,4 @@
-// The `meshstream-client` command line (contract in ../shared/DESIGN.md):
+// The `meshstream-client` command line (contract in docs/design.md):
 //   meshstream-client HOST:PORT [MODEL] [--list] [--out DIR] [--asa-levels L]
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]

@@ -1,5 +1,5 @@
 // What the client tells its user while streaming: JSON event lines on stdout
-// (--json; contract in ../shared/DESIGN.md: header, refinement per display
+// (--json; contract in docs/design.md: header, refinement per display
 // update, done or error), or a progress line on a terminal. Thread-safe:
 // the header comes from the network thread, refinements from the pipeline.
 #pragma once

@@ -1,4 +1,4 @@
-// The `meshstream-server` command line (contract in shared/DESIGN.md) and
+// The `meshstream-server` command line (contract in docs/design.md) and
 // the settings it turns into.
 #pragma once
 

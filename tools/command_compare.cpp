@@ -99,8 +99,10 @@ void add_compare_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--json", args->json, "one JSON object on stdout");
   cmd->add_option("--samples", args->samples,
                   "area samples per direction (vertices and edge midpoints are added)")
-      ->check(CLI::Range(0u, 50000000u));
-  cmd->add_option("--seed", args->seed, "sampling seed (results are deterministic for a seed)");
+      ->check(CLI::Range(0u, 50000000u))
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed, "sampling seed (results are deterministic for a seed)")
+      ->capture_default_str();
   cmd->callback([args, &exit_code] { exit_code = run_compare(*args); });
 }
 

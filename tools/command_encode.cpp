@@ -75,8 +75,9 @@ void add_encode_command(CLI::App& app, int& exit_code) {
                   "low bits of the base positions sent later as bit planes (-1: automatic)")
       ->check(CLI::Range(-1, 12))
       ->capture_default_str();
-  cmd->add_flag("--issue1-order", args->issue1_order,
-                "no bit planes: every position exact when its vertex arrives (issue I's ordering)");
+  cmd->add_flag(
+      "--issue1-order", args->issue1_order,
+      "no bit planes: every position exact when its vertex arrives (the first record order)");
   cmd->callback([args, &exit_code] { exit_code = run_encode(*args); });
 }
 

@@ -19,7 +19,7 @@ Result<GLuint> compile(const GlFunctions& gl, GLenum type, const char* source, c
     gl.GetShaderInfoLog(shader, sizeof log, nullptr, log);
     gl.DeleteShader(shader);
     return make_error(ErrorCode::kUnsupported,
-                      std::string("viewer: the ") + what + " shader does not compile: " + log);
+                      std::string("the ") + what + " shader does not compile: " + log);
   }
   return shader;
 }
@@ -56,7 +56,7 @@ Result<MeshRenderer> MeshRenderer::create(const GlFunctions& gl) {
     char log[2048] = {};
     gl.GetProgramInfoLog(program, sizeof log, nullptr, log);
     gl.DeleteProgram(program);
-    return make_error(ErrorCode::kUnsupported, std::string("viewer: shaders do not link: ") + log);
+    return make_error(ErrorCode::kUnsupported, std::string("the shaders do not link: ") + log);
   }
   r.program_ = program;
   r.created_ = true;
@@ -110,6 +110,7 @@ MeshRenderer& MeshRenderer::operator=(MeshRenderer&& other) noexcept {
     face_kind_buffer_ = other.face_kind_buffer_;
     face_kind_texture_ = other.face_kind_texture_;
     vertex_count_ = other.vertex_count_;
+    copied_from_ = std::move(other.copied_from_);
     triangle_count_ = other.triangle_count_;
     has_distances_ = other.has_distances_;
     uniforms_ = other.uniforms_;
@@ -130,28 +131,27 @@ void MeshRenderer::release() {
   gl_.DeleteProgram(program_);
 }
 
-void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind) {
+void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
+                          float crease_degrees) {
   vertex_count_ = mesh.vertex_count();
   triangle_count_ = mesh.face_count();
-  // Normals the mesh brings are used as they are (no O(V + F) pass on the
-  // render thread); otherwise area-weighted ones are computed here.
-  std::vector<Vec3f> computed;
-  if (mesh.normals.size() != mesh.positions.size()) computed = compute_vertex_normals(mesh);
-  const std::vector<Vec3f>& normals = computed.empty() ? mesh.normals : computed;
+  ShadingMesh shading = split_normals_at_creases(mesh, shading_crease_degrees(crease_degrees));
+  copied_from_ = std::move(shading.copied_from);
   auto send = [&](GLenum target, GLuint buffer, size_t bytes, const void* data) {
     gl_.BindBuffer(target, buffer);
     gl_.BufferData(target, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
   };
-  send(GL_ARRAY_BUFFER, position_buffer_, mesh.positions.size() * sizeof(Vec3f),
-       mesh.positions.data());
-  send(GL_ARRAY_BUFFER, normal_buffer_, normals.size() * sizeof(Vec3f), normals.data());
-  std::vector<float> zeros(vertex_count_, 0.0f);
+  send(GL_ARRAY_BUFFER, position_buffer_, shading.positions.size() * sizeof(Vec3f),
+       shading.positions.data());
+  send(GL_ARRAY_BUFFER, normal_buffer_, shading.normals.size() * sizeof(Vec3f),
+       shading.normals.data());
+  std::vector<float> zeros(shading.positions.size(), 0.0f);
   send(GL_ARRAY_BUFFER, distance_buffer_, zeros.size() * sizeof(float), zeros.data());
   has_distances_ = false;
   gl_.BindBuffer(GL_ARRAY_BUFFER, 0);
   gl_.BindVertexArray(vao_);
-  send(GL_ELEMENT_ARRAY_BUFFER, index_buffer_, mesh.triangles.size() * sizeof(Triangle),
-       mesh.triangles.data());
+  send(GL_ELEMENT_ARRAY_BUFFER, index_buffer_, shading.triangles.size() * sizeof(Triangle),
+       shading.triangles.data());
   gl_.BindVertexArray(0);
 
   // A texture buffer may not be empty on every driver: keep at least one texel.
@@ -168,9 +168,13 @@ void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_ki
 
 void MeshRenderer::upload_distances(const std::vector<float>& distances) {
   if (distances.size() != vertex_count_) return;
+  std::vector<float> drawn;
+  drawn.reserve(distances.size() + copied_from_.size());
+  drawn.assign(distances.begin(), distances.end());
+  for (uint32_t v : copied_from_) drawn.push_back(distances[v]);
   gl_.BindBuffer(GL_ARRAY_BUFFER, distance_buffer_);
-  gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(distances.size() * sizeof(float)),
-                 distances.data(), GL_STATIC_DRAW);
+  gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(drawn.size() * sizeof(float)),
+                 drawn.data(), GL_STATIC_DRAW);
   gl_.BindBuffer(GL_ARRAY_BUFFER, 0);
   has_distances_ = true;
 }

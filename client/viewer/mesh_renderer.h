@@ -1,10 +1,12 @@
 // The one renderer behind the window and the off-screen snapshots: indexed
-// triangles with smooth per-vertex normals, a single-pass wireframe overlay
+// triangles with per-vertex normals split at creases (crease_normals.h, so
+// machined parts keep their sharp edges), a single-pass wireframe overlay
 // (a geometry shader gives every fragment its window-space distance to the
 // triangle's edges; Bærentzen, Nielsen, Gjøl, Larsen, "Two methods for
 // antialiased wireframe drawing with hidden line removal", SCCG 2008) and
 // three colour modes. Per-face labels (what ASA did) live in a texture
-// buffer indexed by gl_PrimitiveID, so vertices are never duplicated.
+// buffer indexed by gl_PrimitiveID (the split keeps every face's index), so
+// vertices are duplicated only where a crease needs two normals.
 //
 // Every method needs the GL context the renderer was created in to be
 // current on the calling thread.
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "client/viewer/camera.h"
+#include "client/viewer/crease_normals.h"
 #include "client/viewer/gl_functions.h"
 #include "common/asa/subdivide.h"
 #include "common/base/result.h"
@@ -48,23 +51,28 @@ class MeshRenderer {
   MeshRenderer& operator=(const MeshRenderer&) = delete;
   ~MeshRenderer();  // frees the GL objects (context must be current)
 
-  // Replaces the drawn mesh: sends positions, normals (the mesh's own when it
-  // has one per vertex, else area-weighted ones computed here) and indices to
-  // the GPU (O(V + F), one copy each).
+  // Replaces the drawn mesh: sends positions, normals and indices to the GPU.
+  // Normals are split where two faces bend more than `crease_degrees` apart
+  // (<= 0: kDefaultShadingCreaseDegrees; see split_normals_at_creases: the
+  // mesh's own normals are kept where nothing splits). O(V + F log d), one
+  // copy of each array.
   // `face_kind` (may be null or of the wrong size: then every face shows as
   // untouched) labels each face. Distances are reset to zero. Precondition:
   // indices in range (validate untrusted meshes first).
-  void upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind);
+  void upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
+              float crease_degrees = 0.0f);
 
   // Per-vertex distances for ColorMode::kDistance; ignored unless the size
-  // equals the uploaded vertex count. O(V).
+  // equals the uploaded mesh's vertex count (copies made at creases take
+  // their vertex's distance). O(V).
   void upload_distances(const std::vector<float>& distances);
 
   // Clears the bound framebuffer (colour and depth) to the style's
   // background and draws the mesh into a `width` x `height` viewport.
   void draw(const OrbitCamera& camera, int width, int height, const RenderStyle& style) const;
 
-  uint32_t vertex_count() const { return vertex_count_; }
+  uint32_t vertex_count() const { return vertex_count_; }  // of the uploaded mesh
+  uint32_t drawn_vertex_count() const { return vertex_count_ + uint32_t(copied_from_.size()); }
   uint32_t triangle_count() const { return triangle_count_; }
   bool has_distances() const { return has_distances_; }
 
@@ -78,6 +86,7 @@ class MeshRenderer {
   GLuint position_buffer_ = 0, normal_buffer_ = 0, distance_buffer_ = 0, index_buffer_ = 0;
   GLuint face_kind_buffer_ = 0, face_kind_texture_ = 0;
   uint32_t vertex_count_ = 0, triangle_count_ = 0;
+  std::vector<uint32_t> copied_from_;  // the vertex each crease copy repeats
   bool has_distances_ = false;
   struct Uniforms {
     GLint view = -1, projection = -1, viewport = -1, coloring = -1, wireframe = -1, wire_width = -1,

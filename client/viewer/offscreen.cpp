@@ -65,7 +65,7 @@ Result<RgbaImage> render_offscreen(const Mesh& mesh, const OffscreenRequest& req
     if (!target) return tl::unexpected(target.error());
     auto renderer = MeshRenderer::create(*gl);
     if (!renderer) return tl::unexpected(renderer.error());
-    renderer->upload(mesh, request.face_kind);
+    renderer->upload(mesh, request.face_kind, request.crease_degrees);
     if (request.vertex_distance != nullptr) renderer->upload_distances(*request.vertex_distance);
 
     OrbitCamera camera;

@@ -19,7 +19,10 @@ struct OffscreenRequest {
   RenderStyle style;
   const std::vector<FaceKind>* face_kind = nullptr;     // per face, for kAsaKinds
   const std::vector<float>* vertex_distance = nullptr;  // per vertex, for kDistance
-  int samples = 4;                                      // multisampling
+  // Normals split where faces bend more than this (the user's --crease; 0:
+  // kDefaultShadingCreaseDegrees), see crease_normals.h.
+  float crease_degrees = 0.0f;
+  int samples = 4;     // multisampling
   float fill = 0.85f;  // share of the smaller image side the model spans
   // Viewing direction (radians); the distance and target frame the model.
   float yaw = 0.6f;

@@ -48,6 +48,9 @@ struct SnapshotOptions {
   int height = 768;
   enum class Coloring { kShaded, kAsaKinds } coloring = Coloring::kShaded;
   bool wireframe = false;
+  // Shading keeps edges bending more than this sharp (the user's --crease;
+  // 0: kDefaultShadingCreaseDegrees, 60).
+  float crease_degrees = 0.0f;
 };
 
 // Renders `mesh` off-screen (OSMesa) with the viewer's renderer, framing the

@@ -85,9 +85,12 @@ class GlfwSession {
   Status open(const ViewerOptions& options) {
     glfw_last_error().clear();
     glfwSetErrorCallback(&on_glfw_error);
+    // No "viewer:" prefix in these messages: the client adds it once.
     if (!glfwInit()) {
       return make_error(ErrorCode::kUnsupported,
-                        "viewer: no display to open a window on: " + glfw_last_error());
+                        "no display to open a window on (" + glfw_last_error() +
+                            "); use --snapshot FILE.png to render without one, or run under "
+                            "xvfb-run");
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -98,7 +101,7 @@ class GlfwSession {
                                options.title.c_str(), nullptr, nullptr);
     if (!window_) {
       return make_error(ErrorCode::kUnsupported,
-                        "viewer: cannot create an OpenGL 3.3 core window: " + glfw_last_error());
+                        "cannot create an OpenGL 3.3 core window: " + glfw_last_error());
     }
     glfwMakeContextCurrent(window_);
     glfwSwapInterval(1);
@@ -123,7 +126,7 @@ class ImGuiSession {
     ImGui::StyleColorsDark();
     glfw_ = ImGui_ImplGlfw_InitForOpenGL(window, true);
     opengl_ = glfw_ && ImGui_ImplOpenGL3_Init("#version 330 core");
-    if (!opengl_) return make_error(ErrorCode::kUnsupported, "viewer: Dear ImGui cannot start");
+    if (!opengl_) return make_error(ErrorCode::kUnsupported, "Dear ImGui cannot start");
     return {};
   }
 
@@ -187,7 +190,9 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
       return;
     }
     auto start = Clock::now();
-    renderer->upload(*mesh, frame.face_kind.get());
+    // Shading follows the panel's crease angle (the ASA control), so the
+    // edges ASA keeps sharp are also drawn sharp.
+    renderer->upload(*mesh, frame.face_kind.get(), panel.asa.crease_degrees);
     double ms = ms_since(start);
     panel.upload_ms = ms;
     report.max_upload_ms = std::max(report.max_upload_ms, ms);

@@ -6,7 +6,7 @@
 // averaging when both endpoints are extraordinary). Boundary curve rule: the
 // four-point scheme of Dyn, Levin and Gregory (1987).
 //
-// Deliberate choices (documented in ../shared/ALGORITHMS.md section 2):
+// Deliberate choices (documented in docs/algorithms.md section 2):
 // * Interior edges touching the boundary follow OpenMesh's ModifiedButterFlyT
 //   (OpenMesh 9, Tools/Subdivider/Uniform/ModifiedButterFlyT.hh) exactly, so the
 //   comparison test covers meshes with boundaries: when each endpoint is either
@@ -14,7 +14,7 @@
 //   and a wing vertex across a boundary edge is replaced by its reflection
 //   e + b - o; otherwise only the interior extraordinary endpoint(s) give the
 //   point. A boundary vertex is never an extraordinary centre.
-// * Creases (our extension; ALGORITHMS.md section 5 notes no published rule for
+// * Creases (our extension; docs/algorithms.md section 5 notes no published rule for
 //   Butterfly): a crease edge is a boundary for both of its sides. Crease edges
 //   get the curve four-point rule along the crease; a vertex with a number of
 //   feature edges other than two is a corner and the curve is extended past it

@@ -1,4 +1,4 @@
-// Flatness marking (Cheang 1998, section 3 of ../shared/ALGORITHMS.md) and
+// Flatness marking (Cheang 1998, section 3 of docs/algorithms.md) and
 // crease tagging: which triangles ASA refines and which edges stay sharp.
 #pragma once
 

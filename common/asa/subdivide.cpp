@@ -1,5 +1,5 @@
 // ASA driver: levels of flatness marking, closure and splitting (Cheang 1998,
-// ../shared/ALGORITHMS.md section 3), or uniform modified Butterfly levels.
+// docs/algorithms.md section 3), or uniform modified Butterfly levels.
 #include "common/asa/subdivide.h"
 
 #include <cmath>

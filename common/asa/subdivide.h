@@ -1,6 +1,6 @@
 // ASA: adaptive modified-Butterfly subdivision driven by local flatness
 // (Cheang 1998; stencils of Zorin, Schröder and Sweldens 1996). See
-// ../shared/ALGORITHMS.md sections 2 and 3.
+// docs/algorithms.md sections 2 and 3.
 //
 // The module, one job per file:
 //   butterfly_stencils  every Butterfly rule (regular ten-point with tension,

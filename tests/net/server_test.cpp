@@ -1,7 +1,7 @@
 // Integration tests: the real meshstream-server binary on loopback, real
 // sockets, synthetic .hcs models (valid containers with CRCs; the server
 // only reads the index). Each test says which contract it checks
-// (proto/meshstream.proto, shared/DESIGN.md).
+// (proto/meshstream.proto, docs/design.md).
 #include <gtest/gtest.h>
 
 #include <atomic>

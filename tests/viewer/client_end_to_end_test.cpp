@@ -16,6 +16,7 @@
 #include "common/mesh/export.h"
 #include "common/mesh/procedural.h"
 #include "tests/viewer/child_process.h"
+#include "tests/viewer/cube_edges.h"
 #include "tests/viewer/image_checks.h"
 #include "tests/viewer/xvfb_display.h"
 
@@ -62,7 +63,9 @@ class ClientEndToEnd : public ::testing::Test {
                         ("meshstream_viewer_e2e_" + std::to_string(::getpid())));
     fs::create_directories(*dir_ / "models");
     // A model with detail at several scales, so early records look coarse.
-    if (!write_ply(make_demo_mesh(12000), (*dir_ / "models" / "knot.ply").string())) {
+    // And a cube, whose edges must look sharp.
+    if (!write_ply(make_demo_mesh(12000), (*dir_ / "models" / "knot.ply").string()) ||
+        !write_ply(testing::make_cube(), (*dir_ / "models" / "cube.ply").string())) {
       TearDownTestSuite();  // the tests then skip, saying why
     }
   }
@@ -180,6 +183,57 @@ TEST_F(ClientEndToEnd, WindowFollowsAThrottledStreamUnderXvfb) {
   ScopedEnv on_xvfb("DISPLAY", display);
   int code = run_client({"--view", "--exit-after", "45", "--width", "400", "--height", "300"});
   EXPECT_EQ(code, 0) << client_log();
+}
+
+// Row 17 of issue 21 through the real client: a snapshot of a cube shows
+// its edges as a change of shade (normals split at the default 60
+// degrees), and --crease 180 (nothing is a crease) gives the old blended
+// look. --no-asa: the decoded cube itself, flat sides.
+TEST_F(ClientEndToEnd, SnapshotsOfACubeKeepItsEdgesSharp) {
+  testing::ChildProcess server;
+  address_ = start_server(server, {});
+  ASSERT_FALSE(address_.empty()) << "server did not start";
+  auto snapshot = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args{client_binary(), address_,     "cube",    "--quiet",
+                                  "--no-asa",      "--width",    "320",     "--height",
+                                  "240",           "--snapshot", path(name)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    testing::ChildProcess client;
+    EXPECT_TRUE(client.start(args, path("client.log")));
+    EXPECT_EQ(client.wait(60s).value_or(-1), 0) << client_log();
+    return read_or_fail(path(name));
+  };
+  const Mesh cube = testing::make_cube();
+  RgbaImage sharp = snapshot("cube_sharp.png", {});
+  RgbaImage blended = snapshot("cube_blended.png", {"--crease", "180"});
+  ASSERT_FALSE(sharp.rgba.empty());
+  ASSERT_FALSE(blended.rgba.empty());
+  const auto sharp_edges = testing::shades_beside_visible_edges(cube, sharp);
+  ASSERT_EQ(sharp_edges.size(), 3u);
+  // Measured: 58 grey levels across the sharpest edge, 5 when blended.
+  EXPECT_GE(testing::largest_edge_step(sharp_edges), 25);
+  EXPECT_LE(testing::largest_edge_step(testing::shades_beside_visible_edges(cube, blended)), 10);
+}
+
+// --view where there is no display: exit 1 with one line that says so once
+// ("viewer: no display ...", not "viewer: viewer: ...") and what to do
+// instead.
+TEST_F(ClientEndToEnd, ViewWithoutADisplaySaysWhatToDoInstead) {
+  testing::ChildProcess server;
+  address_ = start_server(server, {});
+  ASSERT_FALSE(address_.empty()) << "server did not start";
+  ScopedEnv no_x("DISPLAY", "");
+  ScopedEnv no_wayland("WAYLAND_DISPLAY", "");
+  ::unsetenv("DISPLAY");  // restored by the ScopedEnvs
+  ::unsetenv("WAYLAND_DISPLAY");
+  EXPECT_EQ(run_client({"--view", "--width", "200", "--height", "150"}), 1) << client_log();
+  const std::string log = client_log();
+  const size_t at = log.find("viewer: no display to open a window on");
+  ASSERT_NE(at, std::string::npos) << log;
+  const std::string line = log.substr(at, log.find('\n', at) - at);
+  EXPECT_EQ(log.find("viewer: viewer:"), std::string::npos) << log;
+  EXPECT_NE(line.find("--snapshot"), std::string::npos) << line;
+  EXPECT_NE(line.find("xvfb-run"), std::string::npos) << line;
 }
 
 // Closing the window while the stream still runs cancels it; the summary
