@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -160,7 +161,11 @@ class StreamingRun {
   // The phases: stream (until the end, an error, the window closing or
   // Ctrl-C), then report. The exit code.
   int run() {
-    InterruptWatch interrupts([this](int) { client_.stop(); });
+    InterruptWatch interrupts([this](int) {
+      interrupted_ = true;
+      client_.stop();
+      mailbox_.close();  // closes the window, if one is open
+    });
     stream();
     interrupted_by_ = interrupts.signal();
     return report();
@@ -257,9 +262,10 @@ class StreamingRun {
     pipeline_.start();
     if (o_.view && hooks_.run_view) {
       viewer_status_ = hooks_.run_view(o_, mailbox_, pipeline_);
-      // The window closed: stop streaming if it still runs.
+      // The window closed: stop streaming if it still runs. After Ctrl-C the
+      // pipeline still shows (and saves) what arrived.
       client_.stop();
-      decoded_.stop();
+      if (!interrupted_) decoded_.stop();
     }
     pipeline_status_ = pipeline_.wait_finished();
     // The last record may be shown before the server's StreamEnd arrives:
@@ -334,6 +340,7 @@ class StreamingRun {
   DisplayPipeline pipeline_;
 
   StreamFacts facts_;
+  std::atomic<bool> interrupted_{false};  // set by the signal watcher
   int interrupted_by_ = 0;
   Status pipeline_status_, viewer_status_;
   std::mutex file_mutex_;

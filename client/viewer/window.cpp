@@ -201,6 +201,8 @@ class ViewerLoop {
     while (!glfwWindowShouldClose(window_)) {
       const auto frame_start = Clock::now();
       glfwPollEvents();
+      // The client closed the mailbox (Ctrl-C): this frame is the last.
+      if (frames_.closed()) glfwSetWindowShouldClose(window_, GLFW_TRUE);
       bool activity = take_stream_state();  // anything that may change the picture
       const FrameGeometry g = read_geometry();
       activity |= steer_camera(g);
