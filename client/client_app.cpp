@@ -7,18 +7,23 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
 #include <thread>
 
 #include "client/decoded_stream.h"
 #include "client/display_pipeline.h"
 #include "client/event_log.h"
+#include "client/interrupt_watch.h"
 #include "client/stream_client.h"
 #include "common/mesh/export.h"
 
 namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -53,158 +58,320 @@ int run_list(const ClientOptions& o) {
 std::string record_file(const std::string& dir, uint32_t record) {
   char name[32];
   std::snprintf(name, sizeof name, "%04u.ply", record);
-  return (std::filesystem::path(dir) / name).string();
+  return (fs::path(dir) / name).string();
 }
+
+// The files --out writes: NNNN.ply (four digits or more), final.ply and
+// final.decoded.ply. --overwrite deletes these and nothing else.
+bool written_by_this_program(const std::string& name) {
+  static const std::regex pattern(R"(\d{4,}\.ply|final\.ply|final\.decoded\.ply)");
+  return std::regex_match(name, pattern);
+}
+
+// --out DIR: created when missing; a folder with anything in it is refused
+// (its old snapshots would sit beside the new ones) unless --overwrite,
+// which first deletes what an earlier run of this program wrote there.
+Status prepare_out_dir(const ClientOptions& o) {
+  const fs::path dir(o.out_dir);
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) {
+    fs::create_directories(dir, ec);
+    if (ec)
+      return make_error(ErrorCode::kIo, "cannot create --out " + o.out_dir + ": " + ec.message());
+    return {};
+  }
+  if (!fs::is_directory(dir, ec)) {
+    return make_error(ErrorCode::kIo, "--out " + o.out_dir + " exists and is not a folder");
+  }
+  std::vector<std::string> entries;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    entries.push_back(entry.path().filename().string());
+  }
+  if (ec) return make_error(ErrorCode::kIo, "cannot list --out " + o.out_dir + ": " + ec.message());
+  if (entries.empty()) return {};
+  if (!o.overwrite) {
+    return make_error(ErrorCode::kIo,
+                      "--out " + o.out_dir + " is not empty (" + std::to_string(entries.size()) +
+                          " entries, e.g. " + entries.front() +
+                          "): use a new folder, or --overwrite to replace an earlier run's files");
+  }
+  for (const std::string& name : entries) {
+    const fs::path path = dir / name;
+    if (!written_by_this_program(name) || !fs::is_regular_file(path, ec)) continue;
+    if (!fs::remove(path, ec) && ec) {
+      return make_error(ErrorCode::kIo, "cannot delete " + path.string() + ": " + ec.message());
+    }
+  }
+  return {};
+}
+
+// --snapshot FILE.png: its folder must exist and be writable, known before
+// a single byte is streamed.
+Status check_snapshot_folder(const ClientOptions& o) {
+  fs::path folder = fs::path(o.snapshot_png).parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) {
+    return make_error(ErrorCode::kIo, "--snapshot " + o.snapshot_png + ": the folder " +
+                                          folder.string() + " does not exist");
+  }
+  if (::access(folder.c_str(), W_OK) != 0) {
+    return make_error(ErrorCode::kIo, "--snapshot " + o.snapshot_png + ": the folder " +
+                                          folder.string() + " is not writable");
+  }
+  return {};
+}
+
+// "--snapshot-at 5000": a record the stream (within the budget) does not have.
+Status check_record_exists(const std::string& flag, uint32_t record, const StreamFacts& f) {
+  if (record < f.end_record) return {};
+  const std::string range = f.end_record == 0
+                                ? "no records"
+                                : "records 0 to " + std::to_string(f.end_record - 1) +
+                                      (f.end_record < f.records_total ? " within the budget" : "");
+  return make_error(ErrorCode::kInvalidArgument,
+                    flag + " " + std::to_string(record) + ": model '" + f.model + "' has " + range);
+}
+
+// The viewer's error, with one "viewer:" prefix, and where to turn when
+// there is no display to open a window on.
+std::string viewer_failure(const Error& e) {
+  std::string message = e.message.rfind("viewer: ", 0) == 0 ? e.message : "viewer: " + e.message;
+  if (e.code == ErrorCode::kUnsupported && message.find("xvfb-run") == std::string::npos) {
+    message +=
+        "; without a display, render with --snapshot FILE.png, or run the window under xvfb-run";
+  }
+  return message;
+}
+
+// One streaming run: the network thread (StreamClient into DecodedStream),
+// the display pipeline thread (ASA, events, files), the viewer or nothing
+// on this thread; then the report.
+class StreamingRun {
+ public:
+  StreamingRun(const ClientOptions& o, const ViewerHooks& hooks)
+      : o_(o),
+        hooks_(hooks),
+        log_(o.json, !o.json && !o.quiet && ::isatty(2)),
+        client_(target_of(o)),
+        pipeline_(
+            decoded_, &client_, mailbox_, settings_of(o),
+            [this](const DisplayFrame& frame, const FrameInfo& info) { on_frame(frame, info); }) {}
+
+  // The phases: stream (until the end, an error, the window closing or
+  // Ctrl-C), then report. The exit code.
+  int run() {
+    InterruptWatch interrupts([this](int) {
+      interrupted_ = true;
+      client_.stop();
+      mailbox_.close();  // closes the window, if one is open
+    });
+    stream();
+    interrupted_by_ = interrupts.signal();
+    return report();
+  }
+
+ private:
+  static StreamTarget target_of(const ClientOptions& o) {
+    StreamTarget target;
+    target.host = o.host;
+    target.port = o.port;
+    target.model = o.model;
+    target.budget = o.budget;
+    target.max_chunk_bytes = o.max_chunk_bytes;
+    target.reconnect = o.reconnect;
+    return target;
+  }
+  static PipelineSettings settings_of(const ClientOptions& o) {
+    PipelineSettings settings;
+    settings.asa_enabled = o.asa_enabled;
+    settings.asa = o.asa;
+    settings.path = o.asa_path;
+    return settings;
+  }
+
+  double elapsed() const {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0_).count();
+  }
+
+  // Network thread, first header, before any record: refuse records the
+  // stream does not have, and set the records to be shown exactly.
+  Status check_header(const StreamFacts& f) {
+    if (o_.snapshot_at) {
+      if (Status s = check_record_exists("--snapshot-at", *o_.snapshot_at, f); !s) return s;
+    }
+    for (uint32_t r : o_.out_at) {
+      if (Status s = check_record_exists("--out-at", r, f); !s) return s;
+    }
+    std::vector<uint32_t> barriers = o_.out_at;
+    if (o_.snapshot_at) barriers.push_back(*o_.snapshot_at);
+    for (uint64_t r = 0; o_.out_every > 0 && r < f.end_record; r += o_.out_every) {
+      barriers.push_back(static_cast<uint32_t>(r));
+    }
+    decoded_.set_barriers(std::move(barriers));
+    return {};
+  }
+
+  void on_header(const StreamFacts& f) {
+    facts_ = f;
+    pipeline_.set_totals(f.total_bytes, f.records_total, f.end_record);
+    log_.header(f, elapsed());
+  }
+
+  void keep_error(const Status& s) {
+    if (s) return;
+    std::lock_guard lock(file_mutex_);
+    if (!file_error_) file_error_ = s.error();
+  }
+
+  // Pipeline thread, after each published frame: events and files.
+  void on_frame(const DisplayFrame& frame, const FrameInfo& info) {
+    if (info.new_records) {
+      last_frame_ = frame;
+      ++display_updates_;
+      coalesced_ += frame.coalesced_updates;
+      log_.refinement(frame, info, elapsed(), client_.rate_bytes_per_s());
+      const uint32_t record = frame.records_decoded - 1;
+      if (!o_.out_dir.empty() && o_.saves_record(record))
+        keep_error(write_mesh(*frame.display, record_file(o_.out_dir, record)));
+      if (o_.snapshot_at && !snapshot_done_ && record == *o_.snapshot_at && hooks_.snapshot) {
+        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(), o_, o_.snapshot_png));
+        snapshot_done_ = true;
+      }
+    }
+    if (frame.final && !final_frame_) {
+      final_frame_ = frame;
+      if (!o_.out_dir.empty()) {
+        keep_error(write_mesh(*frame.display, (fs::path(o_.out_dir) / "final.ply").string()));
+        keep_error(
+            write_mesh(*frame.decoded, (fs::path(o_.out_dir) / "final.decoded.ply").string()));
+      }
+      if (!o_.snapshot_png.empty() && !o_.snapshot_at && hooks_.snapshot) {
+        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(), o_, o_.snapshot_png));
+        snapshot_done_ = true;
+      }
+    }
+  }
+
+  void stream() {
+    decoded_.on_record([this](const AppliedRecord& r) { log_.record(r, elapsed()); });
+    client_.on_retry([this](const Error& e, int attempt) { log_.reconnecting(e, attempt); });
+    client_.check_header([this](const StreamFacts& f) { return check_header(f); });
+    std::thread network(
+        [this] { client_.run(decoded_, [this](const StreamFacts& f) { on_header(f); }); });
+    pipeline_.start();
+    if (o_.view && hooks_.run_view) {
+      viewer_status_ = hooks_.run_view(o_, mailbox_, pipeline_);
+      // The window closed: stop streaming if it still runs. After Ctrl-C the
+      // pipeline still shows (and saves) what arrived.
+      client_.stop();
+      if (!interrupted_) decoded_.stop();
+    }
+    pipeline_status_ = pipeline_.wait_finished();
+    // The last record may be shown before the server's StreamEnd arrives:
+    // let the network thread finish the conversation (it stops by itself).
+    if (!pipeline_status_) client_.stop();
+    network.join();
+    pipeline_.stop();
+    mailbox_.close();
+  }
+
+  DoneSummary summary() const {
+    const std::optional<StreamOutcome> outcome = decoded_.outcome();
+    DoneSummary s;
+    s.model = o_.model;
+    s.reason = outcome ? outcome->reason : "cancelled";
+    s.records_total = facts_.records_total;
+    s.bytes_total = facts_.total_bytes;
+    s.elapsed_ms = elapsed();
+    s.reconnects = client_.reconnects();
+    s.display_updates = display_updates_;
+    s.coalesced = coalesced_;
+    if (const auto& shown = final_frame_ ? final_frame_ : last_frame_) {
+      s.records = shown->records_decoded;
+      s.bytes = shown->bytes_received;
+      s.vertices = shown->decoded->vertex_count();
+      s.faces = shown->decoded->face_count();
+      s.display_vertices = shown->display->vertex_count();
+      s.display_faces = shown->display->face_count();
+    }
+    return s;
+  }
+
+  // The first failure wins; a run ended by a signal exits 128 + signal.
+  int report() {
+    const std::optional<StreamOutcome> outcome = decoded_.outcome();
+    if (outcome && !outcome->ok) {
+      log_.error(outcome->error.message);
+      return 1;
+    }
+    if (!pipeline_status_) {
+      log_.error("post-processing failed: " + pipeline_status_.error().message);
+      return 1;
+    }
+    if (!viewer_status_) {
+      log_.error(viewer_failure(viewer_status_.error()));
+      return 1;
+    }
+    if (file_error_) {
+      log_.error(file_error_->message);
+      return 1;
+    }
+    if (o_.snapshot_at && !snapshot_done_) {
+      const std::string why = interrupted_by_ ? ": cancelled before that record"
+                                              : ": the stream ended before that record";
+      if (!interrupted_by_) {
+        log_.error("--snapshot-at " + std::to_string(*o_.snapshot_at) + why);
+        return 1;
+      }
+      log_.note("--snapshot-at " + std::to_string(*o_.snapshot_at) + why);
+    }
+    log_.done(summary());
+    return interrupted_by_ ? 128 + interrupted_by_ : 0;
+  }
+
+  const ClientOptions& o_;
+  const ViewerHooks& hooks_;
+  const Clock::time_point t0_ = Clock::now();
+  EventLog log_;
+  DecodedStream decoded_;
+  StreamClient client_;
+  LatestFrameMailbox mailbox_;
+  DisplayPipeline pipeline_;
+
+  StreamFacts facts_;
+  std::atomic<bool> interrupted_{false};  // set by the signal watcher
+  int interrupted_by_ = 0;
+  Status pipeline_status_, viewer_status_;
+  std::mutex file_mutex_;
+  std::optional<Error> file_error_;  // first failure writing a file
+  // Pipeline thread only (read after it stopped):
+  uint32_t display_updates_ = 0, coalesced_ = 0;
+  bool snapshot_done_ = false;
+  std::optional<DisplayFrame> final_frame_;
+  // The newest frame shown: what the summary reports when the stream is
+  // cancelled (window closed, Ctrl-C) before a final frame.
+  std::optional<DisplayFrame> last_frame_;
+};
 
 }  // namespace
 
 int run_client(const ClientOptions& o, const ViewerHooks& hooks) {
   if (o.list) return run_list(o);
-
+  // What can be checked before connecting is checked before connecting.
   if (!o.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.out_dir, ec);
-    if (ec) {
-      std::cerr << "meshstream-client: cannot create " << o.out_dir << ": " << ec.message() << "\n";
+    if (Status s = prepare_out_dir(o); !s) {
+      EventLog(o.json, false).error(s.error().message);
       return 1;
     }
   }
-  const bool progress = !o.json && !o.quiet && ::isatty(2);
-  EventLog log(o.json, progress);
-
-  StreamTarget target;
-  target.host = o.host;
-  target.port = o.port;
-  target.model = o.model;
-  target.budget = o.budget;
-  target.max_chunk_bytes = o.max_chunk_bytes;
-  target.reconnect = o.reconnect;
-
-  DecodedStream decoded;
-  decoded.set_barrier(o.snapshot_at);
-  StreamClient client(target);
-  client.on_retry([&](const Error& e, int attempt) { log.reconnecting(e, attempt); });
-  LatestFrameMailbox mailbox;
-
-  const auto t0 = Clock::now();
-  auto elapsed = [&] {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  };
-  std::mutex file_mutex;
-  std::optional<Error> file_error;  // first failure writing a file
-  auto keep_error = [&](const Status& s) {
-    if (s) return;
-    std::lock_guard lock(file_mutex);
-    if (!file_error) file_error = s.error();
-  };
-  uint32_t display_updates = 0, coalesced = 0;
-  bool snapshot_done = false;
-  std::optional<DisplayFrame> final_frame;
-  // The newest frame shown: what the summary reports when the stream is
-  // cancelled (window closed) before a final frame.
-  std::optional<DisplayFrame> last_frame;
-
-  PipelineSettings settings;
-  settings.asa_enabled = o.asa_enabled;
-  settings.asa = o.asa;
-  settings.path = o.asa_path;
-  // Runs on the pipeline thread after each published frame.
-  auto observer = [&](const DisplayFrame& frame, const FrameInfo& info) {
-    if (info.new_records) {
-      last_frame = frame;
-      ++display_updates;
-      coalesced += frame.coalesced_updates;
-      log.refinement(frame, info, elapsed(), client.rate_bytes_per_s());
-      if (!o.out_dir.empty())
-        keep_error(write_mesh(*frame.display, record_file(o.out_dir, frame.records_decoded - 1)));
-      if (o.snapshot_at && !snapshot_done && frame.records_decoded == *o.snapshot_at + 1 &&
-          hooks.snapshot) {
-        keep_error(hooks.snapshot(*frame.display, frame.face_kind.get(), o, o.snapshot_png));
-        snapshot_done = true;
-      }
+  if (!o.snapshot_png.empty()) {
+    if (Status s = check_snapshot_folder(o); !s) {
+      EventLog(o.json, false).error(s.error().message);
+      return 1;
     }
-    if (frame.final && !final_frame) {
-      final_frame = frame;
-      if (!o.out_dir.empty()) {
-        keep_error(
-            write_mesh(*frame.display, (std::filesystem::path(o.out_dir) / "final.ply").string()));
-        keep_error(write_mesh(*frame.decoded,
-                              (std::filesystem::path(o.out_dir) / "final.decoded.ply").string()));
-      }
-      if (!o.snapshot_png.empty() && !o.snapshot_at && hooks.snapshot) {
-        keep_error(hooks.snapshot(*frame.display, frame.face_kind.get(), o, o.snapshot_png));
-        snapshot_done = true;
-      }
-    }
-  };
-  DisplayPipeline pipeline(decoded, &client, mailbox, settings, observer);
-
-  StreamFacts facts;
-  std::thread network([&] {
-    client.run(decoded, [&](const StreamFacts& f) {
-      facts = f;
-      pipeline.set_totals(f.total_bytes, f.records_total, f.end_record);
-      log.header(f, elapsed());
-    });
-  });
-  pipeline.start();
-
-  Status viewer_status;
-  if (o.view && hooks.run_view) {
-    viewer_status = hooks.run_view(o, mailbox, pipeline);
-    // The window closed: stop streaming if it still runs.
-    client.stop();
-    decoded.stop();
   }
-  Status pipeline_status = pipeline.wait_finished();
-  // The last record may be shown before the server's StreamEnd arrives:
-  // let the network thread finish the conversation (it stops by itself).
-  if (!pipeline_status) client.stop();
-  network.join();
-  pipeline.stop();
-  mailbox.close();
-
-  const std::optional<StreamOutcome> outcome = decoded.outcome();
-  if (outcome && !outcome->ok) {
-    log.error(outcome->error.message);
-    return 1;
-  }
-  if (!pipeline_status) {
-    log.error("post-processing failed: " + pipeline_status.error().message);
-    return 1;
-  }
-  if (!viewer_status) {
-    log.error("viewer: " + viewer_status.error().message);
-    return 1;
-  }
-  if (file_error) {
-    log.error(file_error->message);
-    return 1;
-  }
-  if (o.snapshot_at && !snapshot_done) {
-    log.error("--snapshot-at " + std::to_string(*o.snapshot_at) +
-              ": the stream ended before that record");
-    return 1;
-  }
-  DoneSummary s;
-  s.model = o.model;
-  s.reason = outcome ? outcome->reason : "cancelled";
-  s.records_total = facts.records_total;
-  s.bytes_total = facts.total_bytes;
-  s.elapsed_ms = elapsed();
-  s.reconnects = client.reconnects();
-  s.display_updates = display_updates;
-  s.coalesced = coalesced;
-  if (const auto& shown = final_frame ? final_frame : last_frame) {
-    s.records = shown->records_decoded;
-    s.bytes = shown->bytes_received;
-    s.vertices = shown->decoded->vertex_count();
-    s.faces = shown->decoded->face_count();
-    s.display_vertices = shown->display->vertex_count();
-    s.display_faces = shown->display->face_count();
-  }
-  log.done(s);
-  return 0;
+  return StreamingRun(o, hooks).run();
 }
 
 }  // namespace meshstream::client

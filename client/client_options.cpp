@@ -1,9 +1,29 @@
 #include "client/client_options.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <iostream>
 
 namespace meshstream::client {
+
+bool ClientOptions::saves_record(uint32_t index) const {
+  if (out_every > 0 && index % out_every == 0) return true;
+  return std::find(out_at.begin(), out_at.end(), index) != out_at.end();
+}
+
+namespace {
+
+// Lower-case extension with its dot ("" when there is none).
+std::string extension_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+}  // namespace
 
 ParsedClientOptions parse_client_options(int argc, char** argv) {
   ClientOptions o;
@@ -19,7 +39,18 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("model", o.model, "model name to stream (see --list)");
   app.add_flag("--list", o.list, "list the server's models and exit");
   app.add_option("--out", o.out_dir,
-                 "write NNNN.ply per display update (NNNN = record index) and final.ply");
+                 "write final.ply (the last display mesh) and final.decoded.ply into DIR, a new "
+                 "or empty folder (see --overwrite)");
+  app.add_option("--out-every", o.out_every,
+                 "with --out: also write NNNN.ply, the display mesh after record NNNN, for every "
+                 "N-th record (0, N, 2N, ...), whatever the timing")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--out-at", o.out_at,
+                 "with --out: also write NNNN.ply after each of these records (e.g. 0,10,50)")
+      ->delimiter(',');
+  app.add_flag("--overwrite", o.overwrite,
+               "let --out use a folder that is not empty: first delete the files this program "
+               "writes there (NNNN.ply, final.ply, final.decoded.ply), nothing else");
   app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
@@ -58,7 +89,7 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_flag("--json", o.json, "print one JSON event per line on stdout");
   app.add_flag("--view", o.view, "open a window that shows the model as it refines");
   app.add_option("--snapshot", o.snapshot_png,
-                 "render the final (or --snapshot-at) display mesh to a PNG");
+                 "render the final (or --snapshot-at) display mesh to FILE.png (PNG only)");
   app.add_option("--width", o.width, "snapshot/window width")
       ->check(CLI::Range(16, 16384))
       ->capture_default_str();
@@ -66,7 +97,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->check(CLI::Range(16, 16384))
       ->capture_default_str();
   app.add_option("--snapshot-at", o.snapshot_at,
-                 "snapshot the display mesh after record N (0 = base mesh)");
+                 "snapshot the display mesh after record N (0 = base mesh; checked against the "
+                 "stream's records when its header arrives)");
   app.add_option("--exit-after", o.exit_after_frames,
                  "close the window after N frames (0 = when the user closes it)")
       ->capture_default_str();
@@ -106,6 +138,14 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   if (percent_bytes && !(*percent_bytes > 0)) return usage("--percent-bytes must be in (0, 100]");
   if (o.snapshot_at && o.snapshot_png.empty())
     return usage("--snapshot-at needs --snapshot FILE.png");
+  if (!o.snapshot_png.empty() && extension_of(o.snapshot_png) != ".png") {
+    const std::string ext = extension_of(o.snapshot_png);
+    return usage("--snapshot " + o.snapshot_png +
+                 ": only PNG is written, so the name must end in " +
+                 (ext.empty() ? std::string(".png") : ".png, not " + ext));
+  }
+  if (o.out_dir.empty() && (o.out_every || !o.out_at.empty() || o.overwrite))
+    return usage("--out-every, --out-at and --overwrite need --out DIR");
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
   o.asa_enabled = !no_asa;
   o.asa_path = path == "full"          ? AsaPath::kFull

@@ -1,5 +1,7 @@
-// The `meshstream-client` command line (contract in docs/design.md):
-//   meshstream-client HOST:PORT [MODEL] [--list] [--out DIR] [--asa-levels L]
+// The `meshstream-client` command line (contract in docs/design.md;
+// every flag in docs/usage.md):
+//   meshstream-client HOST:PORT [MODEL] [--list] [--out DIR [--out-every N]
+//     [--out-at LIST] [--overwrite]] [--asa-levels L]
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
 //     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
@@ -10,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "client/display_builder.h"
 #include "client/stream_client.h"
@@ -22,7 +25,10 @@ struct ClientOptions {
   uint16_t port = 0;
   std::string model;  // empty with --list
   bool list = false;
-  std::string out_dir;                // --out: NNNN.ply per display update, final.ply
+  std::string out_dir;                // --out: final.ply, final.decoded.ply (+ NNNN.ply)
+  uint32_t out_every = 0;             // --out-every: NNNN.ply at every N-th record (0 = none)
+  std::vector<uint32_t> out_at;       // --out-at: NNNN.ply at these records
+  bool overwrite = false;             // --overwrite: reuse a folder of an earlier run
   bool asa_enabled = true;            // --no-asa turns it off
   AsaOptions asa;                     // levels, flatness, rule, crease
   AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)
@@ -33,6 +39,8 @@ struct ClientOptions {
   int width = 1024;
   int height = 768;
   std::optional<uint32_t> snapshot_at;  // record index (0 = base mesh)
+  // True when record `index` is saved as NNNN.ply (--out-every, --out-at).
+  bool saves_record(uint32_t index) const;
   uint64_t exit_after_frames = 0;
   uint32_t exit_after_records = 0;
   uint32_t max_chunk_bytes = 0;

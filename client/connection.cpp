@@ -33,7 +33,8 @@ bool Connection::run_until(const bool& done, Clock::time_point deadline,
 }
 
 Result<std::unique_ptr<Connection>> Connection::open(const std::string& host, uint16_t port,
-                                                     Millis timeout) {
+                                                     Millis timeout,
+                                                     const std::atomic<bool>* cancel) {
   std::unique_ptr<Connection> c(new Connection());
   const std::string where = host + ":" + std::to_string(port);
   c->peer_ = where;
@@ -48,7 +49,9 @@ Result<std::unique_ptr<Connection>> Connection::open(const std::string& host, ui
                         result = e;
                         done = true;
                       });
-  if (!c->run_until(done, Clock::now() + timeout, nullptr)) result = asio::error::timed_out;
+  if (!c->run_until(done, Clock::now() + timeout, cancel)) {
+    result = cancel && cancel->load() ? asio::error::operation_aborted : asio::error::timed_out;
+  }
   if (result)
     return make_error(ErrorCode::kIo, "cannot connect to " + where + ": " + result.message());
   c->socket_.set_option(tcp::no_delay(true), ec);
@@ -98,29 +101,40 @@ Result<v1::ServerMessage> Connection::receive(Millis timeout, const std::atomic<
       const std::string why = result == asio::error::eof ? "closed the connection"
                               : result == asio::error::timed_out
                                   ? "sent nothing for " + std::to_string(timeout.count()) + " ms"
-                                  : "connection failed: " + result.message();
+                                  : "broke the connection: " + result.message();
       return make_error(ErrorCode::kIo, "server " + peer_ + " " + why);
     }
   }
 }
 
 Result<HostPort> parse_host_port(const std::string& text) {
-  auto bad = [&](const std::string& why) {
+  auto malformed = [&](const std::string& why) {
     return make_error(ErrorCode::kInvalidArgument, "'" + text + "' is not HOST:PORT (" + why + ")");
   };
   const size_t colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
-    return bad("missing host or port");
+  if (colon == std::string::npos) return malformed("no ':' before a port");
+  if (colon == 0) return malformed("no host before the ':'");
+  if (colon + 1 == text.size()) return malformed("no port after the ':'");
   HostPort hp;
   hp.host = text.substr(0, colon);
   if (hp.host.size() >= 2 && hp.host.front() == '[' && hp.host.back() == ']') {
     hp.host = hp.host.substr(1, hp.host.size() - 2);
   }
   const std::string port = text.substr(colon + 1);
-  unsigned value = 0;
+  const bool negative = port.size() > 1 && port[0] == '-' &&
+                        port.find_first_not_of("0123456789", 1) == std::string::npos;
+  if (negative) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "port " + port + " in '" + text + "' is out of range: a port is 1 to 65535");
+  }
+  unsigned long long value = 0;
   auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
-  if (ec != std::errc() || end != port.data() + port.size() || value == 0 || value > 65535) {
-    return bad("port must be 1..65535");
+  if (end != port.data() + port.size() || ec == std::errc::invalid_argument) {
+    return malformed("the port '" + port + "' is not a number");
+  }
+  if (ec == std::errc::result_out_of_range || value == 0 || value > 65535) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "port " + port + " in '" + text + "' is out of range: a port is 1 to 65535");
   }
   hp.port = static_cast<uint16_t>(value);
   return hp;

@@ -23,9 +23,10 @@ using Millis = std::chrono::milliseconds;
 class Connection {
  public:
   // Resolves `host` and connects to `port`; kIo with the address and the
-  // reason when it cannot within `timeout`.
+  // reason when it cannot within `timeout` (or `cancel` became true).
   static Result<std::unique_ptr<Connection>> open(const std::string& host, uint16_t port,
-                                                  Millis timeout);
+                                                  Millis timeout,
+                                                  const std::atomic<bool>* cancel = nullptr);
 
   ~Connection();
   Connection(const Connection&) = delete;

@@ -11,10 +11,12 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
   // Decoding runs under the lock: the pipeline only holds it to copy the
   // (small) changes, never while running ASA.
   const auto start = Clock::now();
+  const uint32_t before = decoder_.records_decoded();
   auto applied = decoder_.feed(bytes);
   const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   if (!applied) return applied;
   if (*applied == 0) return applied;
+  if (record_observer_) report_records(before, *applied, ms);
   for (const RecordDelta& d : decoder_.last_deltas()) {
     // A plane record's delta sets full_rebuild for consumers that predate
     // moved_vertices; with no vertex added and no face touched it is a
@@ -42,14 +44,42 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
   pending_decode_ms_ += ms;
   lock.unlock();
   changed_.notify_all();
-  if (barrier_) {
+  // A barrier among the records just applied: wait until the pipeline took
+  // this state (it holds that record, and no later one).
+  const uint32_t after = before + *applied;
+  const auto barrier = std::lower_bound(barriers_.begin(), barriers_.end(), before);
+  if (barrier != barriers_.end() && *barrier < after) {
     lock.lock();
-    const uint32_t target = *barrier_ + 1;
-    if (decoder_.records_decoded() >= target && taken_records_ < target) {
-      changed_.wait(lock, [&] { return stopped_ || taken_records_ >= target; });
-    }
+    changed_.wait(lock, [&] { return stopped_ || taken_records_ >= after; });
   }
   return applied;
+}
+
+void DecodedStream::report_records(uint32_t before, uint32_t applied, double ms) {
+  const StreamIndex* index = decoder_.index();
+  for (uint32_t i = before; i < before + applied; ++i) {
+    AppliedRecord r;
+    r.index = i;
+    r.decode_ms = ms / applied;
+    if (index && i < index->records.size()) {
+      const RecordEntry& e = index->records[i];
+      r.end_offset = e.offset + e.size;
+      r.bytes = i == 0 ? r.end_offset : e.size;
+      r.vertices = e.vertices;
+      r.faces = e.faces;
+    }
+    if (i + 1 == before + applied) {  // the newest: the mesh itself
+      r.end_offset = decoder_.resume_offset();
+      r.vertices = decoder_.mesh().vertex_count();
+      r.faces = decoder_.mesh().face_count();
+    }
+    record_observer_(r);
+  }
+}
+
+void DecodedStream::on_record(RecordObserver observer) {
+  std::lock_guard lock(mutex_);
+  record_observer_ = std::move(observer);
 }
 
 Status DecodedStream::resume_at(uint64_t offset) {
@@ -98,9 +128,15 @@ void DecodedStream::finish(StreamOutcome outcome) {
   changed_.notify_all();
 }
 
-void DecodedStream::set_barrier(std::optional<uint32_t> record) {
+void DecodedStream::set_barriers(std::vector<uint32_t> records) {
+  std::sort(records.begin(), records.end());
+  records.erase(std::unique(records.begin(), records.end()), records.end());
   std::lock_guard lock(mutex_);
-  barrier_ = record;
+  barriers_ = std::move(records);
+}
+
+void DecodedStream::set_barrier(std::optional<uint32_t> record) {
+  set_barriers(record ? std::vector<uint32_t>{*record} : std::vector<uint32_t>{});
 }
 
 bool DecodedStream::wait(uint64_t seen_pokes, bool outcome_seen,

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -55,13 +56,33 @@ struct TakenUpdate {
   bool ended = false;           // no further records will come
 };
 
+// One record the decoder applied, as the stream's own index describes it
+// (the decoder checked the record against it): for `record` events.
+struct AppliedRecord {
+  uint32_t index = 0;
+  uint64_t end_offset = 0;  // stream bytes up to the end of this record
+  uint64_t bytes = 0;       // since the previous record's end (record 0: the
+                            // container prefix and the base mesh)
+  uint32_t vertices = 0;    // decoded mesh after this record (cumulative)
+  uint32_t faces = 0;
+  double decode_ms = 0;  // decoder time (shared evenly by the records of one feed)
+};
+using RecordObserver = std::function<void(const AppliedRecord&)>;
+
 class DecodedStream {
  public:
   // ---- network side (one thread)
-  // Feeds bytes at stream offset `offset` (must continue the stream);
-  // applies completed records and records their changes. Never waits for
-  // the pipeline, except at the barrier record (see set_barrier).
+  // Feeds the next bytes of the stream (they must continue where the last
+  // feed, or resume_at, left off); applies completed records and records
+  // their changes. Never waits for the pipeline, except at a barrier record
+  // (see set_barriers).
   Result<uint32_t> feed(std::span<const uint8_t> bytes);
+  // Called by feed for every record it applies, in order, on the network
+  // thread, before the pipeline can take that record (so a consumer sees a
+  // record reported before any display update that shows it). Runs under
+  // this object's lock: keep it short, and do not call back into it. Set
+  // before streaming.
+  void on_record(RecordObserver observer);
   // Prepares for bytes starting at `offset` after a reconnect (a record
   // boundary the decoder reached, or 0).
   Status resume_at(uint64_t offset);
@@ -76,10 +97,12 @@ class DecodedStream {
   uint64_t bytes_received() const;
   void set_bytes_received(uint64_t offset);
   void finish(StreamOutcome outcome);
-  // The network thread stops after applying record `record` until the
-  // pipeline has taken it, so that exact state gets displayed (for
-  // --snapshot-at). Call before streaming.
-  void set_barrier(std::optional<uint32_t> record);
+  // The network thread stops after applying any of `records` until the
+  // pipeline has taken that state, so that exact record gets displayed (for
+  // --snapshot-at, --out-every and --out-at: which records are shown then
+  // does not depend on timing). Call before streaming.
+  void set_barriers(std::vector<uint32_t> records);
+  void set_barrier(std::optional<uint32_t> record);  // one record, or none
 
   // ---- pipeline side (one thread)
   // Blocks until there is something to take, the stream ended, a poke() or
@@ -99,6 +122,10 @@ class DecodedStream {
   bool stopped() const;
 
  private:
+  // Calls record_observer_ for the `applied` records after the first
+  // `before` (mutex_ held).
+  void report_records(uint32_t before, uint32_t applied, double ms);
+
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   IncrementalDecoder decoder_;
@@ -107,7 +134,8 @@ class DecodedStream {
   double pending_decode_ms_ = 0;
   uint32_t taken_records_ = 0;
   uint64_t bytes_received_ = 0;
-  std::optional<uint32_t> barrier_;
+  std::vector<uint32_t> barriers_;  // sorted, unique
+  RecordObserver record_observer_;
   std::optional<StreamOutcome> outcome_;
   uint64_t pokes_ = 0;
   bool stopped_ = false;

@@ -10,18 +10,18 @@ namespace {
 
 double round3(double x) { return std::round(x * 1000.0) / 1000.0; }
 
+}  // namespace
+
 std::string human_bytes(double b) {
   char buf[32];
   if (b >= 1e6)
     std::snprintf(buf, sizeof buf, "%.2f MB", b / 1e6);
   else if (b >= 1e3)
-    std::snprintf(buf, sizeof buf, "%.1f KB", b / 1e3);
+    std::snprintf(buf, sizeof buf, "%.1f kB", b / 1e3);
   else
     std::snprintf(buf, sizeof buf, "%.0f B", b);
   return buf;
 }
-
-}  // namespace
 
 void EventLog::line(const std::string& text) {
   std::fwrite(text.data(), 1, text.size(), stdout);
@@ -51,6 +51,20 @@ void EventLog::header(const StreamFacts& f, double elapsed_ms) {
                    {"start_offset", f.start_offset},
                    {"end_offset", f.end_offset},
                    {"end_record", f.end_record},
+                   {"elapsed_ms", round3(elapsed_ms)}};
+  line(j.dump());
+}
+
+void EventLog::record(const AppliedRecord& r, double elapsed_ms) {
+  std::lock_guard lock(mutex_);
+  if (!json_) return;
+  nlohmann::json j{{"event", "record"},
+                   {"index", r.index},
+                   {"bytes", r.end_offset},
+                   {"record_bytes", r.bytes},
+                   {"vertices", r.vertices},
+                   {"faces", r.faces},
+                   {"decode_ms", round3(r.decode_ms)},
                    {"elapsed_ms", round3(elapsed_ms)}};
   line(j.dump());
 }

@@ -1,6 +1,7 @@
 // What the client tells its user while streaming: JSON event lines on stdout
-// (--json; contract in docs/design.md: header, refinement per display
-// update, done or error), or a progress line on a terminal. Thread-safe:
+// (--json; contract in docs/design.md: header, a record event per
+// decoded record, refinement per display update, done or error; the fields
+// in docs/usage.md), or a progress line on a terminal. Thread-safe:
 // the header comes from the network thread, refinements from the pipeline.
 #pragma once
 
@@ -27,6 +28,10 @@ struct DoneSummary {
   uint32_t coalesced = 0;  // decoder updates merged into later frames, in total
 };
 
+// "950 B", "12.3 kB", "1.25 MB": SI units (1 kB = 1000 bytes), the one
+// spelling the client's progress line, summary and viewer panel use.
+std::string human_bytes(double bytes);
+
 class EventLog {
  public:
   // json: event lines on stdout; progress: a progress line on stderr
@@ -34,6 +39,7 @@ class EventLog {
   EventLog(bool json, bool progress) : json_(json), progress_(progress) {}
 
   void header(const StreamFacts& facts, double elapsed_ms);
+  void record(const AppliedRecord& record, double elapsed_ms);
   void refinement(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms, double rate);
   void reconnecting(const Error& error, int attempt);
   void done(const DoneSummary& summary);

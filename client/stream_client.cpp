@@ -7,29 +7,40 @@ namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
 
-void RateMeter::add(uint64_t bytes) {
+void RateMeter::add(uint64_t bytes, Clock::time_point now) {
   std::lock_guard lock(mutex_);
-  const auto now = Clock::now();
+  if (!first_) {
+    first_ = now;
+    return;
+  }
   samples_.emplace_back(now, bytes);
-  while (!samples_.empty() && now - samples_.front().first > std::chrono::seconds(1))
-    samples_.pop_front();
+  while (!samples_.empty() && now - samples_.front().first > window_) samples_.pop_front();
 }
 
-double RateMeter::bytes_per_s() const {
+double RateMeter::bytes_per_s(Clock::time_point now) const {
   std::lock_guard lock(mutex_);
-  if (samples_.empty()) return 0;
-  const auto now = Clock::now();
+  if (!first_ || now <= *first_) return 0;
+  const Clock::time_point from = std::max(*first_, now - window_);
   uint64_t sum = 0;
   for (const auto& [t, b] : samples_) {
-    if (now - t <= std::chrono::seconds(1)) sum += b;
+    if (t > from && t <= now) sum += b;
   }
-  return static_cast<double>(sum);  // bytes within the last second
+  const double seconds = std::chrono::duration<double>(now - from).count();
+  return seconds > 0 ? static_cast<double>(sum) / seconds : 0;
 }
 
 namespace {
 
-std::string server_error_text(const v1::Error& e) {
-  return "server error " + v1::Error_Code_Name(e.code()) + ": " + e.message();
+// The server's own message first (it names the model, the value, a
+// suggestion), then who said it and the protocol code.
+std::string server_error_text(const std::string& peer, const v1::Error& e) {
+  return "server " + peer + ": " + e.message() + " [" + v1::Error_Code_Name(e.code()) + "]";
+}
+
+// A Connection error's reason without its "server PEER " lead-in.
+std::string reason_only(const std::string& message, const std::string& peer) {
+  const std::string lead = "server " + peer + " ";
+  return message.rfind(lead, 0) == 0 ? message.substr(lead.size()) : message;
 }
 
 // Errors after which trying again later may succeed.
@@ -68,23 +79,31 @@ v1::Budget to_proto(const Budget& b) {
 
 }  // namespace
 
-Status handshake(Connection& connection, Millis timeout) {
+Status handshake(Connection& connection, Millis timeout, bool* server_answered) {
+  if (server_answered) *server_answered = false;
+  const std::string peer = connection.peer();
   v1::ClientMessage hello;
   hello.mutable_hello()->set_protocol_version(proto::kProtocolVersion);
   hello.mutable_hello()->set_client_name("meshstream-client 0.1");
   if (auto s = connection.send(hello, timeout); !s) return s;
   auto reply = connection.receive(timeout);
-  if (!reply) return tl::unexpected(reply.error());
+  if (!reply) {
+    return make_error(reply.error().code, "no meshstream server at " + peer +
+                                              " (no answer to Hello: it " +
+                                              reason_only(reply.error().message, peer) + ")");
+  }
   if (reply->has_error()) {
+    if (server_answered) *server_answered = true;
     // kUnsupported marks an answer that retrying will not change.
     const ErrorCode code =
         transient(reply->error().code()) ? ErrorCode::kIo : ErrorCode::kUnsupported;
-    return make_error(code, server_error_text(reply->error()));
+    return make_error(code, server_error_text(peer, reply->error()));
   }
   if (!reply->has_hello()) {
-    return make_error(ErrorCode::kParse,
-                      "server " + connection.peer() + " did not answer Hello with ServerHello");
+    return make_error(ErrorCode::kParse, "no meshstream server at " + peer +
+                                             " (it did not answer Hello with ServerHello)");
   }
+  if (server_answered) *server_answered = true;
   if (reply->hello().protocol_version() != proto::kProtocolVersion) {
     return make_error(ErrorCode::kUnsupported,
                       "server speaks protocol version " +
@@ -105,7 +124,8 @@ Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t
   while (true) {
     auto reply = (*connection)->receive(timeout);
     if (!reply) return tl::unexpected(reply.error());
-    if (reply->has_error()) return make_error(ErrorCode::kIo, server_error_text(reply->error()));
+    if (reply->has_error())
+      return make_error(ErrorCode::kIo, server_error_text((*connection)->peer(), reply->error()));
     if (reply->has_model_list()) {
       return std::vector<v1::ModelInfo>(reply->model_list().models().begin(),
                                         reply->model_list().models().end());
@@ -135,16 +155,23 @@ StreamClient::Attempt StreamClient::attempt(
     DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header,
     bool& progressed, Error& error) {
   const ReconnectPolicy& policy = target_.reconnect;
-  auto connection = Connection::open(target_.host, target_.port, policy.connect_timeout);
+  auto connection = Connection::open(target_.host, target_.port, policy.connect_timeout, &stop_);
   if (!connection) {
     error = connection.error();
-    return Attempt::kRetry;
+    // Nothing to resume: a first connection that cannot be made is the
+    // address's fault (wrong port, a name that does not resolve).
+    return handshaken_ ? Attempt::kRetry : Attempt::kFatal;
   }
   Connection& c = **connection;
-  if (auto s = handshake(c, policy.connect_timeout); !s) {
+  bool server_answered = false;
+  if (auto s = handshake(c, policy.connect_timeout, &server_answered); !s) {
     error = s.error();
-    return s.error().code == ErrorCode::kUnsupported ? Attempt::kFatal : Attempt::kRetry;
+    if (s.error().code == ErrorCode::kUnsupported) return Attempt::kFatal;
+    // A server that answered "busy" (or the like) asks to be tried again; a
+    // peer that never spoke the protocol will not start to.
+    return handshaken_ || server_answered ? Attempt::kRetry : Attempt::kFatal;
   }
+  handshaken_ = true;
   v1::ClientMessage request;
   v1::StreamRequest& r = *request.mutable_stream();
   r.set_model(target_.model);
@@ -172,7 +199,7 @@ StreamClient::Attempt StreamClient::attempt(
       return Attempt::kRetry;
     }
     if (message->has_error()) {
-      error = Error{ErrorCode::kIo, server_error_text(message->error())};
+      error = Error{ErrorCode::kIo, server_error_text(c.peer(), message->error())};
       return transient(message->error().code()) ? Attempt::kRetry : Attempt::kFatal;
     }
     if (message->has_header()) {
@@ -189,6 +216,12 @@ StreamClient::Attempt StreamClient::attempt(
         return Attempt::kFatal;
       }
       if (!facts_) {
+        if (check_header_) {
+          if (Status checked = check_header_(*facts); !checked) {
+            error = checked.error();
+            return Attempt::kFatal;
+          }
+        }
         facts_ = std::move(*facts);
         if (on_header) on_header(*facts_);
       }
@@ -278,6 +311,7 @@ void StreamClient::run(DecodedStream& decoded,
     Error error{ErrorCode::kIo, ""};
     const Attempt a = attempt(decoded, on_header, progressed, error);
     if (a == Attempt::kDone) return;
+    if (stop_) break;  // stop() (Ctrl-C) cut the attempt short: not its error
     if (a == Attempt::kFatal) {
       decoded.finish(StreamOutcome{false, "error", error});
       return;

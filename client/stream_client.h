@@ -50,15 +50,23 @@ struct StreamTarget {
   ReconnectPolicy reconnect;
 };
 
-// Bytes per second over the last second of reads.
+// The stream's true rate: bytes over the time since the first byte arrived,
+// and once that is longer than `window`, over the last `window` only (a
+// moving average: smooth, and it follows a link that slows down or a
+// pause). The first read only starts the clock: its bytes arrived before
+// any time could be measured.
 class RateMeter {
  public:
-  void add(uint64_t bytes);
-  double bytes_per_s() const;
+  using Clock = std::chrono::steady_clock;
+  explicit RateMeter(Clock::duration window = std::chrono::seconds(3)) : window_(window) {}
+  void add(uint64_t bytes, Clock::time_point now = Clock::now());
+  double bytes_per_s(Clock::time_point now = Clock::now()) const;
 
  private:
+  Clock::duration window_;
   mutable std::mutex mutex_;
-  std::deque<std::pair<std::chrono::steady_clock::time_point, uint64_t>> samples_;
+  std::optional<Clock::time_point> first_;
+  std::deque<std::pair<Clock::time_point, uint64_t>> samples_;  // reads after the first
 };
 
 class StreamClient {
@@ -69,7 +77,19 @@ class StreamClient {
   // stop(); always calls decoded.finish() before returning. `on_header` runs
   // once, on this thread, when the first header arrives. Blocking: run it on
   // its own thread.
+  //
+  // Only a connection lost after a successful handshake is retried (and a
+  // server that answers BUSY, SHUTTING_DOWN, TIMEOUT or INTERNAL): when the
+  // first connection cannot be made (the name does not resolve, nobody
+  // listens, the connect times out) or the peer does not answer Hello as a
+  // meshstream server, the run fails at once with that reason.
   void run(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header);
+
+  // Checks the first header before anything else is streamed (e.g. that a
+  // requested record exists); an error ends the run with it. Set before run.
+  void check_header(std::function<Status(const StreamFacts&)> check) {
+    check_header_ = std::move(check);
+  }
 
   void stop();
   void pause();
@@ -87,6 +107,8 @@ class StreamClient {
   bool wait_while_paused();
 
   StreamTarget target_;
+  std::function<Status(const StreamFacts&)> check_header_;
+  bool handshaken_ = false;  // a handshake succeeded once: later losses are retried
   std::optional<StreamFacts> facts_;
   bool index_checked_ = false;  // header compared with the stream's own index
   std::atomic<bool> stop_{false};
@@ -102,7 +124,9 @@ class StreamClient {
 Result<std::vector<v1::ModelInfo>> list_models(const std::string& host, uint16_t port,
                                                Millis timeout);
 
-// Hello/ServerHello exchange on an open connection.
-Status handshake(Connection& connection, Millis timeout);
+// Hello/ServerHello exchange on an open connection. `server_answered`, if
+// given, tells whether the peer answered as a meshstream server does (a
+// ServerHello or a protocol Error) even when the result is an error.
+Status handshake(Connection& connection, Millis timeout, bool* server_answered = nullptr);
 
 }  // namespace meshstream::client

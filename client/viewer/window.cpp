@@ -135,8 +135,388 @@ class ImGuiSession {
   bool glfw_ = false, opengl_ = false;
 };
 
+// Window size, framebuffer size and cursor of one frame.
+struct FrameGeometry {
+  int window_w = 0, window_h = 0, fb_w = 0, fb_h = 0;
+  float aspect = 1.0f;
+  double x = 0, y = 0;
+};
+
+// What a key asks for; false for keys the viewer does not use.
+bool command_for_key(int key, ViewerCommand& command) {
+  switch (key) {
+    case GLFW_KEY_F:
+      command = ViewerCommand::kFrameModel;
+      return true;
+    case GLFW_KEY_W:
+      command = ViewerCommand::kToggleWireframe;
+      return true;
+    case GLFW_KEY_1:
+      command = ViewerCommand::kColorShaded;
+      return true;
+    case GLFW_KEY_2:
+      command = ViewerCommand::kColorAsaKinds;
+      return true;
+    case GLFW_KEY_3:
+      command = ViewerCommand::kColorDistance;
+      return true;
+    case GLFW_KEY_SPACE:
+      command = ViewerCommand::kTogglePause;
+      return true;
+    case GLFW_KEY_S:
+      command = ViewerCommand::kScreenshot;
+      return true;
+    case GLFW_KEY_ESCAPE:
+      command = ViewerCommand::kClose;
+      return true;
+    default:
+      return false;
+  }
+}
+
+// The window's loop once GLFW, OpenGL, the renderer and ImGui are up: per
+// frame, (1) new stream state, (2) input and commands, (3) the model, a
+// screenshot, the panel, (4) what the panel asked for, then a wait that
+// caps the frame rate.
+class ViewerLoop {
+ public:
+  ViewerLoop(const ViewerOptions& options, LatestFrameMailbox& frames, StreamControls& controls,
+             const std::vector<ScriptedCommand>& script, GLFWwindow* window, const GlFunctions& gl,
+             MeshRenderer& renderer, PendingInput& input)
+      : options_(options),
+        frames_(frames),
+        controls_(controls),
+        script_(script),
+        window_(window),
+        gl_(gl),
+        renderer_(renderer),
+        input_(input) {
+    panel_.coloring = static_cast<ColorMode>(std::clamp(options.initial_coloring, 0, 2));
+    panel_.wireframe = options.initial_wireframe;
+    panel_.asa_enabled = controls.asa_enabled();
+    panel_.asa = controls.asa_options();
+    glfwGetCursorPos(window, &last_x_, &last_y_);
+  }
+
+  Result<ViewerReport> run() {
+    const auto loop_start = Clock::now();
+    last_activity_ = loop_start;
+    while (!glfwWindowShouldClose(window_)) {
+      const auto frame_start = Clock::now();
+      glfwPollEvents();
+      // The client closed the mailbox (Ctrl-C): this frame is the last.
+      if (frames_.closed()) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+      bool activity = take_stream_state();  // anything that may change the picture
+      const FrameGeometry g = read_geometry();
+      activity |= steer_camera(g);
+      const std::vector<ScriptedCommand> commands = commands_this_frame();
+      activity |= !commands.empty();
+      for (const ScriptedCommand& c : commands) apply(c);
+      input_.keys.clear();
+      frame_model_if_asked(g);
+      const bool last_frame = draw_model(g);
+      const PanelActions actions = draw_panel_and_swap(g, last_frame);
+      apply_panel_actions(actions);
+      if (last_frame) break;
+      wait_for_next_frame(frame_start, activity);
+    }
+    return finish(loop_start);
+  }
+
+ private:
+  void show(const DisplayFrame& frame) {
+    std::shared_ptr<const Mesh> mesh = frame.display ? frame.display : frame.decoded;
+    if (!mesh) return;
+    // A bad index would make the GPU read out of bounds: refuse, say why.
+    if (Status valid = validate_arrays(*mesh); !valid) {
+      panel_.message =
+          "frame " + std::to_string(frame.sequence) + " not shown: " + valid.error().message;
+      ++report_.rejected_meshes;
+      return;
+    }
+    auto start = Clock::now();
+    // Shading follows the panel's crease angle (the ASA control), so the
+    // edges ASA keeps sharp are also drawn sharp.
+    renderer_.upload(*mesh, frame.face_kind.get(), panel_.asa.crease_degrees);
+    double ms = ms_since(start);
+    panel_.upload_ms = ms;
+    report_.max_upload_ms = std::max(report_.max_upload_ms, ms);
+    ++report_.meshes_uploaded;
+    report_.last_sequence_shown = frame.sequence;
+    shown_ = frame;
+    has_shown_ = true;
+    panel_.distance_ready = false;
+    if (distances_.has_reference()) distances_.request(mesh, ++distance_tag_);
+    if (!framed_once_) {
+      want_frame_ = true;
+      framed_once_ = true;
+    }
+  }
+
+  // 1. New stream state: upload only when the sequence moved; distances to
+  // the final mesh when the worker has them.
+  bool take_stream_state() {
+    bool activity = false;
+    if (auto frame = frames_.take_newer(seen_)) {
+      seen_ = frame->sequence;
+      activity = true;
+      latest_ = *frame;
+      panel_.has_frame = true;
+      history_.add(latest_);
+      if (latest_.final && latest_.decoded && !distances_.has_reference()) {
+        distances_.set_reference(latest_.decoded);
+        if (has_shown_) {
+          distances_.request(shown_.display ? shown_.display : shown_.decoded, ++distance_tag_);
+        }
+      }
+      if (panel_.history_index < 0) show(latest_);
+    }
+    if (auto answer = distances_.take_result(); answer && answer->tag == distance_tag_) {
+      renderer_.upload_distances(answer->distances);
+      activity = true;
+      ++report_.distance_uploads;
+      panel_.distance_ready = true;
+      panel_.distance_max_found = answer->max;
+      panel_.distance_p98 = answer->p98;
+      panel_.reference_diagonal = answer->reference_diagonal;
+    }
+    panel_.distance_reference_known = distances_.has_reference();
+    return activity;
+  }
+
+  FrameGeometry read_geometry() const {
+    FrameGeometry g;
+    glfwGetWindowSize(window_, &g.window_w, &g.window_h);
+    glfwGetFramebufferSize(window_, &g.fb_w, &g.fb_h);
+    g.aspect = g.fb_h > 0 ? static_cast<float>(g.fb_w) / static_cast<float>(g.fb_h) : 1.0f;
+    glfwGetCursorPos(window_, &g.x, &g.y);
+    return g;
+  }
+
+  // 2a. The mouse moves the camera unless the panel wants it.
+  bool steer_camera(const FrameGeometry& g) {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (!io.WantCaptureMouse) {
+      float dx = static_cast<float>(g.x - last_x_), dy = static_cast<float>(g.y - last_y_);
+      bool left = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+      bool right = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
+      bool middle = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS;
+      bool shift = glfwGetKey(window_, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                   glfwGetKey(window_, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+      if (left && !shift) camera_.orbit(dx, dy);
+      if (right || middle || (left && shift)) camera_.pan(dx, dy, static_cast<float>(g.window_h));
+      if (input_.scroll != 0) camera_.zoom(input_.scroll);
+    }
+    const bool activity = input_.scroll != 0 || g.x != last_x_ || g.y != last_y_ ||
+                          !input_.keys.empty() ||
+                          glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS ||
+                          glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
+                          g.window_w != last_window_w_ || g.window_h != last_window_h_;
+    last_window_w_ = g.window_w;
+    last_window_h_ = g.window_h;
+    input_.scroll = 0;
+    last_x_ = g.x;
+    last_y_ = g.y;
+    return activity;
+  }
+
+  // 2b. Scripted commands for this frame, then the keys (unless the panel
+  // has the keyboard).
+  std::vector<ScriptedCommand> commands_this_frame() const {
+    std::vector<ScriptedCommand> commands;
+    for (const ScriptedCommand& c : script_) {
+      if (c.at_frame == report_.frames_drawn) commands.push_back(c);
+    }
+    if (!ImGui::GetIO().WantCaptureKeyboard) {
+      for (int key : input_.keys) {
+        ScriptedCommand c;
+        if (command_for_key(key, c.command)) commands.push_back(c);
+      }
+    }
+    return commands;
+  }
+
+  void apply(const ScriptedCommand& c) {
+    switch (c.command) {
+      case ViewerCommand::kFrameModel:
+        want_frame_ = true;
+        break;
+      case ViewerCommand::kToggleWireframe:
+        panel_.wireframe = !panel_.wireframe;
+        break;
+      case ViewerCommand::kColorShaded:
+        panel_.coloring = ColorMode::kShaded;
+        break;
+      case ViewerCommand::kColorAsaKinds:
+        panel_.coloring = ColorMode::kAsaKinds;
+        break;
+      case ViewerCommand::kColorDistance:
+        panel_.coloring = ColorMode::kDistance;
+        break;
+      case ViewerCommand::kTogglePause:
+        controls_.paused() ? controls_.resume() : controls_.pause();
+        break;
+      case ViewerCommand::kScreenshot:
+        panel_.screenshot_requested = true;
+        break;
+      case ViewerCommand::kClose:
+        glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        break;
+      case ViewerCommand::kSetAsa:
+        panel_.asa_enabled = c.asa_enabled;
+        panel_.asa = c.asa;
+        controls_.set_asa(panel_.asa_enabled, panel_.asa);
+        break;
+    }
+  }
+
+  // 2c. Frame into the part of the window right of the panel: fit the
+  // model to that width, then slide it over by half the panel.
+  void frame_model_if_asked(const FrameGeometry& g) {
+    if (!(want_frame_ && has_shown_ && report_.frames_drawn > 0)) return;  // panel has a size
+    const auto& mesh = shown_.display ? shown_.display : shown_.decoded;
+    float covered = std::clamp(panel_.right_edge_px, 0.0f, 0.5f * static_cast<float>(g.window_w));
+    float free_aspect =
+        g.window_h > 0 ? (static_cast<float>(g.window_w) - covered) / static_cast<float>(g.window_h)
+                       : g.aspect;
+    camera_.frame(*mesh, std::min(g.aspect, free_aspect));
+    camera_.pan(covered / 2, 0, static_cast<float>(g.window_h));
+    want_frame_ = false;
+  }
+
+  // 3a. The model, then (optionally) a screenshot of it. True when this is
+  // the last frame (options.exit_after_frames / exit_after_records).
+  bool draw_model(const FrameGeometry& g) {
+    style_.coloring = panel_.coloring;
+    style_.wireframe = panel_.wireframe;
+    style_.distance_max = panel_.distance_auto ? std::max(panel_.distance_p98, 1e-12f)
+                                               : panel_.distance_max_percent / 100.0f *
+                                                     std::max(panel_.reference_diagonal, 1e-12f);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    renderer_.draw(camera_, g.fb_w, g.fb_h, style_);
+    const bool last_frame = (options_.exit_after_frames != 0 &&
+                             report_.frames_drawn + 1 >= options_.exit_after_frames) ||
+                            (options_.exit_after_records != 0 && has_shown_ &&
+                             shown_.records_decoded >= options_.exit_after_records);
+    if (panel_.screenshot_requested && g.fb_w > 0 && g.fb_h > 0) {
+      panel_.screenshot_requested = false;
+      std::string path = options_.screenshot_dir + "/meshstream-screenshot-" +
+                         std::to_string(shown_.sequence) + "-" +
+                         std::to_string(++screenshot_counter_) + ".png";
+      Status written = write_png(path, read_back_buffer(gl_, g.fb_w, g.fb_h));
+      panel_.message = written ? "saved " + path : written.error().message;
+      if (written) report_.screenshots.push_back(path);
+    }
+    if (capture_exit(g, last_frame) && !options_.exit_screenshot_with_panel) {
+      last_model_image_ = read_back_buffer(gl_, g.fb_w, g.fb_h);
+    }
+    return last_frame;
+  }
+
+  // The exit screenshot is taken on the last frame (or once the window is
+  // asked to close).
+  bool capture_exit(const FrameGeometry& g, bool last_frame) const {
+    return (last_frame || glfwWindowShouldClose(window_)) && !options_.exit_screenshot.empty() &&
+           g.fb_w > 0 && g.fb_h > 0;
+  }
+
+  // 3b. The panel over the model, then the swap.
+  PanelActions draw_panel_and_swap(const FrameGeometry& g, bool last_frame) {
+    const bool capture = capture_exit(g, last_frame);
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    panel_.fps = ImGui::GetIO().Framerate;
+    panel_.paused = controls_.paused();
+    panel_.rate_bytes_per_s = controls_.current_rate_bytes_per_s();
+    panel_.history_size = history_.size();
+    PanelActions actions =
+        draw_panel(panel_, latest_, shown_, has_shown_ ? renderer_.vertex_count() : 0,
+                   has_shown_ ? renderer_.triangle_count() : 0);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (capture && options_.exit_screenshot_with_panel) {
+      last_model_image_ = read_back_buffer(gl_, g.fb_w, g.fb_h);
+    }
+    glfwSwapBuffers(window_);
+    ++report_.frames_drawn;
+    return actions;
+  }
+
+  // 4. What the panel asked for.
+  void apply_panel_actions(const PanelActions& actions) {
+    if (actions.asa_changed) controls_.set_asa(panel_.asa_enabled, panel_.asa);
+    if (actions.toggle_pause) controls_.paused() ? controls_.resume() : controls_.pause();
+    if (actions.frame_model) want_frame_ = true;
+    if (actions.history_changed && !history_.empty()) {
+      if (panel_.history_index < 0) {
+        show(history_.newest());
+      } else {
+        size_t i = std::min(static_cast<size_t>(panel_.history_index), history_.size() - 1);
+        show(history_[i]);
+      }
+    }
+  }
+
+  // Xvfb and some drivers ignore the swap interval: cap at ~60 frames per
+  // second, and at 20 once nothing has happened for half a second, so an
+  // idle viewer on a software rasterizer leaves the cores to decoding, ASA
+  // and the distance worker. Any input event wakes the wait at once.
+  void wait_for_next_frame(Clock::time_point frame_start, bool activity) {
+    if (activity) last_activity_ = Clock::now();
+    double frame_budget_ms = ms_since(last_activity_) > 500.0 ? 50.0 : 1000.0 / 60.0;
+    double spare_ms = frame_budget_ms - ms_since(frame_start);
+    if (spare_ms > 1.0) glfwWaitEventsTimeout(spare_ms / 1000.0);
+  }
+
+  // The report, and the exit screenshot if one was asked for.
+  Result<ViewerReport> finish(Clock::time_point loop_start) {
+    report_.final_coloring = static_cast<int>(panel_.coloring);
+    report_.final_wireframe = panel_.wireframe;
+    report_.mean_frame_ms = report_.frames_drawn ? ms_since(loop_start) / report_.frames_drawn : 0;
+    if (!options_.exit_screenshot.empty()) {
+      if (last_model_image_.rgba.empty()) {
+        return make_error(ErrorCode::kIo, options_.exit_screenshot + ": no frame was drawn");
+      }
+      if (Status written = write_png(options_.exit_screenshot, last_model_image_); !written) {
+        return tl::unexpected(written.error());
+      }
+    }
+    return report_;
+  }
+
+  const ViewerOptions& options_;
+  LatestFrameMailbox& frames_;
+  StreamControls& controls_;
+  const std::vector<ScriptedCommand>& script_;
+  GLFWwindow* window_;
+  const GlFunctions& gl_;
+  MeshRenderer& renderer_;
+  PendingInput& input_;
+
+  PanelState panel_;
+  RenderStyle style_;
+  OrbitCamera camera_;
+  FrameHistory history_;
+  DistanceWorker distances_;
+  ViewerReport report_;
+
+  uint64_t seen_ = 0;
+  DisplayFrame latest_;  // newest frame received (for the panel)
+  DisplayFrame shown_;   // frame whose mesh is on the GPU
+  bool has_shown_ = false, framed_once_ = false, want_frame_ = false;
+  uint64_t distance_tag_ = 0;  // identifies `shown_` for the distance worker
+  int screenshot_counter_ = 0;
+  RgbaImage last_model_image_;
+  double last_x_ = 0, last_y_ = 0;
+  Clock::time_point last_activity_;
+  int last_window_w_ = 0, last_window_h_ = 0;
+};
+
 }  // namespace
 
+// Opens the window (GLFW, OpenGL functions, the renderer, ImGui), then runs
+// the loop.
 Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
                                             LatestFrameMailbox& frames, StreamControls& controls,
                                             const std::vector<ScriptedCommand>& script) {
@@ -155,284 +535,8 @@ Result<ViewerReport> run_viewer_with_report(const ViewerOptions& options,
   ImGuiSession imgui;
   if (Status opened = imgui.open(window); !opened) return tl::unexpected(opened.error());
 
-  PanelState panel;
-  panel.coloring = static_cast<ColorMode>(std::clamp(options.initial_coloring, 0, 2));
-  panel.wireframe = options.initial_wireframe;
-  panel.asa_enabled = controls.asa_enabled();
-  panel.asa = controls.asa_options();
-  RenderStyle style;
-  OrbitCamera camera;
-  FrameHistory history;
-  DistanceWorker distances;
-  ViewerReport report;
-
-  uint64_t seen = 0;
-  DisplayFrame latest;  // newest frame received (for the panel)
-  DisplayFrame shown;   // frame whose mesh is on the GPU
-  bool has_shown = false, framed_once = false, want_frame = false;
-  uint64_t distance_tag = 0;  // identifies `shown` for the distance worker
-  int screenshot_counter = 0;
-  RgbaImage last_model_image;
-  double last_x = 0, last_y = 0;
-  glfwGetCursorPos(window, &last_x, &last_y);
-  auto loop_start = Clock::now();
-  auto last_activity = loop_start;
-  int last_window_w = 0, last_window_h = 0;
-
-  auto show = [&](const DisplayFrame& frame) {
-    std::shared_ptr<const Mesh> mesh = frame.display ? frame.display : frame.decoded;
-    if (!mesh) return;
-    // A bad index would make the GPU read out of bounds: refuse, say why.
-    if (Status valid = validate_arrays(*mesh); !valid) {
-      panel.message =
-          "frame " + std::to_string(frame.sequence) + " not shown: " + valid.error().message;
-      ++report.rejected_meshes;
-      return;
-    }
-    auto start = Clock::now();
-    // Shading follows the panel's crease angle (the ASA control), so the
-    // edges ASA keeps sharp are also drawn sharp.
-    renderer->upload(*mesh, frame.face_kind.get(), panel.asa.crease_degrees);
-    double ms = ms_since(start);
-    panel.upload_ms = ms;
-    report.max_upload_ms = std::max(report.max_upload_ms, ms);
-    ++report.meshes_uploaded;
-    report.last_sequence_shown = frame.sequence;
-    shown = frame;
-    has_shown = true;
-    panel.distance_ready = false;
-    if (distances.has_reference()) distances.request(mesh, ++distance_tag);
-    if (!framed_once) {
-      want_frame = true;
-      framed_once = true;
-    }
-  };
-
-  while (!glfwWindowShouldClose(window)) {
-    auto frame_start = Clock::now();
-    glfwPollEvents();
-    bool activity = false;  // anything that may change the picture
-
-    // 1. New stream state: upload only when the sequence moved.
-    if (auto frame = frames.take_newer(seen)) {
-      seen = frame->sequence;
-      activity = true;
-      latest = *frame;
-      panel.has_frame = true;
-      history.add(latest);
-      if (latest.final && latest.decoded && !distances.has_reference()) {
-        distances.set_reference(latest.decoded);
-        if (has_shown) {
-          distances.request(shown.display ? shown.display : shown.decoded, ++distance_tag);
-        }
-      }
-      if (panel.history_index < 0) show(latest);
-    }
-    if (auto answer = distances.take_result(); answer && answer->tag == distance_tag) {
-      renderer->upload_distances(answer->distances);
-      activity = true;
-      ++report.distance_uploads;
-      panel.distance_ready = true;
-      panel.distance_max_found = answer->max;
-      panel.distance_p98 = answer->p98;
-      panel.reference_diagonal = answer->reference_diagonal;
-    }
-    panel.distance_reference_known = distances.has_reference();
-
-    // 2. Input: mouse on the model unless the panel wants it; keys.
-    int window_w = 0, window_h = 0, fb_w = 0, fb_h = 0;
-    glfwGetWindowSize(window, &window_w, &window_h);
-    glfwGetFramebufferSize(window, &fb_w, &fb_h);
-    float aspect = fb_h > 0 ? static_cast<float>(fb_w) / static_cast<float>(fb_h) : 1.0f;
-    double x = 0, y = 0;
-    glfwGetCursorPos(window, &x, &y);
-    const ImGuiIO& io = ImGui::GetIO();
-    if (!io.WantCaptureMouse) {
-      float dx = static_cast<float>(x - last_x), dy = static_cast<float>(y - last_y);
-      bool left = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-      bool right = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
-      bool middle = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS;
-      bool shift = glfwGetKey(window, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
-                   glfwGetKey(window, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
-      if (left && !shift) camera.orbit(dx, dy);
-      if (right || middle || (left && shift)) camera.pan(dx, dy, static_cast<float>(window_h));
-      if (input.scroll != 0) camera.zoom(input.scroll);
-    }
-    activity |= input.scroll != 0 || x != last_x || y != last_y || !input.keys.empty() ||
-                glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS ||
-                glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS ||
-                window_w != last_window_w || window_h != last_window_h;
-    last_window_w = window_w;
-    last_window_h = window_h;
-    input.scroll = 0;
-    last_x = x;
-    last_y = y;
-    std::vector<ScriptedCommand> commands;
-    for (const ScriptedCommand& c : script) {
-      if (c.at_frame == report.frames_drawn) commands.push_back(c);
-    }
-    if (!io.WantCaptureKeyboard) {
-      for (int key : input.keys) {
-        ScriptedCommand c;
-        switch (key) {
-          case GLFW_KEY_F:
-            c.command = ViewerCommand::kFrameModel;
-            break;
-          case GLFW_KEY_W:
-            c.command = ViewerCommand::kToggleWireframe;
-            break;
-          case GLFW_KEY_1:
-            c.command = ViewerCommand::kColorShaded;
-            break;
-          case GLFW_KEY_2:
-            c.command = ViewerCommand::kColorAsaKinds;
-            break;
-          case GLFW_KEY_3:
-            c.command = ViewerCommand::kColorDistance;
-            break;
-          case GLFW_KEY_SPACE:
-            c.command = ViewerCommand::kTogglePause;
-            break;
-          case GLFW_KEY_S:
-            c.command = ViewerCommand::kScreenshot;
-            break;
-          case GLFW_KEY_ESCAPE:
-            c.command = ViewerCommand::kClose;
-            break;
-          default:
-            continue;
-        }
-        commands.push_back(c);
-      }
-    }
-    activity |= !commands.empty();
-    for (const ScriptedCommand& c : commands) {
-      switch (c.command) {
-        case ViewerCommand::kFrameModel:
-          want_frame = true;
-          break;
-        case ViewerCommand::kToggleWireframe:
-          panel.wireframe = !panel.wireframe;
-          break;
-        case ViewerCommand::kColorShaded:
-          panel.coloring = ColorMode::kShaded;
-          break;
-        case ViewerCommand::kColorAsaKinds:
-          panel.coloring = ColorMode::kAsaKinds;
-          break;
-        case ViewerCommand::kColorDistance:
-          panel.coloring = ColorMode::kDistance;
-          break;
-        case ViewerCommand::kTogglePause:
-          controls.paused() ? controls.resume() : controls.pause();
-          break;
-        case ViewerCommand::kScreenshot:
-          panel.screenshot_requested = true;
-          break;
-        case ViewerCommand::kClose:
-          glfwSetWindowShouldClose(window, GLFW_TRUE);
-          break;
-        case ViewerCommand::kSetAsa:
-          panel.asa_enabled = c.asa_enabled;
-          panel.asa = c.asa;
-          controls.set_asa(panel.asa_enabled, panel.asa);
-          break;
-      }
-    }
-    input.keys.clear();
-    if (want_frame && has_shown && report.frames_drawn > 0) {  // after the panel has a size
-      // Frame into the part of the window right of the panel: fit the model
-      // to that width, then slide it over by half the panel.
-      const auto& mesh = shown.display ? shown.display : shown.decoded;
-      float covered = std::clamp(panel.right_edge_px, 0.0f, 0.5f * static_cast<float>(window_w));
-      float free_aspect =
-          window_h > 0 ? (static_cast<float>(window_w) - covered) / static_cast<float>(window_h)
-                       : aspect;
-      camera.frame(*mesh, std::min(aspect, free_aspect));
-      camera.pan(covered / 2, 0, static_cast<float>(window_h));
-      want_frame = false;
-    }
-
-    // 3. The model, then (optionally) a screenshot of it, then the panel.
-    style.coloring = panel.coloring;
-    style.wireframe = panel.wireframe;
-    style.distance_max = panel.distance_auto ? std::max(panel.distance_p98, 1e-12f)
-                                             : panel.distance_max_percent / 100.0f *
-                                                   std::max(panel.reference_diagonal, 1e-12f);
-    gl->BindFramebuffer(GL_FRAMEBUFFER, 0);
-    renderer->draw(camera, fb_w, fb_h, style);
-    bool last_frame =
-        (options.exit_after_frames != 0 && report.frames_drawn + 1 >= options.exit_after_frames) ||
-        (options.exit_after_records != 0 && has_shown &&
-         shown.records_decoded >= options.exit_after_records);
-    if (panel.screenshot_requested && fb_w > 0 && fb_h > 0) {
-      panel.screenshot_requested = false;
-      std::string path = options.screenshot_dir + "/meshstream-screenshot-" +
-                         std::to_string(shown.sequence) + "-" +
-                         std::to_string(++screenshot_counter) + ".png";
-      Status written = write_png(path, read_back_buffer(*gl, fb_w, fb_h));
-      panel.message = written ? "saved " + path : written.error().message;
-      if (written) report.screenshots.push_back(path);
-    }
-    bool capture_exit = (last_frame || glfwWindowShouldClose(window)) &&
-                        !options.exit_screenshot.empty() && fb_w > 0 && fb_h > 0;
-    if (capture_exit && !options.exit_screenshot_with_panel) {
-      last_model_image = read_back_buffer(*gl, fb_w, fb_h);
-    }
-
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
-    panel.fps = io.Framerate;
-    panel.paused = controls.paused();
-    panel.rate_bytes_per_s = controls.current_rate_bytes_per_s();
-    panel.history_size = history.size();
-    PanelActions actions =
-        draw_panel(panel, latest, shown, has_shown ? renderer->vertex_count() : 0,
-                   has_shown ? renderer->triangle_count() : 0);
-    ImGui::Render();
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    if (capture_exit && options.exit_screenshot_with_panel) {
-      last_model_image = read_back_buffer(*gl, fb_w, fb_h);
-    }
-    glfwSwapBuffers(window);
-    ++report.frames_drawn;
-
-    // 4. What the panel asked for.
-    if (actions.asa_changed) controls.set_asa(panel.asa_enabled, panel.asa);
-    if (actions.toggle_pause) controls.paused() ? controls.resume() : controls.pause();
-    if (actions.frame_model) want_frame = true;
-    if (actions.history_changed && !history.empty()) {
-      if (panel.history_index < 0) {
-        show(history.newest());
-      } else {
-        size_t i = std::min(static_cast<size_t>(panel.history_index), history.size() - 1);
-        show(history[i]);
-      }
-    }
-
-    if (last_frame) break;
-    // Xvfb and some drivers ignore the swap interval: cap at ~60 frames per
-    // second, and at 20 once nothing has happened for half a second, so an
-    // idle viewer on a software rasterizer leaves the cores to decoding, ASA
-    // and the distance worker. Any input event wakes the wait at once.
-    if (activity) last_activity = Clock::now();
-    double frame_budget_ms = ms_since(last_activity) > 500.0 ? 50.0 : 1000.0 / 60.0;
-    double spare_ms = frame_budget_ms - ms_since(frame_start);
-    if (spare_ms > 1.0) glfwWaitEventsTimeout(spare_ms / 1000.0);
-  }
-  report.final_coloring = static_cast<int>(panel.coloring);
-  report.final_wireframe = panel.wireframe;
-  report.mean_frame_ms = report.frames_drawn ? ms_since(loop_start) / report.frames_drawn : 0;
-  if (!options.exit_screenshot.empty()) {
-    if (last_model_image.rgba.empty()) {
-      return make_error(ErrorCode::kIo, options.exit_screenshot + ": no frame was drawn");
-    }
-    if (Status written = write_png(options.exit_screenshot, last_model_image); !written) {
-      return tl::unexpected(written.error());
-    }
-  }
-  return report;
+  ViewerLoop loop(options, frames, controls, script, window, *gl, *renderer, input);
+  return loop.run();
 }
 
 Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,

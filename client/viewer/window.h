@@ -45,8 +45,9 @@ struct ViewerReport {
 };
 
 // Opens the window, shows frames from `frames` as they arrive, steers the
-// stream through `controls`, until the window is closed or
-// options.exit_after_frames frames were drawn. kUnsupported when no display
+// stream through `controls`, until the window is closed, `frames` is
+// closed (the client's Ctrl-C) or options.exit_after_frames frames were
+// drawn. kUnsupported when no display
 // or no OpenGL 3.3 core context is available; kIo when exit_screenshot
 // cannot be written. Runs on the calling thread (GLFW wants the main thread
 // on some platforms).

@@ -1,6 +1,7 @@
 // The client library in-process: the decoder hand-over (latest wins, the
 // pipeline's mirror copies only what changed, the snapshot barrier), the
-// display builder's two ASA paths, and address parsing.
+// display builder's two ASA paths, address parsing, the rate meter and the
+// per-record reports.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "client/connection.h"
 #include "client/decoded_stream.h"
 #include "client/display_builder.h"
+#include "client/stream_client.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/procedural.h"
@@ -184,6 +186,81 @@ TEST(ParseHostPort, AcceptsHostPortAndRefusesTheRest) {
        {"127.0.0.1", ":7878", "host:", "host:0", "host:65536", "host:12x", "host:-1"}) {
     EXPECT_FALSE(parse_host_port(bad)) << bad;
   }
+  // Each mistake gets its own reason: malformed, or a number out of range.
+  auto reason = [](const char* text) { return parse_host_port(text).error().message; };
+  EXPECT_NE(reason("127.0.0.1").find("no ':' before a port"), std::string::npos);
+  EXPECT_NE(reason("host:").find("no port after"), std::string::npos);
+  EXPECT_NE(reason(":7878").find("no host"), std::string::npos);
+  EXPECT_NE(reason("host:12x").find("'12x' is not a number"), std::string::npos);
+  for (const char* out_of_range :
+       {"host:0", "host:65536", "host:-1", "host:99999999999999999999"}) {
+    EXPECT_NE(reason(out_of_range).find("is out of range: a port is 1 to 65535"), std::string::npos)
+        << reason(out_of_range);
+    EXPECT_EQ(reason(out_of_range).find("not HOST:PORT"), std::string::npos) << out_of_range;
+  }
+}
+
+// The rate is bytes over the time since the first byte (whose own bytes
+// only start the clock), then over the last window: exact on a steady
+// link from the start, and it falls during a pause.
+TEST(RateMeter, ShowsTheTrueRateFromTheFirstByteAndFollowsAPause) {
+  using namespace std::chrono;
+  RateMeter meter(seconds(3));
+  const auto t0 = steady_clock::now();
+  EXPECT_EQ(meter.bytes_per_s(t0), 0);
+  meter.add(5000, t0);  // the first read: starts the clock
+  EXPECT_EQ(meter.bytes_per_s(t0), 0);
+  for (int i = 1; i <= 50; ++i) {
+    const auto t = t0 + milliseconds(100 * i);
+    meter.add(2000, t);  // 20 kB/s
+    EXPECT_NEAR(meter.bytes_per_s(t), 20000.0, 1e-6) << "after " << i * 100 << " ms";
+  }
+  // Nothing for 1.5 s: half the window is silent.
+  EXPECT_NEAR(meter.bytes_per_s(t0 + milliseconds(6500)), 10000.0, 700.0);
+  EXPECT_EQ(meter.bytes_per_s(t0 + seconds(9)), 0);
+}
+
+// One AppliedRecord per record, in order, with the index's counts and the
+// bytes up to its end; the barriers set by set_barriers all hold.
+TEST(DecodedStream, ReportsEveryRecordAndHoldsEveryBarrier) {
+  const auto stream = demo_stream();
+  DecodedStream decoded;
+  std::vector<AppliedRecord> reported;
+  decoded.on_record([&](const AppliedRecord& r) { reported.push_back(r); });
+  decoded.set_barriers({5, 1, 9});
+  std::thread network([&] {
+    for (size_t at = 0; at < stream.size(); at += 4) {
+      const size_t n = std::min<size_t>(4, stream.size() - at);
+      if (!decoded.feed(std::span<const uint8_t>(stream.data() + at, n))) return;
+    }
+  });
+  Mesh mirror;
+  std::vector<uint32_t> seen;
+  while (seen.empty() || seen.back() < decoded.records_decoded() || seen.back() < 10) {
+    decoded.wait(0, true, std::chrono::milliseconds(50));
+    if (!decoded.has_pending()) continue;
+    MeshChanges changes;
+    seen.push_back(decoded.take(mirror, changes).records_decoded);
+    if (seen.size() > 5000) break;
+  }
+  network.join();
+  for (uint32_t held : {2u, 6u, 10u}) {
+    EXPECT_NE(std::find(seen.begin(), seen.end(), held), seen.end()) << held;
+  }
+  ASSERT_EQ(reported.size(), decoded.records_decoded());
+  uint64_t end = 0;
+  for (size_t i = 0; i < reported.size(); ++i) {
+    EXPECT_EQ(reported[i].index, i);
+    EXPECT_GT(reported[i].end_offset, end);
+    EXPECT_EQ(reported[i].end_offset, end + reported[i].bytes);
+    end = reported[i].end_offset;
+    const Mesh at = decode_prefix(stream, reported[i].end_offset);
+    if (i % 7 == 0 || i + 1 == reported.size()) {
+      EXPECT_EQ(reported[i].vertices, at.vertex_count()) << i;
+      EXPECT_EQ(reported[i].faces, at.face_count()) << i;
+    }
+  }
+  EXPECT_EQ(end, stream.size());
 }
 
 }  // namespace

@@ -86,14 +86,18 @@ class ClientStreamTest : public ::testing::Test {
 TempDir* ClientStreamTest::dir_ = nullptr;
 Server* ClientStreamTest::server_ = nullptr;
 
-// Events: one header, refinements with strictly increasing index and
-// non-decreasing bytes/vertices/faces/elapsed, the last one final, then done.
+// Events: one header, a record event per decoded record, refinements with
+// strictly increasing index and non-decreasing bytes/vertices/faces/elapsed,
+// the last one final, then done.
 void expect_monotone_events(const std::vector<nlohmann::json>& events) {
   ASSERT_GE(events.size(), 3u);
   EXPECT_EQ(events.front()["event"], "header");
   EXPECT_EQ(events.back()["event"], "done");
   const auto refinements = of_kind(events, "refinement");
-  ASSERT_EQ(refinements.size() + 2, events.size()) << "only header, refinements and done expected";
+  const auto records = of_kind(events, "record");
+  ASSERT_EQ(refinements.size() + records.size() + 2, events.size())
+      << "only header, records, refinements and done expected";
+  EXPECT_EQ(static_cast<int64_t>(records.size()), events.back()["records"].get<int64_t>());
   for (size_t i = 1; i < refinements.size(); ++i) {
     const auto &a = refinements[i - 1], &b = refinements[i];
     EXPECT_LT(a["index"].get<int64_t>(), b["index"].get<int64_t>());
@@ -143,16 +147,21 @@ TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
   TempDir out;
   const std::vector<std::string> asa{"--asa-levels", "2",          "--flatness", "0.8",
                                      "--rule",       "projection", "--crease",   "60"};
-  std::vector<std::string> args{"demo", "--json", "--out", out.path()};
+  std::vector<std::string> args{"demo", "--json", "--out", out.path(), "--out-every", "25"};
   args.insert(args.end(), asa.begin(), asa.end());
   const ClientRun r = client(server_->address(), args);
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
-  const auto refinements = of_kind(r.events, "refinement");
-  // First, a middle and the last display update (the checks run the tools).
-  std::vector<size_t> picks{0, refinements.size() / 2, refinements.size() - 1};
+  // The display updates of the saved records (every 25th: each shown as is).
+  std::vector<nlohmann::json> saved;
+  for (const auto& e : of_kind(r.events, "refinement")) {
+    if (e["index"].get<int64_t>() % 25 == 0) saved.push_back(e);
+  }
+  ASSERT_GE(saved.size(), 3u);
+  // First, a middle and the last saved record (the checks run the tools).
+  std::vector<size_t> picks{0, saved.size() / 2, saved.size() - 1};
   for (size_t pick : picks) {
-    const auto& e = refinements[pick];
+    const auto& e = saved[pick];
     const int64_t index = e["index"];
     char name[32];
     std::snprintf(name, sizeof name, "%04lld.ply", static_cast<long long>(index));
@@ -168,12 +177,11 @@ TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
         "sub" + std::to_string(index) + ".ply");
     EXPECT_TRUE(same_geometry(display, expected)) << "record " << index;
   }
-  EXPECT_EQ(read_text(out / "final.ply"), read_text(out / [&] {
-              char name[32];
-              std::snprintf(name, sizeof name, "%04lld.ply",
-                            static_cast<long long>(refinements.back()["index"].get<int64_t>()));
-              return std::string(name);
-            }()));
+  const Mesh final_expected = tool_subdivide(
+      out / "final.decoded.ply",
+      {"--levels", "2", "--flatness", "0.8", "--rule", "projection", "--crease", "60"},
+      "sub_final.ply");
+  EXPECT_TRUE(same_geometry(load_ply(out / "final.ply"), final_expected));
 }
 
 // The incremental path (only the region a record changed is recomputed)
@@ -186,9 +194,9 @@ TEST_F(ClientStreamTest, IncrementalAsaEqualsOfflineSubdivideAtEachRecord) {
                           out.path()))
       << paced.log();
   const std::vector<std::string> asa{"--levels", "1", "--flatness", "0.8", "--crease", "50"};
-  const ClientRun r =
-      client(paced.address(), {"demo", "--json", "--out", out.path(), "--asa-levels", "1",
-                               "--flatness", "0.8", "--crease", "50", "--asa-path", "incremental"});
+  const ClientRun r = client(
+      paced.address(), {"demo", "--json", "--out", out / "o", "--out-every", "1", "--asa-levels",
+                        "1", "--flatness", "0.8", "--crease", "50", "--asa-path", "incremental"});
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
   std::vector<nlohmann::json> incremental;
@@ -201,7 +209,7 @@ TEST_F(ClientStreamTest, IncrementalAsaEqualsOfflineSubdivideAtEachRecord) {
     const int64_t index = e["index"];
     char name[32];
     std::snprintf(name, sizeof name, "%04lld.ply", static_cast<long long>(index));
-    const Mesh display = load_ply(out / name);
+    const Mesh display = load_ply(out / ("o/" + std::string(name)));
     const std::string prefix = "iprefix" + std::to_string(index) + ".ply";
     tool_decode(e["bytes"].get<uint64_t>(), prefix);
     const Mesh expected =
@@ -413,7 +421,7 @@ TEST_F(ClientStreamTest, ServerErrorsExitOneWithTheirMessage) {
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_NE(errors[0]["message"].get<std::string>().find("no-such-model"), std::string::npos)
       << errors[0]["message"];
-  // Nobody listening: gives up after the allowed reconnects.
+  // Nobody listening: fails at once (client_cli_test.cpp has the details).
   const ClientRun gone = client("127.0.0.1:" + std::to_string(free_port()),
                                 {"demo", "--json", "--reconnect-attempts", "1"});
   EXPECT_EQ(gone.status, 1);

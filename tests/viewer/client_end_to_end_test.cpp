@@ -215,27 +215,6 @@ TEST_F(ClientEndToEnd, SnapshotsOfACubeKeepItsEdgesSharp) {
   EXPECT_LE(testing::largest_edge_step(testing::shades_beside_visible_edges(cube, blended)), 10);
 }
 
-// --view where there is no display: exit 1 with one line that says so once
-// ("viewer: no display ...", not "viewer: viewer: ...") and what to do
-// instead.
-TEST_F(ClientEndToEnd, ViewWithoutADisplaySaysWhatToDoInstead) {
-  testing::ChildProcess server;
-  address_ = start_server(server, {});
-  ASSERT_FALSE(address_.empty()) << "server did not start";
-  ScopedEnv no_x("DISPLAY", "");
-  ScopedEnv no_wayland("WAYLAND_DISPLAY", "");
-  ::unsetenv("DISPLAY");  // restored by the ScopedEnvs
-  ::unsetenv("WAYLAND_DISPLAY");
-  EXPECT_EQ(run_client({"--view", "--width", "200", "--height", "150"}), 1) << client_log();
-  const std::string log = client_log();
-  const size_t at = log.find("viewer: no display to open a window on");
-  ASSERT_NE(at, std::string::npos) << log;
-  const std::string line = log.substr(at, log.find('\n', at) - at);
-  EXPECT_EQ(log.find("viewer: viewer:"), std::string::npos) << log;
-  EXPECT_NE(line.find("--snapshot"), std::string::npos) << line;
-  EXPECT_NE(line.find("xvfb-run"), std::string::npos) << line;
-}
-
 // Closing the window while the stream still runs cancels it; the summary
 // then reports what was shown, not zeros.
 TEST_F(ClientEndToEnd, ClosingTheWindowEarlyReportsWhatWasShown) {
