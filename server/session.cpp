@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "server/model_suggestions.h"
+
 namespace meshstream::server {
 namespace {
 
@@ -247,8 +249,12 @@ void Session::handle(const v1::ClientMessage& message) {
 void Session::handle_stream(const v1::StreamRequest& request) {
   const CatalogModel* model = shared_.catalog->find(request.model());
   if (!model) {
-    std::string shown = request.model().substr(0, 128);
-    send_error(v1::Error::UNKNOWN_MODEL, "unknown model '" + shown + "'", false);
+    std::vector<std::string> names;
+    for (const CatalogModel* m : shared_.catalog->models()) names.push_back(m->name);
+    const std::string message =
+        unknown_model_message(request.model(), closest_names(request.model(), names));
+    spdlog::info("session {}: {}", peer_, message);
+    send_error(v1::Error::UNKNOWN_MODEL, message, false);
     return;
   }
   Budget budget;
