@@ -46,7 +46,9 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   app.add_option("--models", o.models_dir,
                  "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded at start-up; "
                  "other files are skipped with a warning");
-  app.add_option("--listen", listen, "address to listen on, HOST:PORT (port 0 = any free port)")
+  app.add_option("--listen", listen,
+                 "address to listen on, HOST:PORT (port 0 = any free port); bound before the "
+                 "models load, so a busy port fails at once")
       ->capture_default_str();
   app.add_flag("--demo", o.demo, "also serve the procedural demo models");
   app.add_option("--cache", cache,
