@@ -53,12 +53,15 @@ class Catalog {
   std::map<std::string, CatalogModel, std::less<>> models_;
 };
 
+// How much a loading line matters: progress is info; a skipped input, a
+// name clash or an unusable cache is a warning.
+enum class CatalogLogLevel { kInfo, kWarn };
 // Progress and problems while loading, one line each ("skipped x.ply: ...").
-using CatalogLog = std::function<void(const std::string& line)>;
+using CatalogLog = std::function<void(CatalogLogLevel level, const std::string& line)>;
 
-// One way models enter the catalog: a folder of .hcs files, a folder of mesh
-// files encoded at start-up, the procedural demo models. Sources are loaded
-// in order; a name taken by an earlier source is not overwritten.
+// One way models enter the catalog: a folder of .hcs and mesh files, the
+// procedural demo models. Sources are loaded in order; a name taken by an
+// earlier source is not overwritten.
 class CatalogSource {
  public:
   virtual ~CatalogSource() = default;
@@ -67,19 +70,19 @@ class CatalogSource {
   virtual void load(Catalog& catalog, const CatalogLog& log) = 0;
 };
 
-// Every `*.hcs` file directly in `dir`, served as-is (memory-mapped).
-std::unique_ptr<CatalogSource> hcs_folder_source(std::string dir);
-
-struct MeshFolderOptions {
+struct ModelsFolderOptions {
   std::string dir;
   // Where encoded streams are cached, keyed by content hash and
-  // kEncoderVersion. Empty: no cache (encode at every start).
+  // kEncoderVersion; an existing folder (prepare_cache_folder). Empty: no
+  // cache (encode at every start).
   std::string cache_dir;
   unsigned threads = 0;  // 0 = one per core
 };
-// Every mesh file (.ply .obj .stl .drc .off) directly in `options.dir`,
-// imported and encoded at start-up on all cores, cached.
-std::unique_ptr<CatalogSource> mesh_folder_source(MeshFolderOptions options);
+// The files directly in `options.dir`, named as scan_models_folder says
+// (models_folder.h): `.hcs` files served as-is (memory-mapped), mesh files
+// (.ply .obj .stl .drc .off) imported and encoded at start-up on all cores,
+// cached. Each skipped entry and each name clash is one warning.
+std::unique_ptr<CatalogSource> models_folder_source(ModelsFolderOptions options);
 
 // The procedural demo models (no folder needed): "demo" (trefoil, ~100k
 // vertices), "demo-small" (~10k) and "torus", encoded at start-up and cached

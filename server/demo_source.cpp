@@ -17,7 +17,8 @@ class DemoSource final : public CatalogSource {
 
   void load(Catalog& catalog, const CatalogLog& log) override {
     if (!demo_models_available()) {
-      log("--demo: this build has no procedural demo meshes or no encoder; serving files only");
+      log(CatalogLogLevel::kWarn,
+          "--demo: this build has no procedural demo meshes or no encoder; serving files only");
       return;
     }
 #if MESHSTREAM_HAVE_DEMO_MESH
@@ -29,7 +30,8 @@ class DemoSource final : public CatalogSource {
     std::vector<EncodeJob> jobs;
     for (const Demo demo : {Demo{"demo", 200000}, Demo{"demo-small", 20000}}) {
       if (catalog.contains(demo.name)) {
-        log(std::string("skipped demo model '") + demo.name + "': name is taken");
+        log(CatalogLogLevel::kWarn,
+            std::string("skipped demo model '") + demo.name + "': name is taken");
         continue;
       }
       const uint32_t faces = demo.faces;
@@ -38,7 +40,9 @@ class DemoSource final : public CatalogSource {
                                "demo-trefoil-" + std::to_string(faces),
                                [faces]() -> Result<Mesh> { return make_demo_mesh(faces); }});
     }
-    if (!catalog.contains("torus")) {
+    if (catalog.contains("torus")) {
+      log(CatalogLogLevel::kWarn, "skipped demo model 'torus': name is taken");
+    } else {
       jobs.push_back(EncodeJob{"torus", "demo", "demo torus 96x48", "demo-torus-96x48",
                                []() -> Result<Mesh> { return make_torus(96, 48); }});
     }

@@ -74,14 +74,38 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir) 
 #endif
 }
 
+Result<bool> prepare_cache_folder(const std::string& dir, bool create_parents) {
+  std::error_code ec;
+  const fs::path path(dir);
+  if (fs::is_directory(path, ec)) return false;
+  if (fs::exists(path, ec)) {
+    return make_error(ErrorCode::kInvalidArgument, dir + " exists and is not a folder");
+  }
+  // "x/" names the folder x: its parent is that of x.
+  const fs::path parent = (path.has_filename() ? path : path.parent_path()).parent_path();
+  if (!create_parents && !parent.empty() && !fs::is_directory(parent, ec)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      dir + ": its parent folder " + parent.string() +
+                          " does not exist (the server creates only the last level of a cache "
+                          "path)");
+  }
+  if (create_parents) {
+    fs::create_directories(path, ec);
+  } else {
+    fs::create_directory(path, ec);
+  }
+  if (ec) return make_error(ErrorCode::kIo, dir + ": cannot create it: " + ec.message());
+  return true;
+}
+
 void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsigned threads,
                 Catalog& catalog, const CatalogLog& log) {
   if (jobs.empty()) return;
   if (!cache_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(cache_dir, ec);
-    if (ec) {
-      log("cache " + cache_dir + " unusable (" + ec.message() + "); encoding in memory");
+    if (!fs::is_directory(cache_dir, ec)) {
+      log(CatalogLogLevel::kWarn,
+          "cache " + cache_dir + " unusable (not a folder); encoding in memory");
       cache_dir.clear();
     }
   }
@@ -97,6 +121,7 @@ void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsig
       std::lock_guard lock(log_mutex);
       std::string line = "[" + std::to_string(++done) + "/" + std::to_string(jobs.size()) + "] ";
       const EncodeOutcome& o = outcomes[i];
+      CatalogLogLevel level = CatalogLogLevel::kInfo;
       if (o.model) {
         char facts[256];
         std::snprintf(facts, sizeof facts, "%s %s: %u vertices, %zu bytes in %.2f s",
@@ -105,8 +130,9 @@ void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsig
         line += facts;
       } else {
         line += "skipped: " + o.model.error().message;  // errors name the input
+        level = CatalogLogLevel::kWarn;
       }
-      log(line);
+      log(level, line);
     }
   };
   std::vector<std::thread> pool;

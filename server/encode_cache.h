@@ -34,9 +34,19 @@ struct EncodeOutcome {
 // Thread-safe for distinct keys. Cost: an encode on a miss, O(1) on a hit.
 EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir);
 
+// Makes `dir` ready to hold cached streams: nothing to do when it is a
+// folder; else creates it, only its last level unless `create_parents` (a
+// mistyped --cache must not grow a tree of folders). True when it was
+// created. kInvalidArgument when it exists as a file or (without
+// `create_parents`) its parent is missing, kIo when creating fails; the
+// message names `dir`.
+Result<bool> prepare_cache_folder(const std::string& dir, bool create_parents);
+
 // Runs `jobs` on `threads` threads (0 = one per core), calling `log` with a
-// progress line as each finishes ("[3/12] encoded bunny.ply: ..."), and adds
-// the successes to `catalog` in job order.
+// progress line as each finishes ("[3/12] encoded bunny.ply: ...", a
+// warning for a failure), and adds the successes to `catalog` in job order.
+// A `cache_dir` that is not a folder is one warning; the jobs then encode
+// in memory.
 void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsigned threads,
                 Catalog& catalog, const CatalogLog& log);
 

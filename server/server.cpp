@@ -43,11 +43,9 @@ constexpr int64_t kMaxRejecting = 256;
 
 }  // namespace
 
-Server::Server(const ServerOptions& options, const Catalog& catalog)
-    : options_(options), catalog_(catalog), first_chunks_(options.first_chunk_hold) {
+Server::Server(const ServerOptions& options)
+    : options_(options), first_chunks_(options.first_chunk_hold) {
   shared_.options = &options_;
-  shared_.catalog = &catalog_;
-  shared_.model_list_frame = model_list_frame(catalog_);
   shared_.hello_frame = hello_frame(options_);
   shared_.active_sessions = &active_sessions_;
   shared_.rejecting_sessions = &rejecting_;
@@ -82,6 +80,12 @@ Status Server::listen() {
                                           ec.message());
   }
   acceptor_ = std::move(acceptor);
+  return {};
+}
+
+void Server::start_serving(const Catalog& catalog) {
+  shared_.catalog = &catalog;
+  shared_.model_list_frame = model_list_frame(catalog);
   // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
   // queues a signal that arrives before run() and delivers it then.
   signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);
@@ -90,7 +94,6 @@ Status Server::listen() {
     spdlog::info("received signal {}", signal);
     stop();
   });
-  return {};
 }
 
 net::tcp::endpoint Server::local_endpoint() const {

@@ -20,18 +20,25 @@ namespace meshstream::server {
 
 class Server {
  public:
-  // `catalog` must outlive the server.
-  Server(const ServerOptions& options, const Catalog& catalog);
+  explicit Server(const ServerOptions& options);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and listens on options.listen_host:listen_port, and from then on
-  // turns SIGINT/SIGTERM into stop(). kIo when the address is unusable (in
-  // use, not local, not an address).
+  // Binds and listens on options.listen_host:listen_port: done before the
+  // catalog is loaded, so an unusable address fails at once instead of
+  // after every model is encoded. Clients that connect before run() wait in
+  // the backlog. kIo when the address is unusable (in use, not local, not an
+  // address); the message names it and the cause.
   Status listen();
   // The bound address (after listen()); port is the real one for port 0.
   net::tcp::endpoint local_endpoint() const;
+
+  // What the server serves (must outlive it), and from now on SIGINT/SIGTERM
+  // mean stop(). Call after listen(), before announcing the port and run().
+  // (Until then the signals keep their default effect, so Ctrl-C while the
+  // models are encoding ends the program at once.)
+  void start_serving(const Catalog& catalog);
 
   // Serves until stop() or SIGINT/SIGTERM, then shuts down cleanly (sessions
   // get up to `grace` to close) and returns. Blocks the calling thread.
@@ -50,7 +57,6 @@ class Server {
   void begin_shutdown();  // on worker 0
 
   const ServerOptions& options_;
-  const Catalog& catalog_;
   FirstChunkGate first_chunks_;
   ServerShared shared_;
   std::atomic<int64_t> active_sessions_{0};

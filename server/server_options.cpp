@@ -44,14 +44,16 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   uint64_t stall_ms = o.stall_timeout.count();
   uint64_t hold_ms = o.first_chunk_hold.count();
   app.add_option("--models", o.models_dir,
-                 "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded at start-up")
-      ->check(CLI::ExistingDirectory);
-  app.add_option("--listen", listen, "address to listen on, HOST:PORT (port 0 = any free port)")
+                 "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded at start-up; "
+                 "other files are skipped with a warning");
+  app.add_option("--listen", listen,
+                 "address to listen on, HOST:PORT (port 0 = any free port); bound before the "
+                 "models load, so a busy port fails at once")
       ->capture_default_str();
   app.add_flag("--demo", o.demo, "also serve the procedural demo models");
   app.add_option("--cache", cache,
                  "cache folder for encoded meshes (default $XDG_CACHE_HOME/meshstream or "
-                 "~/.cache/meshstream; 'none' disables)");
+                 "~/.cache/meshstream; 'none' disables); only its last level is created");
   app.add_option("--max-connections", o.max_connections, "clients served at once; more get 'busy'")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1000000u));
@@ -101,6 +103,7 @@ ParsedOptions parse_server_options(int argc, char** argv) {
     return 2;
   }
   o.cache_dir = cache == "none" ? std::string() : cache.empty() ? default_cache_dir() : cache;
+  o.cache_dir_is_default = cache.empty();
   o.handshake_timeout = std::chrono::milliseconds(handshake_ms);
   o.idle_timeout = std::chrono::milliseconds(idle_ms);
   o.stall_timeout = std::chrono::milliseconds(stall_ms);

@@ -16,10 +16,11 @@ struct ServerOptions {
   std::string listen_host = "127.0.0.1";
   uint16_t listen_port = 7878;  // 0 = any free port (printed on stdout)
   bool demo = false;
-  std::string cache_dir;            // default: $XDG_CACHE_HOME/meshstream or ~/.cache/meshstream
-  uint32_t max_connections = 1024;  // extra clients get Error{BUSY}
-  uint64_t rate_bytes_per_s = 0;    // per connection; 0 = unlimited
-  unsigned threads = 0;             // io threads; 0 = one per core
+  std::string cache_dir;             // default: $XDG_CACHE_HOME/meshstream or ~/.cache/meshstream
+  bool cache_dir_is_default = true;  // no --cache given (its parents may be created)
+  uint32_t max_connections = 1024;   // extra clients get Error{BUSY}
+  uint64_t rate_bytes_per_s = 0;     // per connection; 0 = unlimited
+  unsigned threads = 0;              // io threads; 0 = one per core
   std::chrono::milliseconds handshake_timeout{5000};
   std::chrono::milliseconds idle_timeout{60000};
   std::chrono::milliseconds stall_timeout{30000};
@@ -36,7 +37,8 @@ struct ServerOptions {
 using ParsedOptions = std::variant<ServerOptions, int>;
 
 // Parses argv. Usage errors print one line "meshstream-server: <reason>
-// (see --help)" to stderr.
+// (see --help)" to stderr. Whether --models and --cache name usable folders
+// is checked by main (bad input, exit 1), not here.
 ParsedOptions parse_server_options(int argc, char** argv);
 
 }  // namespace meshstream::server

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "server/model_suggestions.h"
+
 namespace meshstream::server {
 namespace {
 
@@ -154,16 +156,17 @@ void Session::send(const google::protobuf::MessageLite& message, bool closing) {
   push(Frame{std::move(bytes), closing}, size);
 }
 
-void Session::send_error(int code, const std::string& message, bool closing) {
+void Session::send_error(v1::Error::Code code, const std::string& message, bool closing) {
   v1::ServerMessage out;
   v1::Error* error = out.mutable_error();
-  error->set_code(static_cast<v1::Error::Code>(code));
+  error->set_code(code);
   error->set_message(message);
   error->set_closing(closing);
   send(out, closing);
 }
 
-void Session::fail(int code, const std::string& message, const std::string& log_reason) {
+void Session::fail(v1::Error::Code code, const std::string& message,
+                   const std::string& log_reason) {
   if (closing_) return;
   closing_ = true;
   set_end_reason(log_reason);
@@ -246,8 +249,12 @@ void Session::handle(const v1::ClientMessage& message) {
 void Session::handle_stream(const v1::StreamRequest& request) {
   const CatalogModel* model = shared_.catalog->find(request.model());
   if (!model) {
-    std::string shown = request.model().substr(0, 128);
-    send_error(v1::Error::UNKNOWN_MODEL, "unknown model '" + shown + "'", false);
+    std::vector<std::string> names;
+    for (const CatalogModel* m : shared_.catalog->models()) names.push_back(m->name);
+    const std::string message =
+        unknown_model_message(request.model(), closest_names(request.model(), names));
+    spdlog::info("session {}: {}", peer_, message);
+    send_error(v1::Error::UNKNOWN_MODEL, message, false);
     return;
   }
   Budget budget;
@@ -285,7 +292,12 @@ void Session::handle_stream(const v1::StreamRequest& request) {
   }
   ++starting_;
   shared_.first_chunks->stream_starting(Clock::now());
-  push(StartStream{model, *plan, chunk, Clock::now(), request.compact_index()}, 0);
+  push(StartStream{.model = model,
+                   .plan = *plan,
+                   .chunk_bytes = chunk,
+                   .requested = Clock::now(),
+                   .compact_index = request.compact_index()},
+       0);
 }
 
 // ------------------------------------------------------------------ writer
@@ -304,10 +316,10 @@ awaitable<bool> Session::write(const Buffers& buffers) {
   co_return true;
 }
 
-awaitable<bool> Session::write_end(int reason) {
+awaitable<bool> Session::write_end(v1::StreamEnd::Reason reason) {
   v1::ServerMessage out;
   v1::StreamEnd* end = out.mutable_end();
-  end->set_reason(static_cast<v1::StreamEnd::Reason>(reason));
+  end->set_reason(reason);
   end->set_bytes_sent(stream_->bytes_sent);
   end->set_end_offset(stream_->position);
   end->set_records_complete(stream_->records_complete);
@@ -377,107 +389,143 @@ std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& p
 
 awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
   while (!closed_) {
-    if (!pending_header_.empty() &&
-        (!queue_.empty() || !stream_ || stream_->position >= stream_->plan.end)) {
-      // Something else must follow the header: send it on its own.
-      const std::vector<uint8_t> header = std::move(pending_header_);
-      pending_header_.clear();
-      started_one();
-      if (!co_await write(asio::buffer(header))) break;
-      continue;
+    bool go_on = true;
+    if (header_must_go_alone()) {
+      go_on = co_await write_header_alone();
+    } else if (!queue_.empty()) {
+      go_on = co_await write_queued_item();  // control items before the stream's chunks
+    } else if (stream_) {
+      go_on = co_await write_stream_step();
+    } else {
+      co_await wait_for_work();
     }
-    if (!queue_.empty()) {
-      Item item = std::move(queue_.front());
-      queue_.pop_front();
-      if (auto* frame = std::get_if<Frame>(&item)) {
-        queued_bytes_ -= frame->bytes->size();
-        wake(reader_wake_);
-        if (!co_await write(asio::buffer(*frame->bytes))) break;
-        if (frame->closing) {
-          // Graceful close: FIN after our last frame, then drain what the
-          // client still sends until it closes or the linger ends.
-          boost::system::error_code ec;
-          socket_.shutdown(net::tcp::socket::shutdown_send, ec);
-          linger_deadline_ = Clock::now() + linger_;
-          wake(watchdog_timer_);
-          break;
-        }
-      } else if (auto* start = std::get_if<StartStream>(&item)) {
-        if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
-        const CatalogModel& model = *start->model;
-        stream_.emplace(ActiveStream{&model, model.bytes, start->plan, start->chunk_bytes,
-                                     start->plan.start, 0,
-                                     records_complete_at(model.index, start->plan.start),
-                                     TokenBucket(double(shared_.options->rate_bytes_per_s),
-                                                 double(start->chunk_bytes), Clock::now()),
-                                     0, false, start->requested});
-        ++streams_;
-        if (models_.find(model.name) == std::string::npos) {
-          models_ += models_.empty() ? model.name : "," + model.name;
-        }
-        pending_header_ =
-            header_frame(model, start->plan, start->chunk_bytes, start->compact_index);
-      } else {  // CancelStream
-        if (stream_ && !co_await write_end(v1::StreamEnd::CANCELLED)) break;
-      }
-      continue;
-    }
-    if (stream_) {
-      ActiveStream& s = *stream_;
-      if (s.position >= s.plan.end) {
-        if (!co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET))
-          break;
-        continue;
-      }
-      const size_t limit =
-          std::min(s.chunk_bytes, kFirstChunkBytes << std::min<uint32_t>(s.chunks_sent, 20));
-      if (s.chunks_sent > 0) {
-        // Bulk: new streams' first chunks go first (held up to the gate's
-        // bound); past it, still one step back per chunk while any wait.
-        if (!co_await wait_for_first_chunks()) break;
-        if (!queue_.empty()) continue;  // a request came while we waited
-        if (shared_.first_chunks->starting() > 0 && !s.yielded) {
-          s.yielded = true;
-          co_await asio::post(socket_.get_executor(), use_awaitable);
-          continue;
-        }
-      }
-      s.yielded = false;
-      const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
-      const size_t size = static_cast<size_t>(cut.end - s.position);
-      // The stream header goes out with the first chunk and is paced with it,
-      // so --rate behaves like a slow link (the header is most of what a
-      // client waits for before its first mesh when the index is not compact).
-      const auto delay = s.bucket.take(size + pending_header_.size(), Clock::now());
-      if (delay > Clock::duration::zero()) {
-        pacing_timer_.expires_after(delay);
-        boost::system::error_code ignored;
-        co_await pacing_timer_.async_wait(asio::redirect_error(use_awaitable, ignored));
-        if (closed_) break;
-      }
-      const proto::ChunkFrameHead head =
-          proto::encode_chunk_frame_head(s.position, cut.records_complete, size);
-      const std::array<asio::const_buffer, 3> buffers{
-          asio::buffer(pending_header_),  // empty except before the first chunk
-          asio::buffer(head.bytes, head.size),
-          asio::buffer(s.model->stream().data() + s.position, size)};
-      if (s.chunks_sent == 0) note_first_chunk(s.requested);
-      if (!pending_header_.empty()) started_one();
-      const bool written = co_await write(buffers);
-      pending_header_.clear();
-      if (!written) break;
-      // Only this coroutine replaces stream_, so `s` is the stream just written.
-      s.position = cut.end;
-      s.bytes_sent += size;
-      s.records_complete = cut.records_complete;
-      ++s.chunks_sent;
-      bytes_total_ += size;
-      continue;
-    }
-    writer_wake_.expires_at(Clock::time_point::max());
-    boost::system::error_code ignored;
-    co_await writer_wake_.async_wait(asio::redirect_error(use_awaitable, ignored));
+    if (!go_on) break;
   }
+}
+
+bool Session::header_must_go_alone() const {
+  return !pending_header_.empty() &&
+         (!queue_.empty() || !stream_ || stream_->position >= stream_->plan.end);
+}
+
+awaitable<bool> Session::write_header_alone() {
+  const std::vector<uint8_t> header = std::move(pending_header_);
+  pending_header_.clear();
+  started_one();
+  co_return co_await write(asio::buffer(header));
+}
+
+awaitable<bool> Session::write_queued_item() {
+  Item item = std::move(queue_.front());
+  queue_.pop_front();
+  if (const auto* frame = std::get_if<Frame>(&item)) co_return co_await write_frame(*frame);
+  if (const auto* start = std::get_if<StartStream>(&item)) co_return co_await begin_stream(*start);
+  // CancelStream. (No co_await inside || or &&: GCC 12 evaluates it anyway.)
+  if (!stream_) co_return true;
+  co_return co_await write_end(v1::StreamEnd::CANCELLED);
+}
+
+awaitable<bool> Session::write_frame(const Frame& frame) {
+  queued_bytes_ -= frame.bytes->size();
+  wake(reader_wake_);
+  if (!co_await write(asio::buffer(*frame.bytes))) co_return false;
+  if (frame.closing) {
+    // Graceful close: FIN after our last frame, then drain what the client
+    // still sends until it closes or the linger ends.
+    boost::system::error_code ec;
+    socket_.shutdown(net::tcp::socket::shutdown_send, ec);
+    linger_deadline_ = Clock::now() + linger_;
+    wake(watchdog_timer_);
+    co_return false;
+  }
+  co_return true;
+}
+
+awaitable<bool> Session::begin_stream(const StartStream& start) {
+  if (stream_) {
+    if (!co_await write_end(v1::StreamEnd::CANCELLED)) co_return false;
+  }
+  const CatalogModel& model = *start.model;
+  stream_.emplace(ActiveStream{
+      .model = &model,
+      .keep_alive = model.bytes,
+      .plan = start.plan,
+      .chunk_bytes = start.chunk_bytes,
+      .requested = start.requested,
+      .bucket = TokenBucket(double(shared_.options->rate_bytes_per_s), double(start.chunk_bytes),
+                            Clock::now()),
+      .position = start.plan.start,
+      .records_complete = records_complete_at(model.index, start.plan.start),
+  });
+  ++streams_;
+  if (models_.find(model.name) == std::string::npos) {
+    models_ += models_.empty() ? model.name : "," + model.name;
+  }
+  // Sent with the first chunk (write_chunk), or alone if something else
+  // must go first (write_header_alone).
+  pending_header_ = header_frame(model, start.plan, start.chunk_bytes, start.compact_index);
+  co_return true;
+}
+
+awaitable<bool> Session::write_stream_step() {
+  ActiveStream& s = *stream_;
+  if (s.position >= s.plan.end) {
+    co_return co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET);
+  }
+  if (s.chunks_sent > 0) {
+    // Bulk: new streams' first chunks go first (held up to the gate's
+    // bound); past it, still one step back per chunk while any wait.
+    if (!co_await wait_for_first_chunks()) co_return false;
+    if (!queue_.empty()) co_return true;  // a request came while we waited
+    if (shared_.first_chunks->starting() > 0 && !s.yielded) {
+      s.yielded = true;
+      co_await asio::post(socket_.get_executor(), use_awaitable);
+      co_return true;
+    }
+  }
+  s.yielded = false;
+  co_return co_await write_chunk(s);
+}
+
+awaitable<bool> Session::write_chunk(ActiveStream& s) {
+  const size_t limit =
+      std::min(s.chunk_bytes, kFirstChunkBytes << std::min<uint32_t>(s.chunks_sent, 20));
+  const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
+  const size_t size = static_cast<size_t>(cut.end - s.position);
+  // The stream header goes out with the first chunk and is paced with it,
+  // so --rate behaves like a slow link (the header is most of what a
+  // client waits for before its first mesh when the index is not compact).
+  const auto delay = s.bucket.take(size + pending_header_.size(), Clock::now());
+  if (delay > Clock::duration::zero()) {
+    pacing_timer_.expires_after(delay);
+    boost::system::error_code ignored;
+    co_await pacing_timer_.async_wait(asio::redirect_error(use_awaitable, ignored));
+    if (closed_) co_return false;
+  }
+  const proto::ChunkFrameHead head =
+      proto::encode_chunk_frame_head(s.position, cut.records_complete, size);
+  const std::array<asio::const_buffer, 3> buffers{
+      asio::buffer(pending_header_),  // empty except before the first chunk
+      asio::buffer(head.bytes, head.size),
+      asio::buffer(s.model->stream().data() + s.position, size)};
+  if (s.chunks_sent == 0) note_first_chunk(s.requested);
+  if (!pending_header_.empty()) started_one();
+  const bool written = co_await write(buffers);
+  pending_header_.clear();
+  if (!written) co_return false;
+  // Only the writer replaces stream_, so `s` is the stream just written.
+  s.position = cut.end;
+  s.bytes_sent += size;
+  s.records_complete = cut.records_complete;
+  ++s.chunks_sent;
+  bytes_total_ += size;
+  co_return true;
+}
+
+awaitable<void> Session::wait_for_work() {
+  writer_wake_.expires_at(Clock::time_point::max());
+  boost::system::error_code ignored;
+  co_await writer_wake_.async_wait(asio::redirect_error(use_awaitable, ignored));
 }
 
 awaitable<bool> Session::wait_for_first_chunks() {

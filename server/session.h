@@ -76,9 +76,9 @@ class Session : public std::enable_shared_from_this<Session> {
     bool closing = false;  // close gracefully after writing it
   };
   struct StartStream {
-    const CatalogModel* model;
+    const CatalogModel* model = nullptr;
     StreamPlan plan;
-    size_t chunk_bytes;
+    size_t chunk_bytes = 0;
     Clock::time_point requested;  // when its request was read
     bool compact_index = false;   // StreamRequest.compact_index
   };
@@ -86,34 +86,51 @@ class Session : public std::enable_shared_from_this<Session> {
   using Item = std::variant<Frame, StartStream, CancelStream>;
 
   struct ActiveStream {
-    const CatalogModel* model;
+    const CatalogModel* model = nullptr;
     std::shared_ptr<const StreamBytes> keep_alive;
     StreamPlan plan;
-    size_t chunk_bytes;
-    uint64_t position;
-    uint64_t bytes_sent = 0;
-    uint32_t records_complete;
+    size_t chunk_bytes = 0;
+    Clock::time_point requested;
     TokenBucket bucket;
+    uint64_t position = 0;  // next byte to send
+    uint32_t records_complete = 0;
+    uint64_t bytes_sent = 0;
     uint32_t chunks_sent = 0;
     bool yielded = false;  // this chunk already stepped back once for new streams
-    Clock::time_point requested;
   };
 
   net::asio::awaitable<void> read_loop(std::shared_ptr<Session> self);
   net::asio::awaitable<void> write_loop(std::shared_ptr<Session> self);
   net::asio::awaitable<void> watchdog(std::shared_ptr<Session> self);
+
+  // The writer's phases (write_loop runs the first that applies, then looks
+  // again). Each returns false when the writer must stop: the connection
+  // closed, or our closing frame went out.
+  // A pending stream header that cannot ride with a first chunk.
+  bool header_must_go_alone() const;
+  net::asio::awaitable<bool> write_header_alone();
+  // The oldest queued control item: a frame, a new stream or a cancel.
+  net::asio::awaitable<bool> write_queued_item();
+  net::asio::awaitable<bool> write_frame(const Frame& frame);
+  net::asio::awaitable<bool> begin_stream(const StartStream& start);
+  // The running stream: its next chunk, or its StreamEnd once all is sent.
+  net::asio::awaitable<bool> write_stream_step();
+  net::asio::awaitable<bool> write_chunk(ActiveStream& stream);
+  // Nothing to write: sleeps until push() or close wakes the writer.
+  net::asio::awaitable<void> wait_for_work();
+
   // Writes `buffers` as the one write in flight; false (and closed) on failure.
   template <class Buffers>
   net::asio::awaitable<bool> write(const Buffers& buffers);
-  net::asio::awaitable<bool> write_end(int reason);
+  net::asio::awaitable<bool> write_end(v1::StreamEnd::Reason reason);
 
   void handle(const v1::ClientMessage& message);
   void handle_stream(const v1::StreamRequest& request);
   void push(Item item, size_t bytes);
   void send(const google::protobuf::MessageLite& message, bool closing = false);
-  void send_error(int code, const std::string& message, bool closing);
+  void send_error(v1::Error::Code code, const std::string& message, bool closing);
   // Fatal for the connection: error frame, then graceful close.
-  void fail(int code, const std::string& message, const std::string& log_reason);
+  void fail(v1::Error::Code code, const std::string& message, const std::string& log_reason);
   void close_now(const std::string& reason);
   void set_end_reason(const std::string& reason);
   void wake(net::asio::steady_timer& timer) { timer.cancel(); }

@@ -315,6 +315,39 @@ TEST_F(NetTest, UnknownModelsAreErrorsNeverPaths) {
   EXPECT_TRUE(read_stream(c).ok);
 }
 
+// Issue 21 row 16: the error frame suggests the close names, the server logs
+// the request (control bytes escaped, so a client cannot forge log lines).
+TEST_F(NetTest, UnknownModelSuggestsCloseNamesAndIsLogged) {
+  TestClient c = connected();
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"smal", "unknown model 'smal': did you mean 'small'? (see --list)"},
+      {"small.hcs", "unknown model 'small.hcs': did you mean 'small'? (see --list)"},
+      {"bgi", "unknown model 'bgi': did you mean 'big'? (see --list)"},
+      {"teapot", "unknown model 'teapot' (see --list)"},
+      {"evil\nname", "unknown model 'evil\\x0aname' (see --list)"}};
+  for (const auto& [name, expected] : cases) {
+    ASSERT_TRUE(c.stream(name));
+    v1::ServerMessage m;
+    ASSERT_EQ(c.read(m), ReadEnd::kMessage);
+    ASSERT_TRUE(m.has_error()) << m.DebugString();
+    EXPECT_EQ(m.error().code(), v1::Error::UNKNOWN_MODEL);
+    EXPECT_EQ(m.error().message(), expected);
+    EXPECT_FALSE(m.error().closing());
+  }
+  // The log has each request, on one line.
+  const auto deadline = Clock::now() + 2s;
+  while (server_->log().find("unknown model 'evil") == std::string::npos &&
+         Clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  const std::string log = server_->log();
+  EXPECT_NE(log.find(": unknown model 'smal': did you mean 'small'? (see --list)"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find(": unknown model 'evil\\x0aname' (see --list)"), std::string::npos) << log;
+  EXPECT_EQ(log.find("evil\nname"), std::string::npos) << log;
+}
+
 // Sends `bytes` on a fresh connection (after Hello when `after_hello`) and
 // expects one Error frame with `code`, then the close.
 void expect_error_and_close(uint16_t port, const std::vector<uint8_t>& bytes, bool after_hello,
@@ -646,8 +679,9 @@ TEST(NetServer, SigintWithNoClientsExitsZero) {
 }
 
 TEST(NetServer, UsageErrorsExitTwoWithOneLine) {
-  for (const std::string args : {"", "--models /nonexistent/dir", "--models . --listen nope",
-                                 "--models . --max-connections 0", "--bogus"}) {
+  // (--models naming no folder is bad input, exit 1: startup_test.cpp.)
+  for (const std::string args :
+       {"", "--models . --listen nope", "--models . --max-connections 0", "--bogus"}) {
     const std::string cmd =
         server_binary() + " " + args + " > /dev/null 2> " + models().dir + "/usage.txt";
     const int status = std::system(cmd.c_str());
