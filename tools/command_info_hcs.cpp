@@ -54,10 +54,13 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
   const uint64_t total = index->total_bytes();
   const FileCoverage in_file = coverage_of(*index, bytes.size());
   const double bpv = h.vertex_count ? 8.0 * double(total) / h.vertex_count : 0.0;
-  size_t structure = 0, planes = 0;
+  size_t structure = 0, planes = 0, unknown = 0;  // kinds after the base
   for (size_t i = 1; i < index->records.size(); ++i) {
     const char* kind = record_kind(bytes, index->records[i], i);
-    if (!kind) continue;
+    if (!kind) {
+      ++unknown;
+      continue;
+    }
     (std::string(kind) == "plane" ? planes : structure) += 1;
   }
   if (json) {
@@ -127,10 +130,7 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
   std::printf("base mesh: %u vertices, %u faces, %u bytes\n", h.base_vertex_count,
               h.base_face_count, index->records[0].size);
   std::string not_in_file;
-  if (in_file.missing_records() > 0) {
-    not_in_file =
-        "; " + std::to_string(in_file.missing_records()) + " not in the file, kind unknown";
-  }
+  if (unknown > 0) not_in_file = "; " + std::to_string(unknown) + " not in the file, kind unknown";
   std::printf("records: %u (base, %zu structure, %zu plane: bit planes of positions%s)%s\n",
               in_file.records, structure, planes, not_in_file.c_str(),
               list_records ? "" : "; --records lists them");
