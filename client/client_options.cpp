@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <iostream>
 
+#include "common/cli/budget_options.h"
+#include "common/cli/version.h"
+
 namespace meshstream::client {
 
 bool ClientOptions::saves_record(uint32_t index) const {
@@ -31,10 +34,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       "meshstream-client: stream a model from a meshstream server, decode every refinement "
       "as it arrives and post-process it with ASA"};
   std::string address, rule = "zorin", path = "auto";
-  std::optional<uint64_t> bytes;
-  std::optional<uint32_t> vertices;
-  std::optional<double> percent, percent_bytes;
   int reconnect_attempts = o.reconnect.max_attempts;
+  cli::add_version_flag(app, "meshstream-client");
   app.add_option("address", address, "server address HOST:PORT")->required();
   app.add_option("model", o.model, "model name to stream (see --list)");
   app.add_flag("--list", o.list, "list the server's models and exit");
@@ -70,22 +71,10 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
       ->check(CLI::IsMember({"auto", "full", "incremental"}))
       ->capture_default_str();
-  auto* b =
-      app.add_option("--bytes", bytes, "stop at the last record boundary within N stream bytes");
-  auto* v =
-      app.add_option("--vertices", vertices, "stop after the last record with at most N vertices");
-  auto* p = app.add_option(
-                   "--percent", percent,
-                   "stop after the last record with at most P percent of the full mesh's vertices "
-                   "(0 < P <= 100; as `meshstream decode --percent`)")
-                ->check(CLI::Range(0.0, 100.0));
-  auto* pb = app.add_option("--percent-bytes", percent_bytes,
-                            "stop at the last record boundary within P percent of the stream's "
-                            "bytes (0 < P <= 100)")
-                 ->check(CLI::Range(0.0, 100.0));
-  b->excludes(v)->excludes(p)->excludes(pb);
-  v->excludes(p)->excludes(pb);
-  p->excludes(pb);
+  // The rule of every program's budgets: common/cli/budget_options.h.
+  cli::add_budget_options(app, o.budget,
+                          {Budget::Kind::kBytes, Budget::Kind::kVertices,
+                           Budget::Kind::kPercentVertices, Budget::Kind::kPercentBytes});
   app.add_flag("--json", o.json, "print one JSON event per line on stdout");
   app.add_flag("--view", o.view, "open a window that shows the model as it refines");
   app.add_option("--snapshot", o.snapshot_png,
@@ -133,9 +122,6 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   o.port = hp->port;
   if (!o.list && o.model.empty()) return usage("name a MODEL to stream, or use --list");
   if (o.list && !o.model.empty()) return usage("--list takes no MODEL");
-  // !(x > 0) also refuses NaN, which CLI11's range check lets through.
-  if (percent && !(*percent > 0)) return usage("--percent must be in (0, 100]");
-  if (percent_bytes && !(*percent_bytes > 0)) return usage("--percent-bytes must be in (0, 100]");
   if (o.snapshot_at && o.snapshot_png.empty())
     return usage("--snapshot-at needs --snapshot FILE.png");
   if (!o.snapshot_png.empty() && extension_of(o.snapshot_png) != ".png") {
@@ -151,10 +137,6 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   o.asa_path = path == "full"          ? AsaPath::kFull
                : path == "incremental" ? AsaPath::kIncremental
                                        : AsaPath::kAuto;
-  if (bytes) o.budget = {Budget::Kind::kBytes, static_cast<double>(*bytes)};
-  if (vertices) o.budget = {Budget::Kind::kVertices, static_cast<double>(*vertices)};
-  if (percent) o.budget = {Budget::Kind::kPercentVertices, *percent};
-  if (percent_bytes) o.budget = {Budget::Kind::kPercentBytes, *percent_bytes};
   o.reconnect.max_attempts = reconnect_attempts;
   return o;
 }

@@ -73,6 +73,9 @@ v1::Budget to_proto(const Budget& b) {
     case Budget::Kind::kPercentBytes:
       out.set_percent(b.value);
       break;
+    case Budget::Kind::kRatio:  // no wire form and no client option: the nearest percent
+      out.set_percent(100.0 / b.value);
+      break;
   }
   return out;
 }

@@ -20,18 +20,15 @@
 #include "client/connection.h"
 #include "client/decoded_stream.h"
 #include "client/stream_facts.h"
+#include "common/codec/budget.h"
 
 namespace meshstream::client {
 
-// Where the stream stops (proto/meshstream.proto, Budget). kPercentVertices
-// is HCS's "percentage of points" (wire percent_vertices, the rule of
-// `meshstream decode --percent`); kPercentBytes is a percent of the stream's
-// bytes (wire percent).
-struct Budget {
-  enum class Kind { kAll, kBytes, kVertices, kPercentVertices, kPercentBytes };
-  Kind kind = Kind::kAll;
-  double value = 0;
-};
+// Where the stream stops: the shared meshstream::Budget
+// (common/codec/budget.h), sent as the wire's Budget (proto/meshstream.proto).
+// kPercentVertices is HCS's "percentage of points" (wire percent_vertices,
+// the rule of `meshstream decode --percent`); kPercentBytes is a percent of
+// the stream's bytes (wire percent).
 
 struct ReconnectPolicy {
   Millis first_delay{50};

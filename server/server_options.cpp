@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "common/cli/version.h"
+
 namespace meshstream::server {
 namespace {
 
@@ -43,6 +45,7 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   uint64_t idle_ms = o.idle_timeout.count();
   uint64_t stall_ms = o.stall_timeout.count();
   uint64_t hold_ms = o.first_chunk_hold.count();
+  cli::add_version_flag(app, "meshstream-server");
   app.add_option("--models", o.models_dir,
                  "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded at start-up; "
                  "other files are skipped with a warning");

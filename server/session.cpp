@@ -257,26 +257,7 @@ void Session::handle_stream(const v1::StreamRequest& request) {
     send_error(v1::Error::UNKNOWN_MODEL, message, false);
     return;
   }
-  Budget budget;
-  if (request.has_budget()) {
-    const v1::Budget& b = request.budget();
-    switch (b.limit_case()) {
-      case v1::Budget::kBytes:
-        budget = ByteBudget{b.bytes()};
-        break;
-      case v1::Budget::kVertices:
-        budget = VertexBudget{b.vertices()};
-        break;
-      case v1::Budget::kPercent:
-        budget = PercentBudget{b.percent()};
-        break;
-      case v1::Budget::kPercentVertices:
-        budget = PercentVerticesBudget{b.percent_vertices()};
-        break;
-      default:
-        break;
-    }
-  }
+  const Budget budget = request.has_budget() ? budget_from_wire(request.budget()) : Budget{};
   auto plan = plan_stream(model->index, request.resume_offset(), budget);
   if (!plan) {
     send_error(v1::Error::INVALID_REQUEST, plan.error().message, false);

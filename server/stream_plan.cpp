@@ -1,8 +1,6 @@
 #include "server/stream_plan.h"
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <string>
 
 #include "common/codec/decoder.h"
@@ -24,17 +22,41 @@ uint32_t records_within_bytes(const StreamIndex& index, uint64_t bytes) {
   return std::max<uint32_t>(1, first_ending_after(index, bytes));
 }
 
-bool valid_percent(double p) { return std::isfinite(p) && p > 0 && p <= 100; }
-
-tl::unexpected<Error> bad_percent(const std::string& what, double value) {
-  // Shortest round-trip form: "nan", "-0", "101", "100.0000001" as sent.
-  char shown[64];
-  const auto end = std::to_chars(shown, shown + sizeof shown, value).ptr;
-  return make_error(ErrorCode::kInvalidArgument,
-                    what + " " + std::string(shown, end) + " is not in (0, 100]");
+// The wire field a budget came from, for INVALID_REQUEST messages.
+const char* wire_name(Budget::Kind kind) {
+  switch (kind) {
+    case Budget::Kind::kBytes:
+      return "budget bytes";
+    case Budget::Kind::kVertices:
+      return "budget vertices";
+    case Budget::Kind::kPercentBytes:
+      return "budget percent (of bytes)";
+    case Budget::Kind::kPercentVertices:
+      return "budget percent_vertices";
+    case Budget::Kind::kAll:
+    case Budget::Kind::kRatio:
+      break;
+  }
+  return "budget";
 }
 
 }  // namespace
+
+Budget budget_from_wire(const v1::Budget& wire) {
+  switch (wire.limit_case()) {
+    case v1::Budget::kBytes:
+      return Budget::bytes(double(std::min<uint64_t>(wire.bytes(), kMaxBudgetBytes)));
+    case v1::Budget::kVertices:
+      return Budget::vertices(wire.vertices());
+    case v1::Budget::kPercent:
+      return Budget::percent_bytes(wire.percent());
+    case v1::Budget::kPercentVertices:
+      return Budget::percent_vertices(wire.percent_vertices());
+    case v1::Budget::LIMIT_NOT_SET:
+      break;
+  }
+  return Budget::all();
+}
 
 uint32_t records_complete_at(const StreamIndex& index, uint64_t offset) {
   return first_ending_after(index, offset);
@@ -45,25 +67,14 @@ Result<StreamPlan> plan_stream(const StreamIndex& index, uint64_t resume_offset,
   const auto count = static_cast<uint32_t>(index.records.size());
   const uint64_t total = index.total_bytes();
 
-  uint32_t end_record = count;
-  if (const auto* b = std::get_if<ByteBudget>(&budget)) {
-    end_record = records_within_bytes(index, b->bytes);
-  } else if (const auto* v = std::get_if<VertexBudget>(&budget)) {
-    auto it = std::upper_bound(index.records.begin(), index.records.end(), v->vertices,
-                               [](uint32_t n, const RecordEntry& r) { return n < r.vertices; });
-    end_record = std::max<uint32_t>(1, static_cast<uint32_t>(it - index.records.begin()));
-  } else if (const auto* p = std::get_if<PercentBudget>(&budget)) {
-    if (!valid_percent(p->percent)) return bad_percent("budget percent (of bytes)", p->percent);
-    const auto bytes = static_cast<uint64_t>(std::floor(double(total) * p->percent / 100.0));
-    end_record = records_within_bytes(index, bytes);
-  } else if (const auto* pv = std::get_if<PercentVerticesBudget>(&budget)) {
-    if (!valid_percent(pv->percent)) return bad_percent("budget percent_vertices", pv->percent);
-    // The decoder's own rule, so the server ends exactly where
-    // `meshstream decode --percent` does. It returns a record boundary.
-    const uint64_t prefix =
-        prefix_for_budget(index, DecodeBudget{DecodeBudget::Kind::kPercentVertices, pv->percent});
-    end_record = records_within_bytes(index, prefix);
+  if (auto valid = check_budget(budget, wire_name(budget.kind)); !valid) {
+    return tl::unexpected(valid.error());
   }
+  // The decoder's own rule, so the server ends exactly where `meshstream
+  // decode` with the same budget does. It returns a record boundary.
+  const uint32_t end_record = budget.kind == Budget::Kind::kAll
+                                  ? count
+                                  : records_within_bytes(index, prefix_for_budget(index, budget));
 
   StreamPlan plan;
   plan.end_record = end_record;

@@ -9,32 +9,20 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
-#include <variant>
 
 #include "common/base/result.h"
+#include "common/codec/budget.h"
 #include "common/codec/container.h"
+#include "proto/meshstream.pb.h"
 
 namespace meshstream::server {
 
-struct ByteBudget {
-  uint64_t bytes;
-};
-struct VertexBudget {
-  uint32_t vertices;
-};
-// Percent of the stream's bytes (wire Budget.percent).
-struct PercentBudget {
-  double percent;
-};
-// Percent of the full mesh's vertices (wire Budget.percent_vertices): the
-// rule of `meshstream decode --percent`, i.e. prefix_for_budget's
-// kPercentVertices (common/codec/decoder.h).
-struct PercentVerticesBudget {
-  double percent;
-};
-// monostate = whole stream.
-using Budget =
-    std::variant<std::monostate, ByteBudget, VertexBudget, PercentBudget, PercentVerticesBudget>;
+// The budget is the shared meshstream::Budget (common/codec/budget.h).
+// From the wire's Budget: bytes (clamped to kMaxBudgetBytes: any budget past
+// the end is the whole stream), vertices, percent (kPercentBytes),
+// percent_vertices; kAll when no case is set. Values are not checked here
+// (plan_stream does).
+Budget budget_from_wire(const v1::Budget& wire);
 
 struct StreamPlan {
   uint64_t start = 0;         // first byte sent (0 or a record's offset)
@@ -44,11 +32,12 @@ struct StreamPlan {
   bool complete = false;      // end is the end of the whole stream
 };
 
-// Resolves a request against `index`. kInvalidArgument for a percent (of
-// bytes or of vertices) outside (0, 100] or not finite; the message names
-// the value. Never fails for offsets or budgets past the end (they are
-// clamped). O(log records), O(records) for a vertex percent (it reuses the
-// decoder's prefix_for_budget so both sides choose the same record).
+// Resolves a request against `index`. kInvalidArgument for a budget value
+// check_budget refuses (a percent outside (0, 100] or not finite); the
+// message names the value. Never fails for offsets or budgets past the end
+// (they are clamped). O(records): the end is the decoder's
+// prefix_for_budget, so the server stops exactly where `meshstream decode`
+// with the same budget does.
 Result<StreamPlan> plan_stream(const StreamIndex& index, uint64_t resume_offset,
                                const Budget& budget);
 

@@ -1,16 +1,18 @@
-// `meshstream info IN.hcs [--json]`: the stream's header, base mesh, every
-// record (bytes, vertices, faces) and totals, read from the index alone
-// (nothing is decoded, as the server does).
+// `meshstream info IN.hcs [--records] [--json]`: the stream's header, base
+// mesh and a summary of its records (with --records, every record's offset,
+// bytes, vertices, faces and kind; --json always has them), read from the
+// index alone (nothing is decoded, as the server does). A file cut short is
+// said so on the second line: how many records are complete, which one is
+// partial, how many are missing.
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "common/codec/base_coder.h"
 #include "common/codec/container.h"
 #include "common/codec/refinement_codec.h"
 #include "tools/commands.h"
+#include "tools/hcs_file.h"
 
 namespace meshstream::tools {
 namespace {
@@ -25,44 +27,64 @@ const char* base_coder_name(uint8_t id) {
   return "unknown";
 }
 
-// "base", "structure", "plane" (bit planes of positions), or "?" when the
-// file is cut short before the record.
+// "base", "structure", "plane" (bit planes of positions), or nullptr when
+// the record's first byte is not in the file (it is cut short).
 const char* record_kind(const std::vector<uint8_t>& bytes, const RecordEntry& r, size_t i) {
   if (i == 0) return "base";
-  if (r.offset >= bytes.size() || r.size == 0) return "?";
+  if (r.offset >= bytes.size() || r.size == 0) return nullptr;
   return bytes[r.offset] == kRecordPlane ? "plane" : "structure";
+}
+
+// Whether record i is whole in the file, begun, or absent.
+const char* record_presence(const FileCoverage& in_file, size_t i) {
+  if (i < in_file.complete_records) return "complete";
+  if (i == in_file.complete_records && in_file.partial_record) return "partial";
+  return "missing";
 }
 
 }  // namespace
 
-int run_info_hcs(const std::string& path, bool json) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return report_failure(Error{ErrorCode::kIo, path + ": cannot open"});
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                             std::istreambuf_iterator<char>());
+int run_info_hcs(const std::string& path, bool json, bool list_records) {
+  auto file = read_whole_file(path);
+  if (!file) return report_failure(file.error());
+  const std::vector<uint8_t>& bytes = *file;
   auto index = read_stream_index(bytes);
   if (!index) return report_failure(std::move(index.error()).with_context(path));
   const StreamHeader& h = index->header;
   const uint64_t total = index->total_bytes();
-  const bool complete = bytes.size() >= total;
+  const FileCoverage in_file = coverage_of(*index, bytes.size());
   const double bpv = h.vertex_count ? 8.0 * double(total) / h.vertex_count : 0.0;
+  size_t structure = 0, planes = 0, unknown = 0;  // kinds after the base
+  for (size_t i = 1; i < index->records.size(); ++i) {
+    const char* kind = record_kind(bytes, index->records[i], i);
+    if (!kind) {
+      ++unknown;
+      continue;
+    }
+    (std::string(kind) == "plane" ? planes : structure) += 1;
+  }
   if (json) {
     nlohmann::json records = nlohmann::json::array();
     for (size_t i = 0; i < index->records.size(); ++i) {
       const RecordEntry& r = index->records[i];
+      const char* kind = record_kind(bytes, r, i);
       records.push_back({{"index", i},
                          {"offset", r.offset},
                          {"bytes", r.size},
                          {"vertices", r.vertices},
                          {"faces", r.faces},
-                         {"kind", record_kind(bytes, r, i)}});
+                         {"kind", kind ? nlohmann::json(kind) : nlohmann::json(nullptr)},
+                         {"in_file", record_presence(in_file, i)}});
     }
     nlohmann::json out = {{"path", path},
                           {"vertices", h.vertex_count},
                           {"faces", h.face_count},
                           {"total_bytes", total},
                           {"file_bytes", bytes.size()},
-                          {"complete", complete},
+                          {"complete", !in_file.cut_short()},
+                          {"complete_records", in_file.complete_records},
+                          {"partial_record", in_file.partial_record},
+                          {"missing_records", in_file.missing_records()},
                           {"bits_per_vertex", bpv},
                           {"quant_bits", h.quant_bits},
                           {"bounds",
@@ -83,9 +105,23 @@ int run_info_hcs(const std::string& path, bool json) {
     std::cout << out.dump() << "\n";
     return 0;
   }
-  std::printf("%s: .hcs stream, %u vertices, %u faces, %llu bytes (%.2f bits/vertex)%s\n",
+  std::printf("%s: .hcs stream, %u vertices, %u faces, %llu bytes (%.2f bits/vertex)\n",
               path.c_str(), h.vertex_count, h.face_count, static_cast<unsigned long long>(total),
-              bpv, complete ? "" : " -- file is cut short");
+              bpv);
+  if (in_file.cut_short()) {
+    std::string partial, decodable;
+    if (in_file.partial_record) {
+      partial = "record " + std::to_string(in_file.complete_records) + " partial, ";
+    }
+    decodable = in_file.complete_records == 0
+                    ? "too short to decode: the base mesh (record 0) is not whole"
+                    : "decode stops after record " + std::to_string(in_file.complete_records - 1);
+    std::printf(
+        "file cut short: %llu of %llu bytes, %u of %u records complete (%s%u missing); %s\n",
+        static_cast<unsigned long long>(in_file.file_bytes),
+        static_cast<unsigned long long>(in_file.stream_bytes), in_file.complete_records,
+        in_file.records, partial.c_str(), in_file.missing_records(), decodable.c_str());
+  }
   std::printf("quantization: %u bits over [%g %g %g] - [%g %g %g]\n", h.quant_bits, h.bounds.min.x,
               h.bounds.min.y, h.bounds.min.z, h.bounds.max.x, h.bounds.max.y, h.bounds.max.z);
   std::printf("header + index: %llu bytes; %u layers; coders: base %s, structure %u, geometry %u\n",
@@ -93,19 +129,24 @@ int run_info_hcs(const std::string& path, bool json) {
               base_coder_name(h.base_coder), h.structure_coder, h.geometry_coder);
   std::printf("base mesh: %u vertices, %u faces, %u bytes\n", h.base_vertex_count,
               h.base_face_count, index->records[0].size);
-  std::printf("%8s %12s %10s %10s %10s  %s\n", "record", "offset", "bytes", "vertices", "faces",
-              "kind");
-  size_t planes = 0;
+  std::string not_in_file;
+  if (unknown > 0) not_in_file = "; " + std::to_string(unknown) + " not in the file, kind unknown";
+  std::printf("records: %u (base, %zu structure, %zu plane: bit planes of positions%s)%s\n",
+              in_file.records, structure, planes, not_in_file.c_str(),
+              list_records ? "" : "; --records lists them");
+  if (!list_records) return 0;
+  // The "in file" column only when there is something to say.
+  const bool presence = in_file.cut_short();
+  std::printf("%8s %12s %10s %10s %10s  %-9s%s\n", "record", "offset", "bytes", "vertices", "faces",
+              "kind", presence ? "  in file" : "");
   for (size_t i = 0; i < index->records.size(); ++i) {
     const RecordEntry& r = index->records[i];
     const char* kind = record_kind(bytes, r, i);
-    planes += std::string(kind) == "plane" ? 1 : 0;
-    std::printf("%8zu %12llu %10u %10u %10u  %s\n", i, static_cast<unsigned long long>(r.offset),
-                r.size, r.vertices, r.faces, kind);
+    std::printf("%8zu %12llu %10u %10u %10u  %-9s%s%s\n", i,
+                static_cast<unsigned long long>(r.offset), r.size, r.vertices, r.faces,
+                kind ? kind : "-", presence ? "  " : "",
+                presence ? record_presence(in_file, i) : "");
   }
-  std::printf("plane records (bit planes of positions): %zu\n", planes);
-  std::printf("total: %zu records, %llu bytes\n", index->records.size(),
-              static_cast<unsigned long long>(total));
   return 0;
 }
 

@@ -18,9 +18,10 @@ void add_compare_command(CLI::App& app, int& exit_code);
 void add_generate_command(CLI::App& app, int& exit_code);
 
 // `meshstream info` on a mesh file and on an .hcs stream (the command
-// dispatches on the file's first bytes).
+// dispatches on the file's first bytes). `list_records`: --records, the
+// per-record table (the summary alone by default).
 int run_info_mesh(const std::string& path, bool json);
-int run_info_hcs(const std::string& path, bool json);
+int run_info_hcs(const std::string& path, bool json, bool list_records);
 
 // Prints "meshstream: <message>" to stderr and returns 1, the exit code for
 // bad data and failures.

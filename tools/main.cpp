@@ -1,12 +1,14 @@
 // meshstream: offline tools over mesh files and .hcs streams.
 #include <iostream>
 
+#include "common/cli/version.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
   using namespace meshstream::tools;
   CLI::App app{"meshstream: encode, decode, inspect, subdivide and compare meshes"};
   app.require_subcommand(1);
+  meshstream::cli::add_version_flag(app, "meshstream");
   int exit_code = 0;
   add_info_command(app, exit_code);
   add_encode_command(app, exit_code);
@@ -17,7 +19,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     std::cerr << "meshstream: " << e.what() << " (see --help)\n";
     return 2;
   }

@@ -320,6 +320,9 @@ uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget)
         fits = double(index.records[i].vertices) <=
                budget.value / 100.0 * double(index.header.vertex_count) + 1e-9;
         break;
+      case DecodeBudget::Kind::kPercentBytes:
+        fits = double(end_of(i)) <= std::floor(total * budget.value / 100.0);
+        break;
       case DecodeBudget::Kind::kRatio:
         fits = budget.value > 0 && double(end_of(i)) <= total / budget.value + 1e-9;
         break;

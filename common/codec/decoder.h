@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/codec/budget.h"
 #include "common/codec/container.h"
 #include "common/mesh/mesh.h"
 
@@ -82,13 +83,13 @@ class IncrementalDecoder {
 Result<Mesh> decode_hcs(std::span<const uint8_t> stream);
 
 // The prefix length (a record boundary) to decode for a budget, following
-// HCS's decoder controls. Exactly one kind is used.
-struct DecodeBudget {
-  enum class Kind { kAll, kBytes, kVertices, kPercentVertices, kRatio };
-  Kind kind = Kind::kAll;
-  double value = 0;
-};
+// HCS's decoder controls. DecodeBudget is the shared Budget
+// (common/codec/budget.h), the name kept for the codec's callers.
+using DecodeBudget = Budget;
 // The largest record boundary within the budget (at least the base mesh).
+// kPercentBytes is kBytes of floor(total * P / 100), as the server counts
+// the wire's Budget.percent. Values outside budget_problem's rule are not
+// refused here (a ratio <= 0 gives the base mesh). O(records).
 uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget);
 
 }  // namespace meshstream

@@ -1,8 +1,10 @@
-// PLY and OBJ writers. Coordinates are written so that reading them back
+// PLY, OBJ, OFF and binary STL writers. Coordinates are written so that reading them back
 // gives the same float bits: binary PLY stores the floats themselves, text
 // formats use the shortest decimal that round-trips (std::to_chars), which a
 // correctly rounding reader (strtof, from_chars, Draco's parser for
-// ordinary decimals) maps back to the same float.
+// ordinary decimals) maps back to the same float. Binary STL stores the
+// floats too, but three per triangle corner: a reader welds them back into
+// shared vertices (ours does, by bit-identical position).
 #include "common/mesh/export.h"
 
 #include <algorithm>
@@ -219,12 +221,90 @@ Status write_obj(const Mesh& mesh, const std::string& path) {
   return {};
 }
 
+Status write_off(const Mesh& mesh, const std::string& path) {
+  if (auto status = check_writable(mesh, path); !status) return status;
+  File file;
+  if (auto status = open_for_writing(path, file); !status) return status;
+  Writer out(file.get());
+  const bool normals = !mesh.normals.empty();
+  const bool colors = !mesh.colors.empty();
+  const bool texcoords = !mesh.texcoords.empty();
+  // The keyword announces the per-vertex attributes, [ST][C][N]OFF; each
+  // vertex line then holds x y z, the normal, the colour (four floats in
+  // 0..1) and the texture coordinates, in that order.
+  out.text(std::string(texcoords ? "ST" : "") + (colors ? "C" : "") + (normals ? "N" : "") +
+           "OFF\n# written by meshstream\n");
+  out.text(std::to_string(mesh.vertex_count()) + " " + std::to_string(mesh.face_count()) + " 0\n");
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    const Vec3f& p = mesh.positions[v];
+    out.number(p.x), out.put(' '), out.number(p.y), out.put(' '), out.number(p.z);
+    if (normals) {
+      const Vec3f& n = mesh.normals[v];
+      out.put(' '), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '), out.number(n.z);
+    }
+    if (colors) {
+      const Vec4f& c = mesh.colors[v];
+      for (float x : {c.x, c.y, c.z, c.w}) {
+        out.put(' '), out.number(std::clamp(std::isnan(x) ? 0.0f : x, 0.0f, 1.0f));
+      }
+    }
+    if (texcoords) {
+      out.put(' '), out.number(mesh.texcoords[v].x), out.put(' '), out.number(mesh.texcoords[v].y);
+    }
+    out.put('\n');
+    out.maybe_flush();
+  }
+  for (const Triangle& t : mesh.triangles) {
+    out.text("3 ");
+    out.number(t[0]), out.put(' '), out.number(t[1]), out.put(' '), out.number(t[2]), out.put('\n');
+    out.maybe_flush();
+  }
+  if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
+  return {};
+}
+
+Status write_stl(const Mesh& mesh, const std::string& path) {
+  if (auto status = check_writable(mesh, path); !status) return status;
+  File file;
+  if (auto status = open_for_writing(path, file); !status) return status;
+  Writer out(file.get());
+  static_assert(std::endian::native == std::endian::little,
+                "binary STL writer assumes little-endian");
+  // 80-byte header (must not start with "solid", which marks ASCII STL),
+  // the triangle count, then 50 bytes a triangle: the facet normal, three
+  // corners, a zero attribute byte count.
+  char header[80] = {};
+  std::snprintf(header, sizeof header, "binary STL written by meshstream: %u triangles",
+                mesh.face_count());
+  out.raw(header, sizeof header);
+  const uint32_t count = mesh.face_count();
+  out.raw(&count, 4);
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3f& a = mesh.positions[t[0]];
+    const Vec3f& b = mesh.positions[t[1]];
+    const Vec3f& c = mesh.positions[t[2]];
+    const Vec3f n = cross(b - a, c - a);
+    const float len = length(n);
+    const Vec3f unit = len > 0 && std::isfinite(len) ? n / len : Vec3f{};
+    uint8_t record[50] = {};
+    std::memcpy(record, &unit, 12);
+    std::memcpy(record + 12, &a, 12);
+    std::memcpy(record + 24, &b, 12);
+    std::memcpy(record + 36, &c, 12);
+    out.raw(record, sizeof record);
+  }
+  if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
+  return {};
+}
+
 Status write_mesh(const Mesh& mesh, const std::string& path) {
   const std::string ext = lower_extension(path);
   if (ext == "ply") return write_ply(mesh, path, PlyEncoding::kBinary);
   if (ext == "obj") return write_obj(mesh, path);
+  if (ext == "off") return write_off(mesh, path);
+  if (ext == "stl") return write_stl(mesh, path);
   return make_error(ErrorCode::kInvalidArgument,
-                    path + ": cannot write '." + ext + "' files (use .ply or .obj)");
+                    path + ": cannot write '." + ext + "' files (use .ply, .obj, .off or .stl)");
 }
 
 }  // namespace meshstream

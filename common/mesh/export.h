@@ -1,5 +1,8 @@
-// Writing meshes: PLY (binary little-endian or ASCII) and OBJ, with whatever
-// optional attributes the mesh has. Chosen by the file's extension.
+// Writing meshes: PLY (binary little-endian or ASCII), OBJ and OFF with
+// whatever optional attributes the mesh has, binary STL (positions only: the
+// format has no per-vertex attributes). Chosen by the file's extension.
+// Every writer refuses an invalid mesh (kInvalidMesh) and names the file on
+// I/O errors (kIo). O(vertices + faces).
 #pragma once
 
 #include <string>
@@ -14,7 +17,15 @@ enum class PlyEncoding { kBinary, kAscii };
 Status write_ply(const Mesh& mesh, const std::string& path,
                  PlyEncoding encoding = PlyEncoding::kBinary);
 Status write_obj(const Mesh& mesh, const std::string& path);
-// By extension: .ply (binary), .obj. kInvalidArgument for anything else.
+// OFF text: the keyword ([ST][C][N]OFF) announces normals, colours (floats
+// in 0..1) and texture coordinates when the mesh has them.
+Status write_off(const Mesh& mesh, const std::string& path);
+// Binary STL: 50 bytes a triangle (facet normal computed from the corners,
+// zero when degenerate), the corners' floats as they are. Attributes are
+// not written, and vertices no face uses are lost.
+Status write_stl(const Mesh& mesh, const std::string& path);
+// By extension (any case): .ply (binary), .obj, .off, .stl (binary).
+// kInvalidArgument for anything else.
 Status write_mesh(const Mesh& mesh, const std::string& path);
 
 }  // namespace meshstream

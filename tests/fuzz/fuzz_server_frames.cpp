@@ -46,23 +46,8 @@ const StreamIndex& sample_index() {
 
 void handle_stream(const v1::StreamRequest& request) {
   const StreamIndex& index = sample_index();
-  server::Budget budget;
-  if (request.has_budget()) {
-    const v1::Budget& b = request.budget();
-    switch (b.limit_case()) {
-      case v1::Budget::kBytes:
-        budget = server::ByteBudget{b.bytes()};
-        break;
-      case v1::Budget::kVertices:
-        budget = server::VertexBudget{b.vertices()};
-        break;
-      case v1::Budget::kPercent:
-        budget = server::PercentBudget{b.percent()};
-        break;
-      default:
-        break;
-    }
-  }
+  const Budget budget =
+      request.has_budget() ? server::budget_from_wire(request.budget()) : Budget{};
   auto plan = server::plan_stream(index, request.resume_offset(), budget);
   if (!plan) return;
   check(plan->start <= plan->end && plan->end <= index.total_bytes());

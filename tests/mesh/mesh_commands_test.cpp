@@ -103,8 +103,8 @@ TEST(MeshCommands, BadDataExitsOneAndBadUsageTwo) {
     EXPECT_EQ(run("info " + testing::test_mesh("inf_nan.obj")).exit_code, 1);
   }
   EXPECT_EQ(run("generate nosuchshape -o " + temp_path("x.ply")).exit_code, 2);
-  EXPECT_EQ(run("generate demo").exit_code, 2);  // -o is required
-  EXPECT_EQ(run("generate grid -o " + temp_path("x.stl")).exit_code, 1);
+  EXPECT_EQ(run("generate demo").exit_code, 2);                           // -o is required
+  EXPECT_EQ(run("generate grid -o " + temp_path("x.xyz")).exit_code, 1);  // no such format
 }
 
 }  // namespace

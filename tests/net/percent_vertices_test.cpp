@@ -61,17 +61,17 @@ TEST(PercentVerticesPlan, EndsWhereTheDecoderBudgetEnds) {
   auto index = read_stream_index(bytes);
   ASSERT_TRUE(index);
   for (double p : interesting_percents(*index)) {
-    auto plan = server::plan_stream(*index, 0, server::PercentVerticesBudget{p});
+    auto plan = server::plan_stream(*index, 0, Budget::percent_vertices(p));
     ASSERT_TRUE(plan) << p << ": " << plan.error().message;
     EXPECT_EQ(plan->end_record, records_by_decoder(*index, p)) << p;
     EXPECT_EQ(plan->end_record, records_by_definition(*index, p)) << p;
     EXPECT_EQ(plan->end, prefix_for_budget(*index, {DecodeBudget::Kind::kPercentVertices, p})) << p;
     EXPECT_EQ(plan->complete, plan->end_record == index->records.size()) << p;
   }
-  EXPECT_TRUE(server::plan_stream(*index, 0, server::PercentVerticesBudget{100})->complete);
+  EXPECT_TRUE(server::plan_stream(*index, 0, Budget::percent_vertices(100))->complete);
   // Resumed past the budget: nothing to send, as for every other budget.
   auto late =
-      server::plan_stream(*index, index->records[70].offset, server::PercentVerticesBudget{1e-6});
+      server::plan_stream(*index, index->records[70].offset, Budget::percent_vertices(1e-6));
   ASSERT_TRUE(late);
   EXPECT_EQ(late->start, late->end);
 }
@@ -89,7 +89,7 @@ TEST(PercentVerticesPlan, RefusesValuesOutsideTheRangeNamingThem) {
   } cases[] = {{std::nan(""), "nan"},        {0, " 0 "},   {-0.0, " -0 "}, {-5, "-5"}, {101, "101"},
                {100.0000001, "100.0000001"}, {inf, "inf"}, {-inf, "-inf"}};
   for (const auto& c : cases) {
-    auto plan = server::plan_stream(*index, 0, server::PercentVerticesBudget{c.value});
+    auto plan = server::plan_stream(*index, 0, Budget::percent_vertices(c.value));
     ASSERT_FALSE(plan) << c.shown;
     EXPECT_EQ(plan.error().code, ErrorCode::kInvalidArgument);
     EXPECT_NE(plan.error().message.find("percent_vertices"), std::string::npos)
@@ -97,7 +97,7 @@ TEST(PercentVerticesPlan, RefusesValuesOutsideTheRangeNamingThem) {
     EXPECT_NE(plan.error().message.find(c.shown), std::string::npos) << plan.error().message;
   }
   // The bytes percent names its value the same way.
-  auto bytes_plan = server::plan_stream(*index, 0, server::PercentBudget{101});
+  auto bytes_plan = server::plan_stream(*index, 0, Budget::percent_bytes(101));
   ASSERT_FALSE(bytes_plan);
   EXPECT_NE(bytes_plan.error().message.find("101"), std::string::npos)
       << bytes_plan.error().message;

@@ -28,7 +28,7 @@ uint64_t end_of(const StreamIndex& index, uint32_t record) {
 
 TEST(StreamPlan, WholeStream) {
   const StreamIndex index = make_index(50, 400000);
-  auto plan = plan_stream(index, 0, std::monostate{});
+  auto plan = plan_stream(index, 0, Budget::all());
   ASSERT_TRUE(plan);
   EXPECT_EQ(plan->start, 0u);
   EXPECT_EQ(plan->end, index.total_bytes());
@@ -41,35 +41,35 @@ TEST(StreamPlan, ByteBudgetEndsAtLastBoundaryWithin) {
   const StreamIndex index = make_index(50, 400000);
   for (uint32_t r = 0; r < 49; ++r) {
     // Exactly at a boundary, and one byte short of the next.
-    auto at = plan_stream(index, 0, ByteBudget{end_of(index, r)});
+    auto at = plan_stream(index, 0, Budget::bytes(end_of(index, r)));
     ASSERT_TRUE(at);
     EXPECT_EQ(at->end, end_of(index, r));
     EXPECT_EQ(at->end_record, r + 1);
-    auto short_of = plan_stream(index, 0, ByteBudget{end_of(index, r + 1) - 1});
+    auto short_of = plan_stream(index, 0, Budget::bytes(end_of(index, r + 1) - 1));
     EXPECT_EQ(short_of->end, end_of(index, r));
     EXPECT_FALSE(short_of->complete);
   }
   // Less than the base mesh still gives the base mesh.
-  EXPECT_EQ(plan_stream(index, 0, ByteBudget{10})->end, end_of(index, 0));
-  EXPECT_TRUE(plan_stream(index, 0, ByteBudget{1ull << 40})->complete);
+  EXPECT_EQ(plan_stream(index, 0, Budget::bytes(10))->end, end_of(index, 0));
+  EXPECT_TRUE(plan_stream(index, 0, Budget::bytes(1ull << 40))->complete);
 }
 
 TEST(StreamPlan, VertexAndPercentBudgets) {
   const StreamIndex index = make_index(50, 400000);
   const uint32_t v = index.records[20].vertices;
-  auto plan = plan_stream(index, 0, VertexBudget{v});
+  auto plan = plan_stream(index, 0, Budget::vertices(v));
   EXPECT_EQ(plan->end_record, 21u);
-  EXPECT_EQ(plan_stream(index, 0, VertexBudget{v - 1})->end_record, 20u);
-  EXPECT_EQ(plan_stream(index, 0, VertexBudget{0})->end_record, 1u);
+  EXPECT_EQ(plan_stream(index, 0, Budget::vertices(v - 1))->end_record, 20u);
+  EXPECT_EQ(plan_stream(index, 0, Budget::vertices(0))->end_record, 1u);
 
-  auto half = plan_stream(index, 0, PercentBudget{50});
+  auto half = plan_stream(index, 0, Budget::percent_bytes(50));
   ASSERT_TRUE(half);
   EXPECT_LE(half->end, index.total_bytes() / 2);
   EXPECT_GT(end_of(index, half->end_record), index.total_bytes() / 2);
-  EXPECT_TRUE(plan_stream(index, 0, PercentBudget{100})->complete);
-  EXPECT_FALSE(plan_stream(index, 0, PercentBudget{0}).has_value());
-  EXPECT_FALSE(plan_stream(index, 0, PercentBudget{100.5}).has_value());
-  EXPECT_FALSE(plan_stream(index, 0, PercentBudget{std::nan("")}).has_value());
+  EXPECT_TRUE(plan_stream(index, 0, Budget::percent_bytes(100))->complete);
+  EXPECT_FALSE(plan_stream(index, 0, Budget::percent_bytes(0)).has_value());
+  EXPECT_FALSE(plan_stream(index, 0, Budget::percent_bytes(100.5)).has_value());
+  EXPECT_FALSE(plan_stream(index, 0, Budget::percent_bytes(std::nan(""))).has_value());
 }
 
 TEST(StreamPlan, ResumeRealignsDown) {
@@ -87,7 +87,7 @@ TEST(StreamPlan, ResumeRealignsDown) {
   EXPECT_EQ(past->start, index.total_bytes());
   EXPECT_EQ(past->end, index.total_bytes());
   // Resumed beyond the budget: nothing to send.
-  auto beyond = plan_stream(index, index.records[30].offset, ByteBudget{end_of(index, 10)});
+  auto beyond = plan_stream(index, index.records[30].offset, Budget::bytes(end_of(index, 10)));
   EXPECT_EQ(beyond->start, beyond->end);
 }
 
