@@ -44,10 +44,11 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                  "or empty folder (see --overwrite)");
   app.add_option("--out-every", o.out_every,
                  "with --out: also write NNNN.ply, the display mesh after record NNNN, for every "
-                 "N-th record (0, N, 2N, ...), whatever the timing")
+                 "N-th record (0, N, 2N, ...), whatever the timing (default: none)")
       ->check(CLI::PositiveNumber);
   app.add_option("--out-at", o.out_at,
-                 "with --out: also write NNNN.ply after each of these records (e.g. 0,10,50)")
+                 "with --out: also write NNNN.ply after each of these records (e.g. 0,10,50; "
+                 "default: none)")
       ->delimiter(',');
   app.add_flag("--overwrite", o.overwrite,
                "let --out use a folder that is not empty: first delete the files this program "
