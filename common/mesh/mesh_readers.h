@@ -19,6 +19,10 @@ struct RawMesh {
   std::vector<std::string> notes;  // e.g. attributes that could not be kept
 };
 
+// The whole file: kIo "cannot open the file for reading" or "read failed".
+// One read into a buffer sized from the file length.
+Result<std::string> read_file_bytes(const std::string& path);
+
 // OFF, COFF, NOFF, STOFF and combinations ("CNOFF", ...), headerless counts
 // too. Comments (#) anywhere; polygons are fan-triangulated (v0, vk, vk+1).
 // Strict: wrong counts, malformed numbers, indices out of range and

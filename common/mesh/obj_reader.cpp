@@ -608,21 +608,9 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
 Result<RawMesh> parse_obj_text(std::string_view text) { return ObjParser().parse(text); }
 
 Result<RawMesh> read_obj(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) return make_error(ErrorCode::kIo, "cannot open the file for reading");
-  std::string text;
-  if (std::fseek(file, 0, SEEK_END) == 0) {
-    const long size = std::ftell(file);
-    if (size > 0) text.reserve(static_cast<size_t>(size));
-    std::rewind(file);
-  }
-  char buffer[1 << 16];
-  size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) text.append(buffer, got);
-  const bool failed = std::ferror(file) != 0;
-  std::fclose(file);
-  if (failed) return make_error(ErrorCode::kIo, "read failed");
-  return parse_obj_text(text);
+  auto text = read_file_bytes(path);
+  if (!text) return tl::unexpected(text.error());
+  return parse_obj_text(*text);
 }
 
 }  // namespace meshstream

@@ -3,8 +3,6 @@
 // Every facet has its own three corners, welded later by clean_mesh.
 #include <cctype>
 #include <charconv>
-#include <fstream>
-#include <sstream>
 #include <string_view>
 
 #include "common/mesh/mesh_readers.h"
@@ -12,11 +10,9 @@
 namespace meshstream {
 
 Result<RawMesh> read_ascii_stl(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(ErrorCode::kIo, "cannot open the file for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = std::move(buffer).str();
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return tl::unexpected(bytes.error());
+  const std::string& text = *bytes;
 
   RawMesh raw;
   Mesh& mesh = raw.mesh;
