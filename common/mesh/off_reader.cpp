@@ -201,10 +201,10 @@ Status read_vertices(LineReader& reader, const OffHeader& header,
   return {};
 }
 
-// One line per face: "n i0 ... i(n-1)" (a trailing colour is ignored),
-// fan-triangulated.
+// One line per face: "n i0 ... i(n-1)", fan-triangulated; a trailing colour
+// is skipped (counted in `face_colors`).
 Status read_faces(LineReader& reader, const OffHeader& header,
-                  std::vector<std::string_view>& tokens, Mesh& mesh) {
+                  std::vector<std::string_view>& tokens, Mesh& mesh, uint64_t& face_colors) {
   const uint64_t vertex_count = header.vertex_count, face_count = header.face_count;
   mesh.triangles.reserve(face_count * 2);
   std::string_view line;
@@ -231,6 +231,7 @@ Status read_faces(LineReader& reader, const OffHeader& header,
                                                std::to_string(corners) + " vertices but lists " +
                                                std::to_string(tokens.size() - 1));
     }
+    if (tokens.size() > corners + 1) ++face_colors;
     uint32_t first = 0, previous = 0;
     for (uint64_t k = 0; k < corners; ++k) {
       uint64_t index = 0;
@@ -267,9 +268,19 @@ Result<RawMesh> read_off(const std::string& path) {
   RawMesh raw;
   if (auto ok = read_vertices(reader, *header, tokens, raw.mesh); !ok)
     return tl::unexpected(ok.error());
-  if (auto ok = read_faces(reader, *header, tokens, raw.mesh); !ok)
+  uint64_t face_colors = 0;
+  if (auto ok = read_faces(reader, *header, tokens, raw.mesh, face_colors); !ok)
     return tl::unexpected(ok.error());
   raw.vertices_in_file = static_cast<uint32_t>(header->vertex_count);
+  raw.contents.format = "OFF";
+  const OffLayout& layout = header->layout;
+  if (layout.normals) raw.contents.normals.count = header->vertex_count;
+  if (layout.colors) raw.contents.colors.count = header->vertex_count;
+  if (layout.texcoords) raw.contents.texcoords.count = header->vertex_count;
+  if (face_colors > 0) {
+    raw.contents.extra_properties.push_back("face colour (on " + std::to_string(face_colors) +
+                                            " faces)");
+  }
   return raw;
 }
 

@@ -511,6 +511,67 @@ class BodyParser {
   std::vector<uint32_t> polygon_;
 };
 
+const char* scalar_name(Scalar type) {
+  switch (type) {
+    case Scalar::kInt8:
+      return "char";
+    case Scalar::kUint8:
+      return "uchar";
+    case Scalar::kInt16:
+      return "short";
+    case Scalar::kUint16:
+      return "ushort";
+    case Scalar::kInt32:
+      return "int";
+    case Scalar::kUint32:
+      return "uint";
+    case Scalar::kFloat32:
+      return "float";
+    case Scalar::kFloat64:
+      return "double";
+  }
+  return "?";
+}
+
+std::string describe_property(const Element& element, const Property& p) {
+  return element.name + " " + p.name + " (" +
+         (p.is_list ? std::string("list of ") + scalar_name(p.type) : scalar_name(p.type)) + ")";
+}
+
+// What the file holds as the header declares it: the attributes read, the
+// properties and elements skipped.
+FileContents describe_contents(const Header& header) {
+  FileContents contents;
+  contents.format = header.encoding == Encoding::kAscii          ? "PLY (ascii)"
+                    : header.encoding == Encoding::kBinaryLittle ? "PLY (binary little-endian)"
+                                                                 : "PLY (binary big-endian)";
+  bool seen_vertex = false, seen_face = false;
+  for (const Element& e : header.elements) {
+    if (e.name == "vertex" && !seen_vertex) {
+      seen_vertex = true;
+      const VertexLayout l = find_vertex_layout(e);
+      if (l.normals()) contents.normals.count = e.count;
+      if (l.colors()) contents.colors.count = e.count;
+      if (l.texcoords()) contents.texcoords.count = e.count;
+      const int read[] = {l.x, l.y, l.z, l.nx, l.ny, l.nz, l.r, l.g, l.b, l.a, l.u, l.v};
+      for (size_t i = 0; i < e.properties.size(); ++i) {
+        if (std::find(std::begin(read), std::end(read), static_cast<int>(i)) == std::end(read))
+          contents.extra_properties.push_back(describe_property(e, e.properties[i]));
+      }
+    } else if (e.name == "face" && !seen_face) {
+      seen_face = true;
+      const int indices = find_index_list(e);
+      for (size_t i = 0; i < e.properties.size(); ++i) {
+        if (static_cast<int>(i) != indices)
+          contents.extra_properties.push_back(describe_property(e, e.properties[i]));
+      }
+    } else {
+      contents.other_elements.push_back(e.name + " (" + std::to_string(e.count) + ")");
+    }
+  }
+  return contents;
+}
+
 }  // namespace
 
 Result<RawMesh> read_ply(const std::string& path) {
@@ -521,6 +582,7 @@ Result<RawMesh> read_ply(const std::string& path) {
   if (auto ok = check_counts(*header, data->size() - header->body_start); !ok)
     return tl::unexpected(ok.error());
   RawMesh raw;
+  raw.contents = describe_contents(*header);
   BodyParser body(*data, *header, raw);
   if (auto ok = body.read_all(); !ok) return tl::unexpected(ok.error());
   raw.vertices_in_file = static_cast<uint32_t>(body.vertex_count());

@@ -33,12 +33,14 @@ Result<RawMesh> read_ascii_stl(const std::string& path) {
     return make_error(ErrorCode::kParse, "not an ASCII STL file (no 'solid' keyword)");
   }
   bool ended = false;
+  uint64_t facet_normals = 0;
   while (next_token(token)) {
     if (token == "endsolid") {
       ended = true;
       break;
     }
-    if (token != "vertex") continue;  // facet, normal, outer, loop, names: structure only
+    if (token == "normal") ++facet_normals;  // per facet: never a per-vertex attribute
+    if (token != "vertex") continue;         // facet, normal, outer, loop, names: structure only
     Vec3f p;
     for (int i = 0; i < 3; ++i) {
       std::string_view number;
@@ -63,6 +65,10 @@ Result<RawMesh> read_ascii_stl(const std::string& path) {
   mesh.triangles.resize(faces);
   for (uint32_t f = 0; f < faces; ++f) mesh.triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
   raw.vertices_in_file = static_cast<uint32_t>(mesh.positions.size());
+  raw.contents.format = "STL (ascii)";
+  raw.contents.normals.count = facet_normals;
+  if (facet_normals > 0)
+    raw.contents.normals.dropped = "STL normals are per facet, not per vertex (not read)";
   return raw;
 }
 
