@@ -424,7 +424,7 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
   const uint32_t E = name_split_edges(m, split, s);
   place_vertices(in, E, s, out);
 
-  Emitter e{out, face_kind, topo};
+  Emitter e{.out = out, .face_kind = face_kind, .topology = topo};
   e.track_source = in.source != nullptr;
   e.normals = topo && in.normals != nullptr;
   if (!e.track_source) out.source.clear();
@@ -442,7 +442,9 @@ void split_adaptive(const SplitInput& in, const ClosureBuffers& closure, SplitSc
     std::memset(out.valence.data() + V, 0, sizeof(uint32_t) * E);
     e.valence = out.valence.data();
   }
-  ChildWriter{in, m, split, s, out, e, face_kind}.write_all(action);
+  ChildWriter writer{
+      .in = in, .m = m, .split = split, .s = s, .out = out, .e = e, .face_kind = face_kind};
+  writer.write_all(action);
   if (!topo) return;
 
   pair_parent_edges(m, s, out);
