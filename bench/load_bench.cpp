@@ -36,8 +36,8 @@
 
 #include "common/codec/container.h"
 #include "common/codec/crc32.h"
+#include "common/net/asio.h"
 #include "proto/framing.h"
-#include "server/asio.h"
 #include "server/catalog.h"
 #include "server/synthetic_stream.h"
 #include "tests/net/net_harness.h"

@@ -11,13 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "client/asio.h"
 #include "common/base/result.h"
+#include "common/net/asio.h"
 #include "proto/framing.h"
 
 namespace meshstream::client {
 
 namespace v1 = ::meshstream::v1;
+namespace asio = net::asio;
+using tcp = net::tcp;
 using Millis = std::chrono::milliseconds;
 
 class Connection {

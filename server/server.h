@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/base/result.h"
-#include "server/asio.h"
+#include "common/net/asio.h"
 #include "server/catalog.h"
 #include "server/server_options.h"
 #include "server/session.h"

@@ -16,8 +16,8 @@
 #include <variant>
 #include <vector>
 
+#include "common/net/asio.h"
 #include "proto/framing.h"
-#include "server/asio.h"
 #include "server/catalog.h"
 #include "server/first_chunk_gate.h"
 #include "server/server_options.h"

@@ -37,6 +37,98 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
   s.centres.push_back(v);
 }
 
+// Pass 2's prefetches while centre k is computed.
+[[gnu::always_inline]] inline void prefetch_centre(const LevelView& m, const uint32_t* edge_vertex,
+                                                   const EdgePointScratch& s,
+                                                   const uint32_t* centres, uint32_t count,
+                                                   uint32_t k, bool cached) {
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
+  if (cached) {
+    // Fan corners are independent loads: fetch a later centre's corner
+    // data, then a nearer one's ring positions.
+    if (k + 8 < count) {
+      for (uint32_t i = s.fan_start[k + 8]; i < s.fan_start[k + 9]; ++i) {
+        const uint32_t y = s.fan_corner[i];
+        __builtin_prefetch(cv + next_corner(y));
+        __builtin_prefetch(edge_vertex + prev_corner(y));
+      }
+    }
+    if (k + 4 < count) {
+      __builtin_prefetch(m.positions + centres[k + 4]);
+      for (uint32_t i = s.fan_start[k + 4]; i < s.fan_start[k + 5]; ++i)
+        __builtin_prefetch(m.positions + cv[next_corner(s.fan_corner[i])]);
+    }
+  } else if (k + 4 < count) {
+    // The start of a later centre's fan walk (the walk itself is a chain).
+    const uint32_t u = centres[k + 4];
+    const uint32_t y = s.vertex_corner[u];
+    __builtin_prefetch(m.positions + u);
+    __builtin_prefetch(opp + y);
+    __builtin_prefetch(cv + y);
+    __builtin_prefetch(m.valence + u);
+  }
+}
+
+// The K stencil sums of one centre, sum j = centre + sum_i ring[i + j] * w_i,
+// each adding its terms in the order of rules::extraordinary_point.
+[[gnu::always_inline]] inline void sum_stencils(uint32_t K, const float* weights, Vec3f centre,
+                                                const float* rx, const float* ry, const float* rz,
+                                                float* sx, float* sy, float* sz) {
+#if defined(__SSE2__)
+  // Four sums at a time; each lane adds exactly the scalar terms in order
+  // (a vector multiply/add rounds each lane like the scalar operation).
+  for (uint32_t g = 0; g < K; g += 4) {
+    __m128 ax = _mm_set1_ps(centre.x), ay = _mm_set1_ps(centre.y), az = _mm_set1_ps(centre.z);
+    for (uint32_t i = 0; i < K; ++i) {
+      const __m128 wi = _mm_set1_ps(weights[i]);
+      ax = _mm_add_ps(ax, _mm_mul_ps(_mm_loadu_ps(rx + i + g), wi));
+      ay = _mm_add_ps(ay, _mm_mul_ps(_mm_loadu_ps(ry + i + g), wi));
+      az = _mm_add_ps(az, _mm_mul_ps(_mm_loadu_ps(rz + i + g), wi));
+    }
+    _mm_storeu_ps(sx + g, ax);
+    _mm_storeu_ps(sy + g, ay);
+    _mm_storeu_ps(sz + g, az);
+  }
+#else
+  for (uint32_t j = 0; j < K; ++j) {
+    sx[j] = centre.x;
+    sy[j] = centre.y;
+    sz[j] = centre.z;
+  }
+  for (uint32_t i = 0; i < K; ++i) {
+    const float wi = weights[i];
+    for (uint32_t j = 0; j < K; ++j) {
+      sx[j] += rx[i + j] * wi;
+      sy[j] += ry[i + j] * wi;
+      sz[j] += rz[i + j] * wi;
+    }
+  }
+#endif
+}
+
+// Each split edge of the centre gets its sum; an edge with two extraordinary
+// centres gets the average of both (in either arrival order: same bits).
+[[gnu::always_inline]] inline void store_centre_points(uint32_t K, const uint32_t* ids,
+                                                       const float* sx, const float* sy,
+                                                       const float* sz, uint32_t first_new,
+                                                       Vec3f* pos, EdgePointScratch& s) {
+  for (uint32_t j = 0; j < K; ++j) {
+    const uint32_t id = ids[j];
+    if (id == kNone) continue;
+    const Vec3f sum{sx[j], sy[j], sz[j]};
+    uint8_t& state = s.arrivals[id - first_new];
+    if (state == kTwoCentres) {
+      pos[id] = sum;
+      state = kSecondOfTwo;
+    } else if (state == kSecondOfTwo) {
+      pos[id] = (pos[id] + sum) * 0.5f;
+    } else {
+      pos[id] = sum;
+    }
+  }
+}
+
 // Pass 2: every centre's stencil for each of its split edges. The ring is
 // gathered once into coordinate arrays, and the K sums are accumulated
 // together, term by term: each sum still adds its terms in the order of
@@ -60,30 +152,7 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
   const uint32_t count = static_cast<uint32_t>(cached ? s.fan_vertex.size() : s.centres.size());
   for (uint32_t k = 0; k < count; ++k) {
     const uint32_t v = centres[k];
-    if (cached) {
-      // Fan corners are independent loads: fetch a later centre's corner
-      // data, then a nearer one's ring positions.
-      if (k + 8 < count) {
-        for (uint32_t i = s.fan_start[k + 8]; i < s.fan_start[k + 9]; ++i) {
-          const uint32_t y = s.fan_corner[i];
-          __builtin_prefetch(cv + next_corner(y));
-          __builtin_prefetch(edge_vertex + prev_corner(y));
-        }
-      }
-      if (k + 4 < count) {
-        __builtin_prefetch(m.positions + centres[k + 4]);
-        for (uint32_t i = s.fan_start[k + 4]; i < s.fan_start[k + 5]; ++i)
-          __builtin_prefetch(m.positions + cv[next_corner(s.fan_corner[i])]);
-      }
-    } else if (k + 4 < count) {
-      // The start of a later centre's fan walk (the walk itself is a chain).
-      const uint32_t u = centres[k + 4];
-      const uint32_t y = s.vertex_corner[u];
-      __builtin_prefetch(m.positions + u);
-      __builtin_prefetch(opp + y);
-      __builtin_prefetch(cv + y);
-      __builtin_prefetch(m.valence + u);
-    }
+    prefetch_centre(m, edge_vertex, s, centres, count, k, cached);
     const uint32_t K = m.valence[v];
     const float* weights = wt.extraordinary(K);
     uint32_t x = kNone;
@@ -130,50 +199,8 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     }
     for (uint32_t j = 2 * K; j < stride; ++j) rx[j] = ry[j] = rz[j] = 0.0f;
     const Vec3f centre = m.positions[v] * weights[K];
-#if defined(__SSE2__)
-    // Four sums at a time; each lane adds exactly the scalar terms in order
-    // (a vector multiply/add rounds each lane like the scalar operation).
-    for (uint32_t g = 0; g < K; g += 4) {
-      __m128 ax = _mm_set1_ps(centre.x), ay = _mm_set1_ps(centre.y), az = _mm_set1_ps(centre.z);
-      for (uint32_t i = 0; i < K; ++i) {
-        const __m128 wi = _mm_set1_ps(weights[i]);
-        ax = _mm_add_ps(ax, _mm_mul_ps(_mm_loadu_ps(rx + i + g), wi));
-        ay = _mm_add_ps(ay, _mm_mul_ps(_mm_loadu_ps(ry + i + g), wi));
-        az = _mm_add_ps(az, _mm_mul_ps(_mm_loadu_ps(rz + i + g), wi));
-      }
-      _mm_storeu_ps(sx + g, ax);
-      _mm_storeu_ps(sy + g, ay);
-      _mm_storeu_ps(sz + g, az);
-    }
-#else
-    for (uint32_t j = 0; j < K; ++j) {
-      sx[j] = centre.x;
-      sy[j] = centre.y;
-      sz[j] = centre.z;
-    }
-    for (uint32_t i = 0; i < K; ++i) {
-      const float wi = weights[i];
-      for (uint32_t j = 0; j < K; ++j) {
-        sx[j] += rx[i + j] * wi;
-        sy[j] += ry[i + j] * wi;
-        sz[j] += rz[i + j] * wi;
-      }
-    }
-#endif
-    for (uint32_t j = 0; j < K; ++j) {
-      const uint32_t id = ids[j];
-      if (id == kNone) continue;
-      const Vec3f sum{sx[j], sy[j], sz[j]};
-      uint8_t& state = s.arrivals[id - first_new];
-      if (state == kTwoCentres) {
-        pos[id] = sum;
-        state = kSecondOfTwo;
-      } else if (state == kSecondOfTwo) {
-        pos[id] = (pos[id] + sum) * 0.5f;
-      } else {
-        pos[id] = sum;
-      }
-    }
+    sum_stencils(K, weights, centre, rx, ry, rz, sx, sy, sz);
+    store_centre_points(K, ids, sx, sy, sz, first_new, pos, s);
   }
 }
 

@@ -57,20 +57,11 @@ Status IncrementalSubdivider::full_update(const Mesh& input) {
   return {};
 }
 
-Status IncrementalSubdivider::update(const Mesh& input) {
-  stats_ = {};
-  if (!has_previous_ || options_.levels == 0 || !same_attribute_layout(input, previous_) ||
-      input.vertex_count() < previous_.vertex_count()) {
-    return full_update(input);
-  }
-  if (auto ok = validate_arrays(input); !ok) {
-    has_previous_ = false;
-    return ok;
-  }
+// 1. What changed, by index: vertices moved or with new attributes, and every
+// vertex of a face that is new, gone or re-connected. Returns their count.
+uint32_t IncrementalSubdivider::mark_changed_vertices(const Mesh& input) {
   const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
   const uint32_t Vo = previous_.vertex_count(), Fo = previous_.face_count();
-
-  // 1. What changed, by index.
   changed_vertex_.assign(Vn, 0);
   for (uint32_t v = 0; v < Vn; ++v) {
     bool changed =
@@ -89,191 +80,223 @@ Status IncrementalSubdivider::update(const Mesh& input) {
     if (f < Fo) mark(previous_.triangles[f]);
   }
   for (uint32_t f = Fn; f < Fo; ++f) mark(previous_.triangles[f]);
-  for (uint8_t c : changed_vertex_) stats_.changed_vertices += c;
-  if (stats_.changed_vertices == 0 && Fn == Fo) {
-    if (!input.normals.empty()) previous_.normals = input.normals;
-    return {};
-  }
+  uint32_t changed = 0;
+  for (uint8_t c : changed_vertex_) changed += c;
+  return changed;
+}
 
-  // 2. Faces around every vertex of the new input (CSR).
+// 2. Faces around every vertex of the new input (CSR).
+void IncrementalSubdivider::index_vertex_faces(const Mesh& input) {
+  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
   vertex_faces_offset_.assign(static_cast<size_t>(Vn) + 1, 0);
   for (const Triangle& t : input.triangles)
     for (uint32_t v : t) ++vertex_faces_offset_[v + 1];
   for (uint32_t v = 0; v < Vn; ++v) vertex_faces_offset_[v + 1] += vertex_faces_offset_[v];
   vertex_faces_.resize(3 * static_cast<size_t>(Fn));
-  {
-    std::vector<uint32_t>& cursor = global_vertex_;  // borrowed as a fill cursor
-    cursor.assign(vertex_faces_offset_.begin(), vertex_faces_offset_.end() - 1);
-    for (uint32_t f = 0; f < Fn; ++f)
-      for (uint32_t v : input.triangles[f]) vertex_faces_[cursor[v]++] = f;
-  }
+  std::vector<uint32_t>& cursor = global_vertex_;  // borrowed as a fill cursor
+  cursor.assign(vertex_faces_offset_.begin(), vertex_faces_offset_.end() - 1);
+  for (uint32_t f = 0; f < Fn; ++f)
+    for (uint32_t v : input.triangles[f]) vertex_faces_[cursor[v]++] = f;
+}
 
+// 3. Dirty faces: rings around the changed vertices; then context rings.
+// Faces added in the first context ring are the clean neighbours whose
+// patches prove the seam (seam_faces_). Returns the dirty face count.
+uint32_t IncrementalSubdivider::grow_region(const Mesh& input, uint32_t attempt) {
+  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  dirty_face_.assign(Fn, 0);
+  in_region_.assign(Fn, 0);
+  vertex_mark_.assign(Vn, 0);
+  frontier_.clear();
+  seam_faces_.clear();
+  for (uint32_t v = 0; v < Vn; ++v)
+    if (changed_vertex_[v]) {
+      vertex_mark_[v] = 1;
+      frontier_.push_back(v);
+    }
+  const uint32_t dirty_rings = incremental_.dirty_rings + attempt;
+  const uint32_t context_rings = incremental_.context_rings + 2 * attempt;
+  uint32_t dirty_count = 0;
+  for (uint32_t ring = 0; ring < dirty_rings + context_rings; ++ring) {
+    const bool dirty_ring = ring < dirty_rings;
+    next_frontier_.clear();
+    for (uint32_t v : frontier_) {
+      for (uint32_t k = vertex_faces_offset_[v]; k < vertex_faces_offset_[v + 1]; ++k) {
+        const uint32_t f = vertex_faces_[k];
+        if (in_region_[f]) continue;
+        in_region_[f] = 1;
+        if (dirty_ring) {
+          dirty_face_[f] = 1;
+          ++dirty_count;
+        } else if (ring == dirty_rings) {
+          seam_faces_.push_back(f);
+        }
+        for (uint32_t w : input.triangles[f])
+          if (!vertex_mark_[w]) {
+            vertex_mark_[w] = 1;
+            next_frontier_.push_back(w);
+          }
+      }
+    }
+    frontier_.swap(next_frontier_);
+  }
+  return dirty_count;
+}
+
+// 4. The region as a mesh of its own (region_), faces in input order, with
+// the maps between its indices and the input's.
+void IncrementalSubdivider::extract_region(const Mesh& input) {
+  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  region_.positions.clear();
+  region_.triangles.clear();
+  region_.colors.clear();
+  region_.texcoords.clear();
+  local_vertex_.assign(Vn, kNone);
+  local_face_.assign(Fn, kNone);
+  global_vertex_.clear();
+  region_faces_.clear();
+  for (uint32_t f = 0; f < Fn; ++f) {
+    if (!in_region_[f]) continue;
+    local_face_[f] = static_cast<uint32_t>(region_faces_.size());
+    region_faces_.push_back(f);
+    Triangle t{};
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t v = input.triangles[f][i];
+      if (local_vertex_[v] == kNone) {
+        local_vertex_[v] = static_cast<uint32_t>(global_vertex_.size());
+        global_vertex_.push_back(v);
+        region_.positions.push_back(input.positions[v]);
+        if (!input.colors.empty()) region_.colors.push_back(input.colors[v]);
+        if (!input.texcoords.empty()) region_.texcoords.push_back(input.texcoords[v]);
+      }
+      t[i] = local_vertex_[v];
+    }
+    region_.triangles.push_back(t);
+  }
+}
+
+// 5. The clean neighbours' patches must come out of the region's run exactly
+// as before; on the way, seam_map_ learns which previous output vertex each
+// region output vertex on them is.
+bool IncrementalSubdivider::seam_matches() {
+  const Mesh& prev_out = result_.mesh;
+  const Mesh& reg_out = region_result_.mesh;
+  seam_map_.assign(reg_out.vertex_count(), kNone);
+  for (uint32_t g : seam_faces_) {
+    if (dirty_face_[g]) continue;
+    const uint32_t lg = local_face_[g];
+    const uint32_t p0 = patch_start_[g], p1 = patch_start_[g + 1];
+    const uint32_t r0 = region_patch_start_[lg], r1 = region_patch_start_[lg + 1];
+    if (p1 - p0 != r1 - r0) return false;
+    for (uint32_t k = 0; k < p1 - p0; ++k) {
+      for (int i = 0; i < 3; ++i) {
+        const uint32_t pv = prev_out.triangles[p0 + k][i], rv = reg_out.triangles[r0 + k][i];
+        if (!same_bits(prev_out.positions[pv], reg_out.positions[rv]) ||
+            (seam_map_[rv] != kNone && seam_map_[rv] != pv))
+          return false;
+        seam_map_[rv] = pv;
+      }
+    }
+  }
+  return true;
+}
+
+// 6. Splice into next_: clean patches from the previous result, dirty ones
+// from the region; input vertices first, then others as first used.
+void IncrementalSubdivider::splice(const Mesh& input) {
+  const uint32_t Fn = input.face_count(), Vo = previous_.vertex_count();
+  const Mesh& prev_out = result_.mesh;
+  const Mesh& reg_out = region_result_.mesh;
+  new_id_prev_.assign(prev_out.vertex_count(), kNone);
+  for (uint32_t v = 0; v < Vo; ++v) new_id_prev_[v] = v;
+  new_id_region_.assign(reg_out.vertex_count(), kNone);
+  for (uint32_t x = 0; x < region_.vertex_count(); ++x) new_id_region_[x] = global_vertex_[x];
+  Mesh& out = next_.mesh;
+  out.positions.assign(input.positions.begin(), input.positions.end());
+  out.colors.assign(input.colors.begin(), input.colors.end());
+  out.texcoords.assign(input.texcoords.begin(), input.texcoords.end());
+  out.triangles.clear();
+  next_.face_kind.clear();
+  next_.source_face.clear();
+  const bool colors = !input.colors.empty(), texcoords = !input.texcoords.empty();
+  auto take_prev = [&](uint32_t p) {
+    uint32_t& id = new_id_prev_[p];
+    if (id == kNone) {
+      id = static_cast<uint32_t>(out.positions.size());
+      out.positions.push_back(prev_out.positions[p]);
+      if (colors) out.colors.push_back(prev_out.colors[p]);
+      if (texcoords) out.texcoords.push_back(prev_out.texcoords[p]);
+    }
+    return id;
+  };
+  auto take_region = [&](uint32_t x) {
+    uint32_t& id = new_id_region_[x];
+    if (id == kNone) {
+      if (seam_map_[x] != kNone) {
+        id = take_prev(seam_map_[x]);
+      } else {
+        id = static_cast<uint32_t>(out.positions.size());
+        out.positions.push_back(reg_out.positions[x]);
+        if (colors) out.colors.push_back(reg_out.colors[x]);
+        if (texcoords) out.texcoords.push_back(reg_out.texcoords[x]);
+      }
+    }
+    return id;
+  };
+  for (uint32_t f = 0; f < Fn; ++f) {
+    if (dirty_face_[f]) {
+      const uint32_t lf = local_face_[f];
+      for (uint32_t k = region_patch_start_[lf]; k < region_patch_start_[lf + 1]; ++k) {
+        const Triangle& t = reg_out.triangles[k];
+        out.triangles.push_back({take_region(t[0]), take_region(t[1]), take_region(t[2])});
+        next_.face_kind.push_back(region_result_.face_kind[k]);
+        next_.source_face.push_back(f);
+      }
+    } else {
+      for (uint32_t k = patch_start_[f]; k < patch_start_[f + 1]; ++k) {
+        const Triangle& t = prev_out.triangles[k];
+        out.triangles.push_back({take_prev(t[0]), take_prev(t[1]), take_prev(t[2])});
+        next_.face_kind.push_back(result_.face_kind[k]);
+        next_.source_face.push_back(f);
+      }
+    }
+  }
+  if (!input.normals.empty()) {
+    out.normals = compute_vertex_normals(out);
+  } else {
+    out.normals.clear();
+  }
+}
+
+Status IncrementalSubdivider::update(const Mesh& input) {
+  stats_ = {};
+  if (!has_previous_ || options_.levels == 0 || !same_attribute_layout(input, previous_) ||
+      input.vertex_count() < previous_.vertex_count()) {
+    return full_update(input);
+  }
+  if (auto ok = validate_arrays(input); !ok) {
+    has_previous_ = false;
+    return ok;
+  }
+  stats_.changed_vertices = mark_changed_vertices(input);
+  if (stats_.changed_vertices == 0 && input.face_count() == previous_.face_count()) {
+    if (!input.normals.empty()) previous_.normals = input.normals;
+    return {};
+  }
+  index_vertex_faces(input);
   for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
     stats_.attempts = attempt + 1;
-    // 3. Dirty faces: rings around the changed vertices; then context rings.
-    // Faces added in the first context ring are the clean neighbours whose
-    // patches prove the seam.
-    dirty_face_.assign(Fn, 0);
-    in_region_.assign(Fn, 0);
-    vertex_mark_.assign(Vn, 0);
-    std::vector<uint32_t> frontier, next_frontier, seam_faces;
-    for (uint32_t v = 0; v < Vn; ++v)
-      if (changed_vertex_[v]) {
-        vertex_mark_[v] = 1;
-        frontier.push_back(v);
-      }
-    const uint32_t dirty_rings = incremental_.dirty_rings + attempt;
-    const uint32_t context_rings = incremental_.context_rings + 2 * attempt;
-    uint32_t dirty_count = 0;
-    for (uint32_t ring = 0; ring < dirty_rings + context_rings; ++ring) {
-      const bool dirty_ring = ring < dirty_rings;
-      next_frontier.clear();
-      for (uint32_t v : frontier) {
-        for (uint32_t k = vertex_faces_offset_[v]; k < vertex_faces_offset_[v + 1]; ++k) {
-          const uint32_t f = vertex_faces_[k];
-          if (in_region_[f]) continue;
-          in_region_[f] = 1;
-          if (dirty_ring) {
-            dirty_face_[f] = 1;
-            ++dirty_count;
-          } else if (ring == dirty_rings) {
-            seam_faces.push_back(f);
-          }
-          for (uint32_t w : input.triangles[f])
-            if (!vertex_mark_[w]) {
-              vertex_mark_[w] = 1;
-              next_frontier.push_back(w);
-            }
-        }
-      }
-      frontier.swap(next_frontier);
-    }
-    stats_.dirty_faces = dirty_count;
-    if (dirty_count > incremental_.max_dirty_fraction * Fn) return full_update(input);
-
-    // 4. The region as a mesh of its own, faces in input order.
-    region_.positions.clear();
-    region_.triangles.clear();
-    region_.colors.clear();
-    region_.texcoords.clear();
-    local_vertex_.assign(Vn, kNone);
-    local_face_.assign(Fn, kNone);
-    global_vertex_.clear();
-    region_faces_.clear();
-    for (uint32_t f = 0; f < Fn; ++f) {
-      if (!in_region_[f]) continue;
-      local_face_[f] = static_cast<uint32_t>(region_faces_.size());
-      region_faces_.push_back(f);
-      Triangle t{};
-      for (int i = 0; i < 3; ++i) {
-        const uint32_t v = input.triangles[f][i];
-        if (local_vertex_[v] == kNone) {
-          local_vertex_[v] = static_cast<uint32_t>(global_vertex_.size());
-          global_vertex_.push_back(v);
-          region_.positions.push_back(input.positions[v]);
-          if (!input.colors.empty()) region_.colors.push_back(input.colors[v]);
-          if (!input.texcoords.empty()) region_.texcoords.push_back(input.texcoords[v]);
-        }
-        t[i] = local_vertex_[v];
-      }
-      region_.triangles.push_back(t);
-    }
+    stats_.dirty_faces = grow_region(input, attempt);
+    if (stats_.dirty_faces > incremental_.max_dirty_fraction * input.face_count())
+      return full_update(input);
+    extract_region(input);
     stats_.region_faces = region_.face_count();
     if (!subdivide_into(region_, options_, workspace_, region_result_)) {
       return full_update(input);  // reports the error with global indices
     }
     compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
-
-    // 5. The clean neighbours' patches must come out exactly as before.
-    const Mesh& prev_out = result_.mesh;
-    const Mesh& reg_out = region_result_.mesh;
-    seam_map_.assign(reg_out.vertex_count(), kNone);
-    bool consistent = true;
-    for (uint32_t g : seam_faces) {
-      if (dirty_face_[g]) continue;
-      const uint32_t lg = local_face_[g];
-      const uint32_t p0 = patch_start_[g], p1 = patch_start_[g + 1];
-      const uint32_t r0 = region_patch_start_[lg], r1 = region_patch_start_[lg + 1];
-      if (p1 - p0 != r1 - r0) {
-        consistent = false;
-        break;
-      }
-      for (uint32_t k = 0; k < p1 - p0 && consistent; ++k) {
-        for (int i = 0; i < 3; ++i) {
-          const uint32_t pv = prev_out.triangles[p0 + k][i], rv = reg_out.triangles[r0 + k][i];
-          if (!same_bits(prev_out.positions[pv], reg_out.positions[rv]) ||
-              (seam_map_[rv] != kNone && seam_map_[rv] != pv)) {
-            consistent = false;
-            break;
-          }
-          seam_map_[rv] = pv;
-        }
-      }
-      if (!consistent) break;
-    }
-    if (!consistent) continue;
-
-    // 6. Splice: clean patches from the previous result, dirty ones from
-    // the region; input vertices first, then others as first used.
-    new_id_prev_.assign(prev_out.vertex_count(), kNone);
-    for (uint32_t v = 0; v < Vo; ++v) new_id_prev_[v] = v;
-    new_id_region_.assign(reg_out.vertex_count(), kNone);
-    for (uint32_t x = 0; x < region_.vertex_count(); ++x) new_id_region_[x] = global_vertex_[x];
-    Mesh& out = next_.mesh;
-    out.positions.assign(input.positions.begin(), input.positions.end());
-    out.colors.assign(input.colors.begin(), input.colors.end());
-    out.texcoords.assign(input.texcoords.begin(), input.texcoords.end());
-    out.triangles.clear();
-    next_.face_kind.clear();
-    next_.source_face.clear();
-    const bool colors = !input.colors.empty(), texcoords = !input.texcoords.empty();
-    auto take_prev = [&](uint32_t p) {
-      uint32_t& id = new_id_prev_[p];
-      if (id == kNone) {
-        id = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(prev_out.positions[p]);
-        if (colors) out.colors.push_back(prev_out.colors[p]);
-        if (texcoords) out.texcoords.push_back(prev_out.texcoords[p]);
-      }
-      return id;
-    };
-    auto take_region = [&](uint32_t x) {
-      uint32_t& id = new_id_region_[x];
-      if (id == kNone) {
-        if (seam_map_[x] != kNone) {
-          id = take_prev(seam_map_[x]);
-        } else {
-          id = static_cast<uint32_t>(out.positions.size());
-          out.positions.push_back(reg_out.positions[x]);
-          if (colors) out.colors.push_back(reg_out.colors[x]);
-          if (texcoords) out.texcoords.push_back(reg_out.texcoords[x]);
-        }
-      }
-      return id;
-    };
-    for (uint32_t f = 0; f < Fn; ++f) {
-      if (dirty_face_[f]) {
-        const uint32_t lf = local_face_[f];
-        for (uint32_t k = region_patch_start_[lf]; k < region_patch_start_[lf + 1]; ++k) {
-          const Triangle& t = reg_out.triangles[k];
-          out.triangles.push_back({take_region(t[0]), take_region(t[1]), take_region(t[2])});
-          next_.face_kind.push_back(region_result_.face_kind[k]);
-          next_.source_face.push_back(f);
-        }
-      } else {
-        for (uint32_t k = patch_start_[f]; k < patch_start_[f + 1]; ++k) {
-          const Triangle& t = prev_out.triangles[k];
-          out.triangles.push_back({take_prev(t[0]), take_prev(t[1]), take_prev(t[2])});
-          next_.face_kind.push_back(result_.face_kind[k]);
-          next_.source_face.push_back(f);
-        }
-      }
-    }
-    if (!input.normals.empty()) {
-      out.normals = compute_vertex_normals(out);
-    } else {
-      out.normals.clear();
-    }
+    if (!seam_matches()) continue;  // the closure reached further: grow the region
+    splice(input);
     std::swap(result_, next_);
     remember(input);
     return {};

@@ -60,6 +60,13 @@ class IncrementalSubdivider {
  private:
   Status full_update(const Mesh& input);
   void remember(const Mesh& input);
+  // The phases of update(), in order (see incremental.cpp).
+  uint32_t mark_changed_vertices(const Mesh& input);
+  void index_vertex_faces(const Mesh& input);
+  uint32_t grow_region(const Mesh& input, uint32_t attempt);
+  void extract_region(const Mesh& input);
+  bool seam_matches();
+  void splice(const Mesh& input);
 
   AsaOptions options_;
   IncrementalOptions incremental_;
@@ -76,6 +83,7 @@ class IncrementalSubdivider {
       region_faces_;
   std::vector<uint32_t> local_face_, region_patch_start_, seam_map_, new_id_prev_, new_id_region_;
   std::vector<uint8_t> changed_vertex_, dirty_face_, in_region_, vertex_mark_;
+  std::vector<uint32_t> frontier_, next_frontier_, seam_faces_;
 };
 
 }  // namespace meshstream

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "common/asa/butterfly_stencils.h"
@@ -36,6 +37,38 @@ struct SplitScratch {
   uint32_t fresh_count = 0;         // adaptive: output faces that are not copies of a parent face
   EdgePointScratch points;
 };
+
+// Sizes out's colours and texture coordinates for V old + E new vertices
+// (copying the old ones), or clears those the input does not have.
+inline void start_vertex_attributes(const SplitInput& in, uint32_t V, uint32_t E, LevelMesh& out) {
+  if (in.colors) {
+    out.colors.resize(static_cast<size_t>(V) + E);
+    std::memcpy(out.colors.data(), in.colors, sizeof(Vec4f) * V);
+  } else {
+    out.colors.clear();
+  }
+  if (in.texcoords) {
+    out.texcoords.resize(static_cast<size_t>(V) + E);
+    std::memcpy(out.texcoords.data(), in.texcoords, sizeof(Vec2f) * V);
+  } else {
+    out.texcoords.clear();
+  }
+}
+
+// New vertex `id` on the edge a-b: the average of the endpoints' attributes
+// (linear, so colours stay in range and texture coordinates on their chart).
+inline void average_vertex_attributes(const SplitInput& in, uint32_t a, uint32_t b, uint32_t id,
+                                      LevelMesh& out) {
+  if (in.colors) {
+    const Vec4f ca = in.colors[a], cb = in.colors[b];
+    out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f,
+                      (ca.w + cb.w) * 0.5f};
+  }
+  if (in.texcoords) {
+    const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
+    out.texcoords[id] = {(ta.x + tb.x) * 0.5f, (ta.y + tb.y) * 0.5f};
+  }
+}
 
 // Uniform 1-to-4 split of every face (classic modified Butterfly).
 // out gets V + E vertices (old ones first, bit-identical) and 4F faces:

@@ -9,49 +9,36 @@
 
 namespace meshstream::asa {
 
-void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
-                   std::vector<FaceKind>* face_kind) {
-  const LevelView& m = in.mesh;
-  const uint32_t V = m.vertex_count, F = m.face_count, corners = 3 * F;
-  const uint32_t* opp = m.opposite;
-  const uint32_t* cv = m.corner_vertex;
+namespace {
 
-  // One pass over the corners: the first corner of an edge (in corner
-  // order) names it and computes its point; the other reads the name.
-  std::vector<uint32_t>& edge_of = scratch.edge_vertex;
-  edge_of.resize(corners);
-  // Edge count first, to size the outputs once.
-  uint32_t E = 0;
-  for (uint32_t c = 0; c < corners; ++c) E += (opp[c] == kNone || c < opp[c]);
-  const bool colors = in.colors != nullptr, texcoords = in.texcoords != nullptr;
-  const bool topology = in.want_topology;
+// Sizes the vertex arrays for V old + E new vertices and copies the old
+// ones. With topology, old vertices keep their face count and features.
+void start_vertices(const SplitInput& in, uint32_t E, LevelMesh& out) {
+  const LevelView& m = in.mesh;
+  const uint32_t V = m.vertex_count;
   out.positions.resize(static_cast<size_t>(V) + E);
-  Vec3f* pos = out.positions.data();
-  std::memcpy(pos, m.positions, sizeof(Vec3f) * V);
-  if (colors) {
-    out.colors.resize(static_cast<size_t>(V) + E);
-    std::memcpy(out.colors.data(), in.colors, sizeof(Vec4f) * V);
-  } else {
-    out.colors.clear();
-  }
-  if (texcoords) {
-    out.texcoords.resize(static_cast<size_t>(V) + E);
-    std::memcpy(out.texcoords.data(), in.texcoords, sizeof(Vec2f) * V);
-  } else {
-    out.texcoords.clear();
-  }
-  if (topology) {
-    // Old vertices keep their face count and features; a new vertex has six
-    // faces (three on a boundary) and two feature edges when its edge was one.
+  std::memcpy(out.positions.data(), m.positions, sizeof(Vec3f) * V);
+  start_vertex_attributes(in, V, E, out);
+  if (in.want_topology) {
     out.valence.resize(static_cast<size_t>(V) + E);
     out.vertex_features.resize(static_cast<size_t>(V) + E);
     std::memcpy(out.valence.data(), m.valence, sizeof(uint32_t) * V);
     std::memcpy(out.vertex_features.data(), m.vertex_features, V);
   }
+}
 
-  // Name the edges (the first corner of an edge in corner order names it),
-  // with the per-vertex data of the new vertices.
-  uint32_t next_id = V;
+// Names the edges (the first corner of an edge in corner order names it, the
+// other reads the name), with the per-vertex data of the new vertices: a new
+// vertex has six faces (three on a boundary) and two feature edges when its
+// edge was one; its attributes are its edge's average.
+void name_edges(const SplitInput& in, uint32_t* edge_of, LevelMesh& out) {
+  const LevelView& m = in.mesh;
+  const uint32_t corners = 3 * m.face_count;
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
+  const bool attributes = in.colors != nullptr || in.texcoords != nullptr;
+  const bool topology = in.want_topology;
+  uint32_t next_id = m.vertex_count;
   const uint8_t* parent_feature = m.feature_edge;
   for (uint32_t c = 0; c < corners; ++c) {
     const uint32_t o = opp[c];
@@ -65,27 +52,16 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
       out.valence[id] = o == kNone ? 3 : 6;
       out.vertex_features[id] = parent_feature[c] ? 2 : 0;
     }
-    if (colors | texcoords) {
-      const uint32_t a = cv[next_corner(c)], b = cv[prev_corner(c)];
-      if (colors) {
-        const Vec4f ca = in.colors[a], cb = in.colors[b];
-        out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f,
-                          (ca.w + cb.w) * 0.5f};
-      }
-      if (texcoords) {
-        const Vec2f ta = in.texcoords[a], tb = in.texcoords[b];
-        out.texcoords[id] = {(ta.x + tb.x) * 0.5f, (ta.y + tb.y) * 0.5f};
-      }
-    }
+    if (attributes) average_vertex_attributes(in, cv[next_corner(c)], cv[prev_corner(c)], id, out);
   }
-  scratch.points.record_fans = in.want_topology;
-  compute_edge_points(m, edge_of.data(), V, E, *in.weights, in.placement, pos, scratch.points);
-  if (in.want_topology) {
-    map_fans_to_uniform_children(scratch.points);
-  } else {
-    scratch.points.fans_valid = false;
-  }
+}
 
+// Face 4f + i = (v_i, m_{i+2}, m_{i+1}), face 4f + 3 = (m_0, m_1, m_2); the
+// children's labels and source faces.
+void write_children(const SplitInput& in, const uint32_t* edge_of, LevelMesh& out,
+                    std::vector<FaceKind>* face_kind) {
+  const uint32_t F = in.mesh.face_count;
+  const uint32_t* cv = in.mesh.corner_vertex;
   out.triangles.resize(4 * static_cast<size_t>(F));
   uint32_t* t = out.triangles.front().data();
   for (uint32_t f = 0; f < F; ++f) {
@@ -113,15 +89,20 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
   } else {
     out.source.clear();
   }
+}
 
-  if (!in.want_topology) return;
+// The children's corner table (opposite, across, feature flags) by index
+// arithmetic from the parent's.
+void link_children(const LevelView& m, const uint32_t* mid, LevelMesh& out) {
+  const uint32_t F = m.face_count;
+  const uint32_t* opp = m.opposite;
+  const uint32_t* cv = m.corner_vertex;
   out.opposite.resize(12 * static_cast<size_t>(F));
   out.feature_edge.resize(12 * static_cast<size_t>(F));
   out.across.resize(12 * static_cast<size_t>(F));
   uint32_t* oo = out.opposite.data();
   uint32_t* ax = out.across.data();
   uint8_t* fe = out.feature_edge.data();
-  const uint32_t* mid = edge_of.data();
   for (uint32_t f = 0; f < F; ++f) {
     const uint32_t base = 12 * f;  // first corner of child 4f
     for (uint32_t i = 0; i < 3; ++i) {
@@ -155,6 +136,35 @@ void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
     }
   }
   out.green.clear();
+}
+
+}  // namespace
+
+void split_uniform(const SplitInput& in, SplitScratch& scratch, LevelMesh& out,
+                   std::vector<FaceKind>* face_kind) {
+  const LevelView& m = in.mesh;
+  const uint32_t V = m.vertex_count, corners = 3 * m.face_count;
+  const uint32_t* opp = m.opposite;
+
+  // Edge count first, to size the outputs once.
+  uint32_t E = 0;
+  for (uint32_t c = 0; c < corners; ++c) E += (opp[c] == kNone || c < opp[c]);
+  start_vertices(in, E, out);
+  std::vector<uint32_t>& edge_of = scratch.edge_vertex;
+  edge_of.resize(corners);
+  name_edges(in, edge_of.data(), out);
+
+  scratch.points.record_fans = in.want_topology;
+  compute_edge_points(m, edge_of.data(), V, E, *in.weights, in.placement, out.positions.data(),
+                      scratch.points);
+  if (in.want_topology) {
+    map_fans_to_uniform_children(scratch.points);
+  } else {
+    scratch.points.fans_valid = false;
+  }
+
+  write_children(in, edge_of.data(), out, face_kind);
+  if (in.want_topology) link_children(m, edge_of.data(), out);
 }
 
 }  // namespace meshstream::asa

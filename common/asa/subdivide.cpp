@@ -56,32 +56,27 @@ Status check_options(const AsaOptions& o) {
   return {};
 }
 
-}  // namespace
-
-Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
-                      AsaResult& result) {
-  if (auto ok = check_options(options); !ok) return ok;
-  if (auto ok = validate_arrays(mesh); !ok) return ok;
-  // Levels multiply faces by up to 4 each; refuse what cannot be indexed.
+// Levels multiply faces by up to 4 each; refuse what cannot be indexed.
+Status check_output_size(const Mesh& mesh, const AsaOptions& options) {
   const double projected = static_cast<double>(mesh.face_count()) * std::pow(4.0, options.levels);
   if (projected > 1.0e9) {
     return make_error(ErrorCode::kLimit, "subdividing " + std::to_string(mesh.face_count()) +
                                              " faces " + std::to_string(options.levels) +
                                              " times exceeds 1e9 faces");
   }
+  return {};
+}
 
-  AsaWorkspace::Buffers& ws = workspace.buffers();
-  ws.scratch.points.fans_valid = false;  // a new input: fans are walked again
-  ws.stats.targets.clear();
-  ws.stats.split_edges.clear();
+// Level 0: the caller's arrays plus our corner table, feature flags and
+// faces per vertex, and the Butterfly weights for its valences.
+Status build_base_level(const Mesh& mesh, const AsaOptions& options, AsaWorkspace::Buffers& ws,
+                        asa::LevelView& view) {
   const uint32_t F = mesh.face_count(), V = mesh.vertex_count();
-
-  // Level 0: the caller's arrays plus our corner table and feature flags.
   asa::LevelMesh& base = ws.base;
   if (auto built = asa::build_opposites(mesh, base.opposite, base.across, ws.corner_scratch);
       !built)
     return built;
-  asa::LevelView view;
+  view = {};
   view.positions = mesh.positions.data();
   view.corner_vertex = F ? mesh.triangles.front().data() : nullptr;
   view.opposite = base.opposite.data();
@@ -105,18 +100,120 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   view.green = nullptr;
   ws.weights.configure(options.tension);
   ws.weights.add_valences(base.valence.data(), base.vertex_features.data(), V);
+  return {};
+}
 
-  const Vec4f* colors = mesh.colors.empty() ? nullptr : mesh.colors.data();
-  const Vec2f* texcoords = mesh.texcoords.empty() ? nullptr : mesh.texcoords.data();
-  const asa::EdgePlacement placement = options.rule == ButterflyRule::kProjection
-                                           ? asa::EdgePlacement::kProjection
-                                           : asa::EdgePlacement::kZorin;
+// The result is the level `in` as it stands (nothing bends any more): its
+// arrays copied, every face untouched, normals recomputed when wanted.
+void copy_level_unchanged(const asa::SplitInput& in, bool normals, AsaResult& result) {
+  const asa::LevelView& view = in.mesh;
+  const size_t V = view.vertex_count, F = view.face_count;
+  result.mesh.positions.assign(view.positions, view.positions + V);
+  result.mesh.triangles.resize(F);
+  if (F) std::memcpy(result.mesh.triangles.data(), view.corner_vertex, F * sizeof(Triangle));
+  if (in.colors)
+    result.mesh.colors.assign(in.colors, in.colors + V);
+  else
+    result.mesh.colors.clear();
+  if (in.texcoords)
+    result.mesh.texcoords.assign(in.texcoords, in.texcoords + V);
+  else
+    result.mesh.texcoords.clear();
+  result.face_kind.assign(F, FaceKind::kUntouched);
+  if (in.source)
+    result.source_face.assign(in.source, in.source + F);
+  else
+    result.source_face.clear();
+  if (normals)
+    result.mesh.normals = compute_vertex_normals(result.mesh);
+  else
+    result.mesh.normals.clear();
+}
 
-  const uint32_t* source = nullptr;
+// One adaptive level of `in` into `out`: flatness targets, closure, split.
+// Level 0 tests every edge; later levels only the edges of faces the last
+// split made (their normals came with the split), unless most faces are new
+// anyway. Returns false, leaving `out` alone, when no face is a target.
+bool split_adaptive_level(int level, const AsaOptions& options, asa::SplitInput& in,
+                          AsaWorkspace::Buffers& ws, asa::LevelMesh& out,
+                          std::vector<FaceKind>* kinds) {
+  const asa::LevelView& view = in.mesh;
+  const bool mostly_fresh =
+      level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
+  const uint32_t targets =
+      level == 0 || mostly_fresh
+          ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
+          : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
+  if (targets == 0) return false;
+  const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
+  in.normals = ws.normals.data();
+  asa::split_adaptive(in, ws.closure, ws.scratch, out, kinds);
+  if (in.want_topology) {
+    std::swap(ws.normals, out.normals);
+    std::swap(ws.fresh, out.fresh);
+  }
+  ws.stats.targets.push_back(targets);
+  ws.stats.split_edges.push_back(split);
+  return true;
+}
+
+// `out` becomes the next level's input. Adaptive bisections change valences
+// (the split counted them): any new ones get weights, looking only at new
+// vertices and those of replaced faces.
+void advance_to(asa::LevelMesh& out, bool uniform, AsaWorkspace::Buffers& ws, asa::SplitInput& in) {
+  if (!uniform) {
+    ws.weights.add_valences(out.valence.data(), out.vertex_features.data(), ws.scratch.touched);
+    ws.weights.add_valences(out.valence.data(), out.vertex_features.data(), in.mesh.vertex_count,
+                            static_cast<uint32_t>(out.valence.size()) - in.mesh.vertex_count);
+  }
+  in.mesh = out.view();
+  if (in.source) in.source = out.source.data();
+  in.colors = out.colors.empty() ? nullptr : out.colors.data();
+  in.texcoords = out.texcoords.empty() ? nullptr : out.texcoords.data();
+}
+
+// The last level's arrays move into the result.
+void take_last_level(asa::LevelMesh& out, bool source, bool normals, AsaResult& result) {
+  std::swap(result.mesh.positions, out.positions);
+  std::swap(result.mesh.triangles, out.triangles);
+  std::swap(result.mesh.colors, out.colors);
+  std::swap(result.mesh.texcoords, out.texcoords);
+  if (source)
+    std::swap(result.source_face, out.source);
+  else
+    result.source_face.clear();
+  if (normals) {
+    result.mesh.normals = compute_vertex_normals(result.mesh);
+  } else {
+    result.mesh.normals.clear();
+  }
+}
+
+}  // namespace
+
+Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
+                      AsaResult& result) {
+  if (auto ok = check_options(options); !ok) return ok;
+  if (auto ok = validate_arrays(mesh); !ok) return ok;
+  if (auto ok = check_output_size(mesh, options); !ok) return ok;
+
+  AsaWorkspace::Buffers& ws = workspace.buffers();
+  ws.scratch.points.fans_valid = false;  // a new input: fans are walked again
+  ws.stats.targets.clear();
+  ws.stats.split_edges.clear();
+  const uint32_t F = mesh.face_count();
+
+  asa::SplitInput in;
+  if (auto built = build_base_level(mesh, options, ws, in.mesh); !built) return built;
+  in.colors = mesh.colors.empty() ? nullptr : mesh.colors.data();
+  in.texcoords = mesh.texcoords.empty() ? nullptr : mesh.texcoords.data();
+  in.weights = &ws.weights;
+  in.placement = options.rule == ButterflyRule::kProjection ? asa::EdgePlacement::kProjection
+                                                            : asa::EdgePlacement::kZorin;
   if (options.track_source_faces) {
     ws.identity.resize(F);
     for (uint32_t f = 0; f < F; ++f) ws.identity[f] = f;
-    source = ws.identity.data();
+    in.source = ws.identity.data();
   }
   if (options.levels == 0 || F == 0) {
     result.mesh = mesh;
@@ -128,101 +225,32 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     return {};
   }
 
+  const bool normals = !mesh.normals.empty();
   for (int level = 0; level < options.levels; ++level) {
     const bool last = level + 1 == options.levels;
     asa::LevelMesh& out = ws.levels[level % 2];
-    asa::SplitInput in;
-    in.mesh = view;
-    in.colors = colors;
-    in.texcoords = texcoords;
-    in.weights = &ws.weights;
-    in.placement = placement;
     in.want_topology = !last;
-    in.source = source;
+    in.normals = nullptr;
     std::vector<FaceKind>* kinds = last ? &result.face_kind : nullptr;
     if (options.uniform) {
       asa::split_uniform(in, ws.scratch, out, kinds);
-      ws.stats.targets.push_back(view.face_count);
+      ws.stats.targets.push_back(in.mesh.face_count);
       ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) -
-                                     view.vertex_count);
-    } else {
-      // Level 0 tests every edge; later levels only the edges of faces the
-      // last split made (their normals came with the split), unless most
-      // faces are new anyway.
-      const bool mostly_fresh =
-          level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
-      const uint32_t targets =
-          level == 0 || mostly_fresh
-              ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
-              : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness,
-                                             ws.target);
-      if (targets == 0) {
-        // Nothing bends: this and every later level would copy the mesh
-        // unchanged (same normals, same verdicts). Stop here.
-        const size_t V = view.vertex_count, F = view.face_count;
-        result.mesh.positions.assign(view.positions, view.positions + V);
-        result.mesh.triangles.resize(F);
-        if (F) std::memcpy(result.mesh.triangles.data(), view.corner_vertex, F * sizeof(Triangle));
-        if (colors)
-          result.mesh.colors.assign(colors, colors + V);
-        else
-          result.mesh.colors.clear();
-        if (texcoords)
-          result.mesh.texcoords.assign(texcoords, texcoords + V);
-        else
-          result.mesh.texcoords.clear();
-        result.face_kind.assign(F, FaceKind::kUntouched);
-        if (source)
-          result.source_face.assign(source, source + F);
-        else
-          result.source_face.clear();
-        if (!mesh.normals.empty())
-          result.mesh.normals = compute_vertex_normals(result.mesh);
-        else
-          result.mesh.normals.clear();
-        for (int rest = level; rest < options.levels; ++rest) {
-          ws.stats.targets.push_back(0);
-          ws.stats.split_edges.push_back(0);
-        }
-        return {};
+                                     in.mesh.vertex_count);
+    } else if (!split_adaptive_level(level, options, in, ws, out, kinds)) {
+      // Nothing bends: this and every later level would copy the mesh
+      // unchanged (same normals, same verdicts). Stop here.
+      copy_level_unchanged(in, normals, result);
+      for (int rest = level; rest < options.levels; ++rest) {
+        ws.stats.targets.push_back(0);
+        ws.stats.split_edges.push_back(0);
       }
-      const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
-      in.normals = ws.normals.data();
-      asa::split_adaptive(in, ws.closure, ws.scratch, out, kinds);
-      if (!last) {
-        std::swap(ws.normals, out.normals);
-        std::swap(ws.fresh, out.fresh);
-      }
-      ws.stats.targets.push_back(targets);
-      ws.stats.split_edges.push_back(split);
+      return {};
     }
-    if (!last) {
-      if (!options.uniform) {
-        // Bisections change valences (the split counted them): add any new
-        // ones, looking only at new vertices and those of replaced faces.
-        ws.weights.add_valences(out.valence.data(), out.vertex_features.data(), ws.scratch.touched);
-        ws.weights.add_valences(out.valence.data(), out.vertex_features.data(), view.vertex_count,
-                                static_cast<uint32_t>(out.valence.size()) - view.vertex_count);
-      }
-      view = out.view();
-      if (source) source = out.source.data();
-      colors = out.colors.empty() ? nullptr : out.colors.data();
-      texcoords = out.texcoords.empty() ? nullptr : out.texcoords.data();
-    } else {
-      std::swap(result.mesh.positions, out.positions);
-      std::swap(result.mesh.triangles, out.triangles);
-      std::swap(result.mesh.colors, out.colors);
-      std::swap(result.mesh.texcoords, out.texcoords);
-      if (source)
-        std::swap(result.source_face, out.source);
-      else
-        result.source_face.clear();
-      if (!mesh.normals.empty()) {
-        result.mesh.normals = compute_vertex_normals(result.mesh);
-      } else {
-        result.mesh.normals.clear();
-      }
-    }
+    if (!last)
+      advance_to(out, options.uniform, ws, in);
+    else
+      take_last_level(out, in.source != nullptr, normals, result);
   }
   return {};
 }

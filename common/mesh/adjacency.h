@@ -93,6 +93,12 @@ class Adjacency {
   uint32_t boundary_edge_count() const { return boundary_edge_count_; }
 
  private:
+  // The phases of build(), in order (see adjacency.cpp).
+  Status copy_corners(const Mesh& mesh);
+  Status link_opposites(uint32_t vertex_count);
+  Status find_vertex_fans(uint32_t vertex_count);
+  void count_edges();
+
   std::vector<uint32_t> corner_vertex_;
   std::vector<uint32_t> opposite_;
   std::vector<uint32_t> vertex_corner_;

@@ -219,13 +219,8 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
   CleanReport report;
   report.vertices_in_file = mesh.vertex_count();
   report.faces_in_file = mesh.face_count();
+  if (auto ok = check_attribute_counts(mesh); !ok) return tl::unexpected(ok.error());
   const size_t n = mesh.positions.size();
-  auto attribute_ok = [n](size_t size) { return size == 0 || size == n; };
-  if (!attribute_ok(mesh.normals.size()) || !attribute_ok(mesh.colors.size()) ||
-      !attribute_ok(mesh.texcoords.size())) {
-    return make_error(ErrorCode::kInvalidMesh, "per-vertex attribute count does not match the " +
-                                                   std::to_string(n) + " vertices");
-  }
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     for (uint32_t v : mesh.triangles[f]) {
       if (v >= n) {

@@ -187,24 +187,25 @@ Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext)
   }
   raw.vertices_in_file = vertex_count;
 
-  auto optional = [&](draco::GeometryAttribute::Type type, const char* name, auto& target, auto tag,
-                      float fill) {
+  auto optional = [&](draco::GeometryAttribute::Type type, const char* name, auto& target,
+                      AttributeInFile& contents, auto tag, float fill) {
     const draco::PointAttribute* attribute = dm.GetNamedAttribute(type);
     if (attribute == nullptr) return;
+    contents.count = attribute->size();
     using V = typename std::remove_reference_t<decltype(target)>::value_type;
     constexpr int N = decltype(tag)::value;
     if (!gather<V, N>(dm, *attribute, corner_vertex, vertex_count, fill, target)) {
       target.clear();
-      raw.notes.push_back(std::string(name) +
-                          " dropped: they differ between corners of one vertex (per-face values)");
+      note_dropped(raw, contents, name,
+                   "they differ between corners of one vertex (per-face values)");
     }
   };
-  optional(draco::GeometryAttribute::NORMAL, "normals", mesh.normals,
+  optional(draco::GeometryAttribute::NORMAL, "normals", mesh.normals, raw.contents.normals,
            std::integral_constant<int, 3>{}, 0.0f);
-  optional(draco::GeometryAttribute::COLOR, "colors", mesh.colors, std::integral_constant<int, 4>{},
-           1.0f);
+  optional(draco::GeometryAttribute::COLOR, "colors", mesh.colors, raw.contents.colors,
+           std::integral_constant<int, 4>{}, 1.0f);
   optional(draco::GeometryAttribute::TEX_COORD, "texture coordinates", mesh.texcoords,
-           std::integral_constant<int, 2>{}, 0.0f);
+           raw.contents.texcoords, std::integral_constant<int, 2>{}, 0.0f);
   return raw;
 }
 

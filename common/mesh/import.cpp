@@ -1,6 +1,7 @@
 #include "common/mesh/import.h"
 
 #include <cctype>
+#include <filesystem>
 #include <fstream>
 
 #include "common/mesh/mesh_readers.h"
@@ -14,6 +15,14 @@ bool has_extension(const std::string& path, const char* wanted) {
   std::string ext = path.substr(path.size() - n);
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext == wanted;
+}
+
+// The format's name from the extension, for readers that do not set one.
+std::string format_name(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  for (char& c : ext) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return ext;
 }
 
 Result<RawMesh> read_by_format(const std::string& path) {
@@ -46,6 +55,8 @@ Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& o
   imported.report = std::move(*report);
   imported.report.vertices_in_file = raw->vertices_in_file;
   imported.report.notes.insert(imported.report.notes.begin(), raw->notes.begin(), raw->notes.end());
+  imported.contents = std::move(raw->contents);
+  if (imported.contents.format.empty()) imported.contents.format = format_name(path);
   return imported;
 }
 

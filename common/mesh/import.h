@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/mesh/file_contents.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
@@ -64,6 +65,7 @@ struct ImportOptions {
 struct ImportedMesh {
   Mesh mesh;
   CleanReport report;
+  FileContents contents;  // what the file holds, including what import did not keep
 };
 
 // Reads and cleans `path`. Errors name the file and the problem: unreadable

@@ -16,7 +16,7 @@ BoundingBox bounding_box(const Mesh& mesh) {
   return box;
 }
 
-Status validate_arrays(const Mesh& mesh) {
+Status check_attribute_counts(const Mesh& mesh) {
   const size_t n = mesh.positions.size();
   auto attribute_ok = [n](size_t size) { return size == 0 || size == n; };
   if (!attribute_ok(mesh.normals.size()) || !attribute_ok(mesh.colors.size()) ||
@@ -24,6 +24,12 @@ Status validate_arrays(const Mesh& mesh) {
     return make_error(ErrorCode::kInvalidMesh, "per-vertex attribute count does not match the " +
                                                    std::to_string(n) + " vertices");
   }
+  return {};
+}
+
+Status validate_arrays(const Mesh& mesh) {
+  if (auto ok = check_attribute_counts(mesh); !ok) return ok;
+  const size_t n = mesh.positions.size();
   for (size_t v = 0; v < n; ++v) {
     const Vec3f& p = mesh.positions[v];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {

@@ -35,6 +35,10 @@ struct BoundingBox {
 // Bounding box of the positions; {0,0,0}-{0,0,0} for an empty mesh. O(V).
 BoundingBox bounding_box(const Mesh& mesh);
 
+// Every per-vertex attribute array is empty or has one value per vertex;
+// kInvalidMesh otherwise. O(1).
+Status check_attribute_counts(const Mesh& mesh);
+
 // Checks the array-level rules: attribute sizes match, every index is in
 // range, no triangle repeats a vertex, every coordinate is finite.
 // The error names the first offending element. O(V + F).

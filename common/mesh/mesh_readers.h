@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/mesh/file_contents.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
@@ -17,7 +18,20 @@ struct RawMesh {
   Mesh mesh;                       // indices may be anything: clean_mesh validates
   uint32_t vertices_in_file = 0;   // as the file counts them (STL: 3 per triangle)
   std::vector<std::string> notes;  // e.g. attributes that could not be kept
+  FileContents contents;           // what the file holds, kept or not (format set by import)
 };
+
+// Records that the file's `name` (e.g. "normals") are not kept, and why: in
+// the notes ("normals dropped: why") and in the attribute's contents entry.
+inline void note_dropped(RawMesh& raw, AttributeInFile& attribute, const std::string& name,
+                         const std::string& why) {
+  attribute.dropped = why;
+  raw.notes.push_back(name + " dropped: " + why);
+}
+
+// The whole file: kIo "cannot open the file for reading" or "read failed".
+// One read into a buffer sized from the file length.
+Result<std::string> read_file_bytes(const std::string& path);
 
 // OFF, COFF, NOFF, STOFF and combinations ("CNOFF", ...), headerless counts
 // too. Comments (#) anywhere; polygons are fan-triangulated (v0, vk, vk+1).

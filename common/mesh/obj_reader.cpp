@@ -186,6 +186,7 @@ class ObjParser {
   uint32_t first_bad_normal_line_ = 0, first_bad_texcoord_line_ = 0;
   uint32_t line_elements_ = 0, point_elements_ = 0, unknown_lines_ = 0;
   std::string first_unknown_;
+  std::vector<std::string> material_libraries_, materials_used_;  // mtllib and usemtl names
   std::string joined_;  // a logical line made of continued physical lines
 };
 
@@ -419,7 +420,16 @@ Status ObjParser::parse_line(std::string_view line) {
   if (keyword == "f") return parse_face(rest);
   if (keyword == "vn") return parse_normal(rest);
   if (keyword == "vt") return parse_texcoord(rest);
-  if (keyword == "l") {
+  if (keyword == "mtllib") {
+    // Names are separated by blanks (names with blanks are not portable).
+    for (std::string_view name = next_token(rest); !name.empty(); name = next_token(rest))
+      material_libraries_.emplace_back(name);
+  } else if (keyword == "usemtl") {
+    const std::string name(next_token(rest));
+    if (!name.empty() &&
+        std::find(materials_used_.begin(), materials_used_.end(), name) == materials_used_.end())
+      materials_used_.push_back(name);
+  } else if (keyword == "l") {
     ++line_elements_;
   } else if (keyword == "p") {
     ++point_elements_;
@@ -469,29 +479,32 @@ void ObjParser::gather_attributes(RawMesh& raw) {
   Mesh& mesh = raw.mesh;
   const uint32_t n = mesh.vertex_count();
   auto attribute = [&](auto& values, const std::vector<uint32_t>& corner_index, auto& target,
-                       const char* name, const char* keyword, uint32_t bad_line) {
+                       AttributeInFile& contents, const char* name, const char* keyword,
+                       uint32_t bad_line) {
+    contents.count = values.size();
     if (values.empty()) return;
     if (corner_index.empty()) {
-      raw.notes.push_back(std::string(name) + " dropped: the file has '" + keyword +
-                          "' lines but no face refers to them");
+      note_dropped(raw, contents, name,
+                   std::string("the file has '") + keyword + "' lines but no face refers to them");
       return;
     }
     if (bad_line != 0) {
-      raw.notes.push_back(std::string(name) + " dropped: " + at_line(bad_line) + "NaN or Inf");
+      note_dropped(raw, contents, name, at_line(bad_line) + "NaN or Inf");
       return;
     }
     bool some_missing = false;
     if (!gather(mesh.triangles, corner_index, values, n, target, some_missing)) {
       target.clear();
-      raw.notes.push_back(std::string(name) +
-                          (some_missing ? " dropped: some face corners have none"
-                                        : " dropped: they differ between corners of one vertex "
-                                          "(per-face values)"));
+      note_dropped(raw, contents, name,
+                   some_missing ? "some face corners have none"
+                                : "they differ between corners of one vertex (per-face values)");
     }
   };
-  attribute(normals_, corner_vn_, mesh.normals, "normals", "vn", first_bad_normal_line_);
-  attribute(texcoords_, corner_vt_, mesh.texcoords, "texture coordinates", "vt",
-            first_bad_texcoord_line_);
+  attribute(normals_, corner_vn_, mesh.normals, raw.contents.normals, "normals", "vn",
+            first_bad_normal_line_);
+  attribute(texcoords_, corner_vt_, mesh.texcoords, raw.contents.texcoords, "texture coordinates",
+            "vt", first_bad_texcoord_line_);
+  raw.contents.colors.count = vertices_with_color_;
 
   if (vertices_with_color_ == n && n > 0) {
     // 0..1 floats, or 0..255 integers when any value exceeds 1 (both occur).
@@ -503,8 +516,9 @@ void ObjParser::gather_attributes(RawMesh& raw) {
       mesh.colors[v] = {colors_[v].x * scale, colors_[v].y * scale, colors_[v].z * scale, 1.0f};
     }
   } else if (vertices_with_color_ > 0) {
-    raw.notes.push_back("colors dropped: only " + std::to_string(vertices_with_color_) + " of " +
-                        std::to_string(n) + " vertices have one");
+    note_dropped(raw, raw.contents.colors, "colors",
+                 "only " + std::to_string(vertices_with_color_) + " of " + std::to_string(n) +
+                     " vertices have one");
   }
 }
 
@@ -591,6 +605,10 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
   raw.mesh.positions = std::move(positions_);
   raw.mesh.triangles = std::move(triangles_);
   gather_attributes(raw);
+  raw.contents.format = "OBJ";
+  for (const std::string& name : material_libraries_)
+    raw.contents.material_libraries.push_back({.name = name});
+  raw.contents.materials_used = std::move(materials_used_);
   if (line_elements_ + point_elements_ > 0) {
     raw.notes.push_back(std::to_string(line_elements_) + " line elements ('l') and " +
                         std::to_string(point_elements_) +
@@ -608,21 +626,9 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
 Result<RawMesh> parse_obj_text(std::string_view text) { return ObjParser().parse(text); }
 
 Result<RawMesh> read_obj(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) return make_error(ErrorCode::kIo, "cannot open the file for reading");
-  std::string text;
-  if (std::fseek(file, 0, SEEK_END) == 0) {
-    const long size = std::ftell(file);
-    if (size > 0) text.reserve(static_cast<size_t>(size));
-    std::rewind(file);
-  }
-  char buffer[1 << 16];
-  size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) text.append(buffer, got);
-  const bool failed = std::ferror(file) != 0;
-  std::fclose(file);
-  if (failed) return make_error(ErrorCode::kIo, "read failed");
-  return parse_obj_text(text);
+  auto text = read_file_bytes(path);
+  if (!text) return tl::unexpected(text.error());
+  return parse_obj_text(*text);
 }
 
 }  // namespace meshstream

@@ -6,8 +6,6 @@
 // line ("n i0 ... i(n-1)" and an optional colour that we ignore).
 #include <charconv>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <string_view>
 
 #include "common/mesh/mesh_readers.h"
@@ -95,25 +93,22 @@ bool parse_keyword(std::string_view word, OffLayout& layout, bool& unsupported) 
 
 std::string at_line(uint32_t line) { return "line " + std::to_string(line) + ": "; }
 
-}  // namespace
+struct OffHeader {
+  OffLayout layout;
+  uint64_t vertex_count = 0, face_count = 0;
+};
 
-Result<RawMesh> read_off(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(ErrorCode::kIo, "cannot open the file for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) return make_error(ErrorCode::kIo, "read failed");
-  const size_t file_size = buffer.str().size();
-  LineReader reader(std::move(buffer).str());
-
+// The keyword line (optional) and the "vertices faces edges" counts; `tokens`
+// is scratch. Counts that cannot fit in the file are refused.
+Result<OffHeader> read_header(LineReader& reader, size_t file_size,
+                              std::vector<std::string_view>& tokens) {
   std::string_view line;
-  std::vector<std::string_view> tokens;
   if (!reader.next(line)) return make_error(ErrorCode::kParse, "empty OFF file");
   split(line, tokens);
-  OffLayout layout;
+  OffHeader header;
   bool unsupported = false;
   size_t first_count = 0;
-  if (parse_keyword(tokens[0], layout, unsupported)) {
+  if (parse_keyword(tokens[0], header.layout, unsupported)) {
     if (unsupported) {
       return make_error(ErrorCode::kUnsupported, at_line(reader.line_number()) + "OFF variant '" +
                                                      std::string(tokens[0]) +
@@ -127,7 +122,8 @@ Result<RawMesh> read_off(const std::string& path) {
       first_count = 0;
     }
   }
-  uint64_t vertex_count = 0, face_count = 0;
+  uint64_t& vertex_count = header.vertex_count;
+  uint64_t& face_count = header.face_count;
   if (tokens.size() < first_count + 2 || !parse_uint(tokens[first_count], vertex_count) ||
       !parse_uint(tokens[first_count + 1], face_count)) {
     return make_error(ErrorCode::kParse,
@@ -142,15 +138,22 @@ Result<RawMesh> read_off(const std::string& path) {
                                              " faces) cannot fit in a file of " +
                                              std::to_string(file_size) + " bytes");
   }
+  return header;
+}
 
-  RawMesh raw;
-  Mesh& mesh = raw.mesh;
+// One line per vertex: x y z, then normal, colour (3 or 4 numbers) and
+// texture coordinates as the keyword announces.
+Status read_vertices(LineReader& reader, const OffHeader& header,
+                     std::vector<std::string_view>& tokens, Mesh& mesh) {
+  const OffLayout& layout = header.layout;
+  const uint64_t vertex_count = header.vertex_count;
   mesh.positions.resize(vertex_count);
   if (layout.normals) mesh.normals.resize(vertex_count);
   if (layout.colors) mesh.colors.resize(vertex_count);
   if (layout.texcoords) mesh.texcoords.resize(vertex_count);
   const size_t needed = 3 + (layout.normals ? 3 : 0) + (layout.texcoords ? 2 : 0);
   bool colors_are_bytes = false;
+  std::string_view line;
   for (uint64_t v = 0; v < vertex_count; ++v) {
     if (!reader.next(line)) {
       return make_error(ErrorCode::kTruncated, "file ends after " + std::to_string(v) + " of " +
@@ -195,8 +198,16 @@ Result<RawMesh> read_off(const std::string& path) {
       c = {c.x * scale, c.y * scale, c.z * scale, opaque ? 1.0f : c.w * scale};
     }
   }
+  return {};
+}
 
+// One line per face: "n i0 ... i(n-1)", fan-triangulated; a trailing colour
+// is skipped (counted in `face_colors`).
+Status read_faces(LineReader& reader, const OffHeader& header,
+                  std::vector<std::string_view>& tokens, Mesh& mesh, uint64_t& face_colors) {
+  const uint64_t vertex_count = header.vertex_count, face_count = header.face_count;
   mesh.triangles.reserve(face_count * 2);
+  std::string_view line;
   for (uint64_t f = 0; f < face_count; ++f) {
     if (!reader.next(line)) {
       return make_error(ErrorCode::kTruncated, "file ends after " + std::to_string(f) + " of " +
@@ -220,6 +231,7 @@ Result<RawMesh> read_off(const std::string& path) {
                                                std::to_string(corners) + " vertices but lists " +
                                                std::to_string(tokens.size() - 1));
     }
+    if (tokens.size() > corners + 1) ++face_colors;
     uint32_t first = 0, previous = 0;
     for (uint64_t k = 0; k < corners; ++k) {
       uint64_t index = 0;
@@ -240,7 +252,35 @@ Result<RawMesh> read_off(const std::string& path) {
       previous = i;
     }
   }
-  raw.vertices_in_file = static_cast<uint32_t>(vertex_count);
+  return {};
+}
+
+}  // namespace
+
+Result<RawMesh> read_off(const std::string& path) {
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return tl::unexpected(bytes.error());
+  const size_t file_size = bytes->size();
+  LineReader reader(std::move(*bytes));
+  std::vector<std::string_view> tokens;
+  auto header = read_header(reader, file_size, tokens);
+  if (!header) return tl::unexpected(header.error());
+  RawMesh raw;
+  if (auto ok = read_vertices(reader, *header, tokens, raw.mesh); !ok)
+    return tl::unexpected(ok.error());
+  uint64_t face_colors = 0;
+  if (auto ok = read_faces(reader, *header, tokens, raw.mesh, face_colors); !ok)
+    return tl::unexpected(ok.error());
+  raw.vertices_in_file = static_cast<uint32_t>(header->vertex_count);
+  raw.contents.format = "OFF";
+  const OffLayout& layout = header->layout;
+  if (layout.normals) raw.contents.normals.count = header->vertex_count;
+  if (layout.colors) raw.contents.colors.count = header->vertex_count;
+  if (layout.texcoords) raw.contents.texcoords.count = header->vertex_count;
+  if (face_colors > 0) {
+    raw.contents.extra_properties.push_back("face colour (on " + std::to_string(face_colors) +
+                                            " faces)");
+  }
   return raw;
 }
 

@@ -8,7 +8,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string_view>
 
@@ -222,17 +221,41 @@ int find_property(const Element& element, std::initializer_list<const char*> nam
   return -1;
 }
 
-}  // namespace
+struct Header {
+  Encoding encoding = Encoding::kAscii;
+  std::vector<Element> elements;
+  size_t body_start = 0;  // first byte after end_header (may be data.size())
+};
 
-Result<RawMesh> read_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(ErrorCode::kIo, "cannot open the file for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) return make_error(ErrorCode::kIo, "read failed");
-  const std::string data = std::move(buffer).str();
+// One `property` line's words after the keyword; the error says what is wrong
+// with them (the caller adds the line).
+Result<Property> parse_property(std::istringstream& words) {
+  Property property;
+  std::string type;
+  words >> type;
+  if (type == "list") {
+    std::string count_type, item_type;
+    words >> count_type >> item_type >> property.name;
+    property.is_list = true;
+    if (!parse_scalar_type(count_type, property.count_type) ||
+        !parse_scalar_type(item_type, property.type)) {
+      return make_error(ErrorCode::kParse,
+                        "unknown list types '" + count_type + " " + item_type + "'");
+    }
+  } else {
+    words >> property.name;
+    if (!parse_scalar_type(type, property.type)) {
+      return make_error(ErrorCode::kParse, "unknown type '" + type + "'");
+    }
+  }
+  if (property.name.empty()) {
+    return make_error(ErrorCode::kParse, "property without a name");
+  }
+  return property;
+}
 
-  // Header.
+// The header: magic, format, elements and their properties, end_header.
+Result<Header> parse_header(const std::string& data) {
   size_t pos = 0;
   uint32_t line_number = 0;
   auto next_line = [&](std::string_view& line) {
@@ -252,9 +275,8 @@ Result<RawMesh> read_ply(const std::string& path) {
   std::string_view line;
   if (!next_line(line) || line != "ply")
     return make_error(ErrorCode::kParse, "not a PLY file (no 'ply' magic)");
-  Encoding encoding = Encoding::kAscii;
+  Header header;
   bool have_format = false, have_end = false;
-  std::vector<Element> elements;
   while (next_line(line)) {
     std::istringstream words{std::string(line)};
     std::string keyword;
@@ -268,49 +290,37 @@ Result<RawMesh> read_ply(const std::string& path) {
       std::string name, version;
       words >> name >> version;
       if (name == "ascii")
-        encoding = Encoding::kAscii;
+        header.encoding = Encoding::kAscii;
       else if (name == "binary_little_endian")
-        encoding = Encoding::kBinaryLittle;
+        header.encoding = Encoding::kBinaryLittle;
       else if (name == "binary_big_endian")
-        encoding = Encoding::kBinaryBig;
+        header.encoding = Encoding::kBinaryBig;
       else
         return header_error("unknown format '" + name + "'");
       have_format = true;
     } else if (keyword == "element") {
       Element element;
       if (!(words >> element.name >> element.count)) return header_error("malformed element line");
-      elements.push_back(std::move(element));
+      header.elements.push_back(std::move(element));
     } else if (keyword == "property") {
-      if (elements.empty()) return header_error("property before any element");
-      Property property;
-      std::string type;
-      words >> type;
-      if (type == "list") {
-        std::string count_type, item_type;
-        words >> count_type >> item_type >> property.name;
-        property.is_list = true;
-        if (!parse_scalar_type(count_type, property.count_type) ||
-            !parse_scalar_type(item_type, property.type)) {
-          return header_error("unknown list types '" + count_type + " " + item_type + "'");
-        }
-      } else {
-        words >> property.name;
-        if (!parse_scalar_type(type, property.type))
-          return header_error("unknown type '" + type + "'");
-      }
-      if (property.name.empty()) return header_error("property without a name");
-      elements.back().properties.push_back(std::move(property));
+      if (header.elements.empty()) return header_error("property before any element");
+      auto property = parse_property(words);
+      if (!property) return header_error(property.error().message);
+      header.elements.back().properties.push_back(std::move(*property));
     } else {
       return header_error("unknown keyword '" + keyword + "'");
     }
   }
   if (!have_end) return make_error(ErrorCode::kParse, "PLY header has no end_header");
   if (!have_format) return make_error(ErrorCode::kParse, "PLY header has no format line");
+  header.body_start = std::min(pos, data.size());
+  return header;
+}
 
-  // Every element needs at least one byte (binary) or two (ASCII): counts
-  // beyond the file size are lies, refused before allocating for them.
-  const size_t body_size = data.size() - std::min(pos, data.size());
-  for (const Element& e : elements) {
+// Every element needs at least one byte (binary) or two (ASCII): counts
+// beyond the file size are lies, refused before allocating for them.
+Status check_counts(const Header& header, size_t body_size) {
+  for (const Element& e : header.elements) {
     if (e.count > body_size + 1) {
       return make_error(ErrorCode::kParse, "element '" + e.name + "' claims " +
                                                std::to_string(e.count) +
@@ -318,121 +328,264 @@ Result<RawMesh> read_ply(const std::string& path) {
                                                std::to_string(body_size) + " bytes");
     }
   }
+  return {};
+}
 
-  RawMesh raw;
-  Mesh& mesh = raw.mesh;
-  BodyReader reader(data, std::min(pos, data.size()), encoding);
-  auto body_error = [&](const std::string& where) {
-    std::string at = encoding == Encoding::kAscii
-                         ? "line " + std::to_string(reader.line_at_position())
-                         : "byte " + std::to_string(reader.position());
-    return make_error(reader.truncated() ? ErrorCode::kTruncated : ErrorCode::kParse,
-                      at + ", " + where + ": " + reader.error());
-  };
-  bool have_vertices = false, have_faces = false;
-  uint64_t vertex_count = 0;
-  std::vector<double> values;
-  std::vector<float> floats;
-  for (const Element& element : elements) {
-    const bool is_vertex = element.name == "vertex" && !have_vertices;
-    const bool is_face = element.name == "face" && !have_faces;
-    int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1, r = -1, g = -1, b = -1, a = -1, u = -1,
-        v = -1;
-    int indices = -1;
+// Where the vertex element keeps what we read (-1: absent).
+struct VertexLayout {
+  int x = -1, y = -1, z = -1;
+  int nx = -1, ny = -1, nz = -1;
+  int r = -1, g = -1, b = -1, a = -1;
+  int u = -1, v = -1;
+  bool normals() const { return nx >= 0 && ny >= 0 && nz >= 0; }
+  bool colors() const { return r >= 0 && g >= 0 && b >= 0; }
+  bool texcoords() const { return u >= 0 && v >= 0; }
+};
+
+VertexLayout find_vertex_layout(const Element& e) {
+  return {.x = find_property(e, {"x"}),
+          .y = find_property(e, {"y"}),
+          .z = find_property(e, {"z"}),
+          .nx = find_property(e, {"nx"}),
+          .ny = find_property(e, {"ny"}),
+          .nz = find_property(e, {"nz"}),
+          .r = find_property(e, {"red", "r", "diffuse_red"}),
+          .g = find_property(e, {"green", "g", "diffuse_green"}),
+          .b = find_property(e, {"blue", "b", "diffuse_blue"}),
+          .a = find_property(e, {"alpha", "a"}),
+          .u = find_property(e, {"u", "s", "texture_u", "texture_s"}),
+          .v = find_property(e, {"v", "t", "texture_v", "texture_t"})};
+}
+
+// The face element's index list: "vertex_indices" or "vertex_index", else
+// its first list; -1 when it has none.
+int find_index_list(const Element& element) {
+  for (size_t i = 0; i < element.properties.size(); ++i) {
+    const Property& p = element.properties[i];
+    if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"))
+      return static_cast<int>(i);
+  }
+  for (size_t i = 0; i < element.properties.size(); ++i) {
+    if (element.properties[i].is_list) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// Reads the body element by element into raw.mesh: the first "vertex"
+// element's positions and attributes, the first "face" element's polygons
+// (fan-triangulated); everything else is read and skipped.
+class BodyParser {
+ public:
+  BodyParser(const std::string& data, const Header& header, RawMesh& raw)
+      : header_(header),
+        reader_(data, header.body_start, header.encoding),
+        body_size_(data.size() - header.body_start),
+        mesh_(raw.mesh) {}
+
+  Status read_all() {
+    for (const Element& element : header_.elements) {
+      if (auto ok = read_element(element); !ok) return ok;
+    }
+    if (!have_vertices_) return make_error(ErrorCode::kParse, "PLY file has no vertex element");
+    return {};
+  }
+  uint64_t vertex_count() const { return vertex_count_; }
+
+ private:
+  Status start_vertices(const Element& element) {
+    layout_ = find_vertex_layout(element);
+    if (layout_.x < 0 || layout_.y < 0 || layout_.z < 0)
+      return make_error(ErrorCode::kParse, "PLY vertices have no x, y, z");
+    vertex_count_ = element.count;
+    mesh_.positions.resize(element.count);
+    if (layout_.normals()) mesh_.normals.resize(element.count);
+    if (layout_.colors()) mesh_.colors.resize(element.count);
+    if (layout_.texcoords()) mesh_.texcoords.resize(element.count);
+    have_vertices_ = true;
+    return {};
+  }
+
+  Status start_faces(const Element& element) {
+    indices_ = find_index_list(element);
+    if (indices_ < 0) return make_error(ErrorCode::kParse, "PLY faces have no vertex index list");
+    if (!have_vertices_) return make_error(ErrorCode::kParse, "PLY faces come before the vertices");
+    mesh_.triangles.reserve(std::min<uint64_t>(element.count * 2, body_size_));
+    have_faces_ = true;
+    return {};
+  }
+
+  Status read_element(const Element& element) {
+    const bool is_vertex = element.name == "vertex" && !have_vertices_;
+    const bool is_face = element.name == "face" && !have_faces_;
     if (is_vertex) {
-      x = find_property(element, {"x"}), y = find_property(element, {"y"}),
-      z = find_property(element, {"z"});
-      if (x < 0 || y < 0 || z < 0)
-        return make_error(ErrorCode::kParse, "PLY vertices have no x, y, z");
-      nx = find_property(element, {"nx"}), ny = find_property(element, {"ny"}),
-      nz = find_property(element, {"nz"});
-      r = find_property(element, {"red", "r", "diffuse_red"});
-      g = find_property(element, {"green", "g", "diffuse_green"});
-      b = find_property(element, {"blue", "b", "diffuse_blue"});
-      a = find_property(element, {"alpha", "a"});
-      u = find_property(element, {"u", "s", "texture_u", "texture_s"});
-      v = find_property(element, {"v", "t", "texture_v", "texture_t"});
-      vertex_count = element.count;
-      mesh.positions.resize(element.count);
-      if (nx >= 0 && ny >= 0 && nz >= 0) mesh.normals.resize(element.count);
-      if (r >= 0 && g >= 0 && b >= 0) mesh.colors.resize(element.count);
-      if (u >= 0 && v >= 0) mesh.texcoords.resize(element.count);
-      have_vertices = true;
+      if (auto ok = start_vertices(element); !ok) return ok;
     }
+    indices_ = -1;
     if (is_face) {
-      for (size_t i = 0; i < element.properties.size() && indices < 0; ++i) {
-        const Property& p = element.properties[i];
-        if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"))
-          indices = static_cast<int>(i);
-      }
-      for (size_t i = 0; i < element.properties.size() && indices < 0; ++i) {
-        if (element.properties[i].is_list) indices = static_cast<int>(i);
-      }
-      if (indices < 0) return make_error(ErrorCode::kParse, "PLY faces have no vertex index list");
-      if (!have_vertices)
-        return make_error(ErrorCode::kParse, "PLY faces come before the vertices");
-      mesh.triangles.reserve(std::min<uint64_t>(element.count * 2, body_size));
-      have_faces = true;
+      if (auto ok = start_faces(element); !ok) return ok;
     }
-    values.resize(element.properties.size());
-    floats.resize(element.properties.size());
-    std::vector<uint32_t> polygon;
+    values_.resize(element.properties.size());
+    floats_.resize(element.properties.size());
     for (uint64_t k = 0; k < element.count; ++k) {
       const std::string where = element.name + " " + std::to_string(k);
       for (size_t p = 0; p < element.properties.size(); ++p) {
         const Property& property = element.properties[p];
         if (!property.is_list) {
-          if (!reader.read(property.type, values[p], floats[p])) return body_error(where);
+          if (!reader_.read(property.type, values_[p], floats_[p])) return body_error(where);
           continue;
         }
-        double count_value = 0;
-        float unused = 0;
-        if (!reader.read(property.count_type, count_value, unused)) return body_error(where);
-        if (count_value < 0 || count_value > 1e6) {
-          return make_error(
-              ErrorCode::kParse,
-              where + ": list length " + std::to_string(count_value) + " is out of range");
-        }
-        const bool keep = is_face && static_cast<int>(p) == indices;
-        polygon.clear();
-        for (uint32_t i = 0; i < static_cast<uint32_t>(count_value); ++i) {
-          double item = 0;
-          if (!reader.read(property.type, item, unused)) return body_error(where);
-          if (!keep) continue;
-          if (item < 0 || item >= static_cast<double>(vertex_count) || item != std::floor(item)) {
-            return make_error(ErrorCode::kInvalidMesh,
-                              where + " refers to vertex " + std::to_string(item) +
-                                  " but there are only " + std::to_string(vertex_count));
-          }
-          polygon.push_back(static_cast<uint32_t>(item));
-        }
-        if (keep) {
-          if (polygon.size() < 3) {
-            return make_error(ErrorCode::kParse, where + " has " + std::to_string(polygon.size()) +
-                                                     " vertices; a polygon needs at least 3");
-          }
-          for (size_t i = 2; i < polygon.size(); ++i)
-            mesh.triangles.push_back({polygon[0], polygon[i - 1], polygon[i]});
-        }
+        const bool keep = is_face && static_cast<int>(p) == indices_;
+        if (auto ok = read_list(property, keep, where); !ok) return ok;
       }
-      if (is_vertex) {
-        mesh.positions[k] = {floats[x], floats[y], floats[z]};
-        if (!mesh.normals.empty()) mesh.normals[k] = {floats[nx], floats[ny], floats[nz]};
-        if (!mesh.colors.empty()) {
-          auto channel = [&](int index) {
-            const Property& prop = element.properties[index];
-            const bool integer = prop.type != Scalar::kFloat32 && prop.type != Scalar::kFloat64;
-            return integer ? static_cast<float>(values[index] / integer_range(prop.type))
-                           : floats[index];
-          };
-          mesh.colors[k] = {channel(r), channel(g), channel(b), a >= 0 ? channel(a) : 1.0f};
-        }
-        if (!mesh.texcoords.empty()) mesh.texcoords[k] = {floats[u], floats[v]};
+      if (is_vertex) store_vertex(element, k);
+    }
+    return {};
+  }
+
+  // One list: its length, then its items; the face index list (`keep`)
+  // becomes fan triangles.
+  Status read_list(const Property& property, bool keep, const std::string& where) {
+    double count_value = 0;
+    float unused = 0;
+    if (!reader_.read(property.count_type, count_value, unused)) return body_error(where);
+    if (count_value < 0 || count_value > 1e6) {
+      return make_error(ErrorCode::kParse, where + ": list length " + std::to_string(count_value) +
+                                               " is out of range");
+    }
+    polygon_.clear();
+    for (uint32_t i = 0; i < static_cast<uint32_t>(count_value); ++i) {
+      double item = 0;
+      if (!reader_.read(property.type, item, unused)) return body_error(where);
+      if (!keep) continue;
+      if (item < 0 || item >= static_cast<double>(vertex_count_) || item != std::floor(item)) {
+        return make_error(ErrorCode::kInvalidMesh,
+                          where + " refers to vertex " + std::to_string(item) +
+                              " but there are only " + std::to_string(vertex_count_));
       }
+      polygon_.push_back(static_cast<uint32_t>(item));
+    }
+    if (!keep) return {};
+    if (polygon_.size() < 3) {
+      return make_error(ErrorCode::kParse, where + " has " + std::to_string(polygon_.size()) +
+                                               " vertices; a polygon needs at least 3");
+    }
+    for (size_t i = 2; i < polygon_.size(); ++i)
+      mesh_.triangles.push_back({polygon_[0], polygon_[i - 1], polygon_[i]});
+    return {};
+  }
+
+  void store_vertex(const Element& element, uint64_t k) {
+    const VertexLayout& l = layout_;
+    const float* f = floats_.data();
+    mesh_.positions[k] = {f[l.x], f[l.y], f[l.z]};
+    if (!mesh_.normals.empty()) mesh_.normals[k] = {f[l.nx], f[l.ny], f[l.nz]};
+    if (!mesh_.colors.empty()) {
+      auto channel = [&](int index) {
+        const Property& prop = element.properties[index];
+        const bool integer = prop.type != Scalar::kFloat32 && prop.type != Scalar::kFloat64;
+        return integer ? static_cast<float>(values_[index] / integer_range(prop.type)) : f[index];
+      };
+      mesh_.colors[k] = {channel(l.r), channel(l.g), channel(l.b), l.a >= 0 ? channel(l.a) : 1.0f};
+    }
+    if (!mesh_.texcoords.empty()) mesh_.texcoords[k] = {f[l.u], f[l.v]};
+  }
+
+  tl::unexpected<Error> body_error(const std::string& where) const {
+    std::string at = header_.encoding == Encoding::kAscii
+                         ? "line " + std::to_string(reader_.line_at_position())
+                         : "byte " + std::to_string(reader_.position());
+    return make_error(reader_.truncated() ? ErrorCode::kTruncated : ErrorCode::kParse,
+                      at + ", " + where + ": " + reader_.error());
+  }
+
+  const Header& header_;
+  BodyReader reader_;
+  size_t body_size_;
+  Mesh& mesh_;
+  VertexLayout layout_;
+  bool have_vertices_ = false, have_faces_ = false;
+  uint64_t vertex_count_ = 0;
+  int indices_ = -1;
+  std::vector<double> values_;
+  std::vector<float> floats_;
+  std::vector<uint32_t> polygon_;
+};
+
+const char* scalar_name(Scalar type) {
+  switch (type) {
+    case Scalar::kInt8:
+      return "char";
+    case Scalar::kUint8:
+      return "uchar";
+    case Scalar::kInt16:
+      return "short";
+    case Scalar::kUint16:
+      return "ushort";
+    case Scalar::kInt32:
+      return "int";
+    case Scalar::kUint32:
+      return "uint";
+    case Scalar::kFloat32:
+      return "float";
+    case Scalar::kFloat64:
+      return "double";
+  }
+  return "?";
+}
+
+std::string describe_property(const Element& element, const Property& p) {
+  return element.name + " " + p.name + " (" +
+         (p.is_list ? std::string("list of ") + scalar_name(p.type) : scalar_name(p.type)) + ")";
+}
+
+// What the file holds as the header declares it: the attributes read, the
+// properties and elements skipped.
+FileContents describe_contents(const Header& header) {
+  FileContents contents;
+  contents.format = header.encoding == Encoding::kAscii          ? "PLY (ascii)"
+                    : header.encoding == Encoding::kBinaryLittle ? "PLY (binary little-endian)"
+                                                                 : "PLY (binary big-endian)";
+  bool seen_vertex = false, seen_face = false;
+  for (const Element& e : header.elements) {
+    if (e.name == "vertex" && !seen_vertex) {
+      seen_vertex = true;
+      const VertexLayout l = find_vertex_layout(e);
+      if (l.normals()) contents.normals.count = e.count;
+      if (l.colors()) contents.colors.count = e.count;
+      if (l.texcoords()) contents.texcoords.count = e.count;
+      const int read[] = {l.x, l.y, l.z, l.nx, l.ny, l.nz, l.r, l.g, l.b, l.a, l.u, l.v};
+      for (size_t i = 0; i < e.properties.size(); ++i) {
+        if (std::find(std::begin(read), std::end(read), static_cast<int>(i)) == std::end(read))
+          contents.extra_properties.push_back(describe_property(e, e.properties[i]));
+      }
+    } else if (e.name == "face" && !seen_face) {
+      seen_face = true;
+      const int indices = find_index_list(e);
+      for (size_t i = 0; i < e.properties.size(); ++i) {
+        if (static_cast<int>(i) != indices)
+          contents.extra_properties.push_back(describe_property(e, e.properties[i]));
+      }
+    } else {
+      contents.other_elements.push_back(e.name + " (" + std::to_string(e.count) + ")");
     }
   }
-  if (!have_vertices) return make_error(ErrorCode::kParse, "PLY file has no vertex element");
-  raw.vertices_in_file = static_cast<uint32_t>(vertex_count);
+  return contents;
+}
+
+}  // namespace
+
+Result<RawMesh> read_ply(const std::string& path) {
+  auto data = read_file_bytes(path);
+  if (!data) return tl::unexpected(data.error());
+  auto header = parse_header(*data);
+  if (!header) return tl::unexpected(header.error());
+  if (auto ok = check_counts(*header, data->size() - header->body_start); !ok)
+    return tl::unexpected(ok.error());
+  RawMesh raw;
+  raw.contents = describe_contents(*header);
+  BodyParser body(*data, *header, raw);
+  if (auto ok = body.read_all(); !ok) return tl::unexpected(ok.error());
+  raw.vertices_in_file = static_cast<uint32_t>(body.vertex_count());
   return raw;
 }
 

@@ -3,8 +3,6 @@
 // Every facet has its own three corners, welded later by clean_mesh.
 #include <cctype>
 #include <charconv>
-#include <fstream>
-#include <sstream>
 #include <string_view>
 
 #include "common/mesh/mesh_readers.h"
@@ -12,11 +10,9 @@
 namespace meshstream {
 
 Result<RawMesh> read_ascii_stl(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(ErrorCode::kIo, "cannot open the file for reading");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = std::move(buffer).str();
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return tl::unexpected(bytes.error());
+  const std::string& text = *bytes;
 
   RawMesh raw;
   Mesh& mesh = raw.mesh;
@@ -37,12 +33,14 @@ Result<RawMesh> read_ascii_stl(const std::string& path) {
     return make_error(ErrorCode::kParse, "not an ASCII STL file (no 'solid' keyword)");
   }
   bool ended = false;
+  uint64_t facet_normals = 0;
   while (next_token(token)) {
     if (token == "endsolid") {
       ended = true;
       break;
     }
-    if (token != "vertex") continue;  // facet, normal, outer, loop, names: structure only
+    if (token == "normal") ++facet_normals;  // per facet: never a per-vertex attribute
+    if (token != "vertex") continue;         // facet, normal, outer, loop, names: structure only
     Vec3f p;
     for (int i = 0; i < 3; ++i) {
       std::string_view number;
@@ -67,6 +65,10 @@ Result<RawMesh> read_ascii_stl(const std::string& path) {
   mesh.triangles.resize(faces);
   for (uint32_t f = 0; f < faces; ++f) mesh.triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
   raw.vertices_in_file = static_cast<uint32_t>(mesh.positions.size());
+  raw.contents.format = "STL (ascii)";
+  raw.contents.normals.count = facet_normals;
+  if (facet_normals > 0)
+    raw.contents.normals.dropped = "STL normals are per facet, not per vertex (not read)";
   return raw;
 }
 

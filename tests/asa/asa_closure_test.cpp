@@ -19,12 +19,7 @@ struct Level {
   LevelMesh lm;
   ButterflyWeights weights;
   explicit Level(Mesh m) : mesh(std::move(m)) {
-    auto adj = Adjacency::build(mesh);
-    EXPECT_TRUE(adj.has_value());
-    lm.positions = mesh.positions;
-    lm.triangles = mesh.triangles;
-    lm.opposite.resize(3 * mesh.face_count());
-    for (uint32_t c = 0; c < lm.opposite.size(); ++c) lm.opposite[c] = adj->opposite(c);
+    lm = asa_test::level_with_opposites(mesh);
     finish();
   }
   explicit Level(LevelMesh next) : lm(std::move(next)) {

@@ -20,12 +20,7 @@ struct Reference {
   LevelMesh lm;
   ButterflyWeights weights;
   explicit Reference(const Mesh& m, float tension) : mesh(m) {
-    auto adj = Adjacency::build(mesh);
-    EXPECT_TRUE(adj.has_value());
-    lm.positions = mesh.positions;
-    lm.triangles = mesh.triangles;
-    lm.opposite.resize(3 * mesh.face_count());
-    for (uint32_t c = 0; c < lm.opposite.size(); ++c) lm.opposite[c] = adj->opposite(c);
+    lm = asa_test::level_with_opposites(mesh);
     std::vector<Vec3f> normals;
     LevelView v = lm.view();
     tag_feature_edges(v, 0, normals, lm.feature_edge);

@@ -10,13 +10,29 @@
 #include <string>
 #include <vector>
 
+#include "common/asa/level_mesh.h"
 #include "common/asa/subdivide.h"
 #include "common/mesh/adjacency.h"
 #include "common/mesh/import.h"
 #include "common/mesh/mesh.h"
+#include "common/mesh/procedural.h"
 #include "tests/test_meshes.h"
 
 namespace meshstream::asa_test {
+
+// A level's positions, triangles and opposite corners from Adjacency (built
+// independently of subdivide's corner table); the rest is the caller's.
+inline asa::LevelMesh level_with_opposites(const Mesh& mesh) {
+  asa::LevelMesh lm;
+  auto adj = Adjacency::build(mesh);
+  EXPECT_TRUE(adj.has_value());
+  lm.positions = mesh.positions;
+  lm.triangles = mesh.triangles;
+  lm.opposite.resize(3 * mesh.face_count());
+  if (adj)
+    for (uint32_t c = 0; c < lm.opposite.size(); ++c) lm.opposite[c] = adj->opposite(c);
+  return lm;
+}
 
 inline Mesh octahedron() {
   Mesh m;
@@ -26,17 +42,7 @@ inline Mesh octahedron() {
   return m;
 }
 
-inline Mesh icosahedron() {
-  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-  Mesh m;
-  m.positions = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
-                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  return m;
-}
+inline Mesh icosahedron() { return make_icosahedron(); }
 
 // A flat n x n grid of squares in z = height(x, y), each square split along
 // its diagonal: interior vertices have valence 6, the border is a boundary.

@@ -10,45 +10,16 @@
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/mesh.h"
+#include "common/mesh/procedural.h"
 
 namespace meshstream::testing {
 
-// Icosphere: an icosahedron split `levels` times, projected to the unit
-// sphere (10 * 4^levels + 2 vertices). Optional bumps make it non-trivial.
+// Icosphere: make_icosphere (an icosahedron split `levels` times on the unit
+// sphere, 10 * 4^levels + 2 vertices). Optional bumps make it non-trivial.
 inline Mesh icosphere(int levels, float bump = 0.0f) {
-  const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-  Mesh m;
-  m.positions = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
-                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                 {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                 {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-    auto midpoint = [&](uint32_t a, uint32_t b) {
-      auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      Vec3f p = (m.positions[a] + m.positions[b]) * 0.5f;
-      m.positions.push_back(p);
-      return mid[key] = static_cast<uint32_t>(m.positions.size() - 1);
-    };
-    std::vector<Triangle> next;
-    for (const Triangle& tri : m.triangles) {
-      uint32_t ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]),
-               ca = midpoint(tri[2], tri[0]);
-      next.push_back({tri[0], ab, ca});
-      next.push_back({tri[1], bc, ab});
-      next.push_back({tri[2], ca, bc});
-      next.push_back({ab, bc, ca});
-    }
-    m.triangles = std::move(next);
-  }
-  for (Vec3f& p : m.positions) {
-    p = normalized(p);
-    if (bump != 0) p = p * (1.0f + bump * std::sin(5 * p.x) * std::cos(4 * p.y + p.z));
-  }
+  Mesh m = make_icosphere(static_cast<uint32_t>(levels));
+  if (bump == 0) return m;
+  for (Vec3f& p : m.positions) p = p * (1.0f + bump * std::sin(5 * p.x) * std::cos(4 * p.y + p.z));
   return m;
 }
 

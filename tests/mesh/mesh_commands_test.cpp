@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -94,6 +95,88 @@ TEST(MeshCommands, InfoShowsWhatImportRepaired) {
   const CommandResult text = run("info " + testing::test_mesh("suzanne.obj"));
   EXPECT_EQ(text.exit_code, 0);
   EXPECT_NE(text.out.find("split vertices"), std::string::npos) << text.out;
+}
+
+// Issue 21 row 11: info names the attributes, materials and properties a
+// file holds, also those import does not keep, in text and JSON.
+TEST(MeshCommands, InfoReportsWhatTheFileHoldsEvenWhatImportDrops) {
+  REQUIRE_BINARY();
+  const std::string path = temp_path("per_face.obj");
+  std::ofstream(path) << "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+                         "vt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvn 0 0 -1\n"
+                         "usemtl shiny\nf 1/1/1 2/2/1 3/3/1\nf 2/1/2 4/2/2 3/3/2\n";
+  const CommandResult text = run("info " + path);
+  const CommandResult json_run = run("info --json " + path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(text.exit_code, 0) << text.out;
+  EXPECT_NE(text.out.find("file holds (OBJ"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("texture coordinates   3 'vt' lines (not kept by import: they differ"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("normals               2 'vn' lines (not kept by import"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("material library      nowhere.mtl (not found"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("materials used        shiny"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("attributes      none\n"), std::string::npos) << text.out;
+  ASSERT_EQ(json_run.exit_code, 0);
+  const auto json = nlohmann::json::parse(json_run.out);
+  const auto& contents = json["contents"];
+  EXPECT_EQ(contents["format"], "OBJ");
+  EXPECT_EQ(contents["texcoords"]["count"], 3);
+  EXPECT_EQ(contents["texcoords"]["kept_by_import"], false);
+  EXPECT_EQ(contents["normals"]["count"], 2);
+  EXPECT_EQ(contents["colors"]["count"], 0);
+  EXPECT_EQ(contents["material_libraries"][0]["name"], "nowhere.mtl");
+  EXPECT_EQ(contents["material_libraries"][0]["found"], false);
+  EXPECT_EQ(contents["materials_used"][0], "shiny");
+}
+
+TEST(MeshCommands, InfoOfKeptAttributesSaysEncodeDropsThem) {
+  REQUIRE_BINARY();
+  const std::string path = temp_path("per_vertex.obj");
+  std::ofstream(path) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+  const CommandResult text = run("info " + path);
+  const CommandResult json_run = run("info --json " + path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(text.exit_code, 0);
+  EXPECT_NE(text.out.find("texture coordinates   3 'vt' lines (kept by import and subdivide; "
+                          "not carried: attributes are dropped by encode)"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("attributes      texture coordinates (not carried"), std::string::npos)
+      << text.out;
+  const auto json = nlohmann::json::parse(json_run.out);
+  EXPECT_EQ(json["contents"]["texcoords"]["kept_by_import"], true);
+  EXPECT_EQ(json["contents"]["texcoords"]["carried_by_encode"], false);
+}
+
+TEST(MeshCommands, InfoOfTheSharedFilesNamesTheirAttributes) {
+  REQUIRE_BINARY();
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  const CommandResult cube = run("info " + testing::test_mesh("cube_att.obj"));
+  EXPECT_NE(cube.out.find("normals               6 'vn' lines (not kept"), std::string::npos)
+      << cube.out;
+  EXPECT_NE(cube.out.find("texture coordinates   4 'vt' lines (not kept"), std::string::npos)
+      << cube.out;
+  const auto bunny =
+      nlohmann::json::parse(run("info --json " + testing::test_mesh("bun_zipper.ply")).out);
+  EXPECT_EQ(bunny["contents"]["extra_properties"],
+            (nlohmann::json{"vertex confidence (float)", "vertex intensity (float)"}));
+  const std::string usb = testing::test_mesh_dir() + "/../models/usb/usb.obj";
+  if (!std::filesystem::exists(usb)) GTEST_SKIP() << "../shared/models/usb/usb.obj not found";
+  const CommandResult text = run("info " + usb);
+  EXPECT_NE(text.out.find("texture coordinates   601 'vt' lines (not kept by import"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("material library      usb.mtl: 1 material (Material_usb.jpg), "
+                          "textures usb.jpg; not read"),
+            std::string::npos)
+      << text.out;
+  const auto json = nlohmann::json::parse(run("info --json " + usb).out);
+  EXPECT_EQ(json["contents"]["texcoords"]["count"], 601);
+  EXPECT_EQ(json["contents"]["material_libraries"][0]["textures"][0], "usb.jpg");
 }
 
 TEST(MeshCommands, BadDataExitsOneAndBadUsageTwo) {

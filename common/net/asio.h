@@ -1,6 +1,7 @@
-// The one way the server (and its tests and tools) include Boost.Asio.
-// GCC 12 in C++20 mode needs <utility> before <boost/asio/awaitable.hpp>
-// ("exchange is not a member of std"); include only this header.
+// The one way meshstream includes Boost.Asio (client, server, their tests,
+// tools and benchmarks): include only this header. GCC 12 in C++20 mode needs
+// <utility> before <boost/asio/awaitable.hpp> ("exchange is not a member of
+// std"), and clang-format's include sorting would move it after boost/.
 #pragma once
 
 // <utility> must stay first, so clang-format must not sort this block.
