@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "common/codec/byte_io.h"
 #include "common/codec/decimate.h"
 
 namespace meshstream {
@@ -13,18 +14,6 @@ namespace meshstream {
 namespace {
 
 Status bad(const std::string& what) { return make_error(ErrorCode::kCorrupt, what); }
-
-bool read_varint(std::span<const uint8_t> in, size_t& pos, uint32_t& value) {
-  value = 0;
-  for (int shift = 0; shift < 35; shift += 7) {
-    if (pos >= in.size()) return false;
-    const uint8_t b = in[pos++];
-    if (shift == 28 && (b & 0x70)) return false;  // does not fit 32 bits
-    value |= uint32_t(b & 0x7F) << shift;
-    if (!(b & 0x80)) return true;
-  }
-  return false;
-}
 
 }  // namespace
 
@@ -514,19 +503,11 @@ uint32_t apply_patch(RefinementState& state, const ResolvedPatch& patch, uint32_
   return v;
 }
 
-void write_varint(uint32_t v, std::vector<uint8_t>& out) {
-  while (v >= 0x80) {
-    out.push_back(uint8_t(v | 0x80));
-    v >>= 7;
-  }
-  out.push_back(uint8_t(v));
-}
-
 void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format) {
   out.push_back(header.starts_layer ? kRecordStartsLayer : 0);
-  write_varint(header.walk_steps, out);
-  write_varint(header.insertions, out);
-  if (format >= 2) write_varint(header.min_shift, out);
+  put_varint(out, header.walk_steps);
+  put_varint(out, header.insertions);
+  if (format >= 2) put_varint(out, header.min_shift);
 }
 
 Status apply_plane_record(RefinementState& state, std::span<const uint8_t> payload,
@@ -537,7 +518,7 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
   size_t pos = 1;
   uint32_t first = 0, count = 0;
   if (state.format < 2) return bad("plane record in a stream of refinement format 1");
-  if (!read_varint(payload, pos, first) || !read_varint(payload, pos, count)) {
+  if (!get_varint(payload, pos, first) || !get_varint(payload, pos, count)) {
     return bad("plane record header is cut short or malformed");
   }
   const uint32_t n = state.mesh.vertex_count();
@@ -580,8 +561,8 @@ std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, 
                                         const std::vector<Vec3i>& residuals) {
   std::vector<uint8_t> out;
   out.push_back(kRecordPlane);
-  write_varint(first, out);
-  write_varint(count, out);
+  put_varint(out, first);
+  put_varint(out, count);
   RangeEncoder enc;
   uint8_t prev_new = 0;
   for (uint32_t v = first; v < first + count; ++v) {
@@ -828,11 +809,11 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   size_t pos = 1;
   RecordHeader h;
   h.starts_layer = flags & 1;
-  if (!read_varint(payload, pos, h.walk_steps) || !read_varint(payload, pos, h.insertions)) {
+  if (!get_varint(payload, pos, h.walk_steps) || !get_varint(payload, pos, h.insertions)) {
     return bad("refinement record header is cut short or malformed");
   }
   if (state.format >= 2) {
-    if (!read_varint(payload, pos, h.min_shift))
+    if (!get_varint(payload, pos, h.min_shift))
       return bad("refinement record header is cut short or malformed");
     if (h.min_shift > kMaxShift)
       return bad("refinement record shift " + std::to_string(h.min_shift) + " too large");

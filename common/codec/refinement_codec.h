@@ -278,7 +278,6 @@ struct RecordHeader {
   uint32_t min_shift = 0;  // format 2 only
 };
 void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format = 2);
-void write_varint(uint32_t value, std::vector<uint8_t>& out);
 
 struct AppliedRecord {
   std::vector<uint32_t> added_vertices;
