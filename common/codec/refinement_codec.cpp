@@ -697,7 +697,10 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
     const uint32_t ring_size = static_cast<uint32_t>(star_ring.size());
     const uint32_t faces = static_cast<uint32_t>(star_corners.size());
     if (mark_taken_faces(state, star_ring, faces, used_faces) != free_faces) {
-      return fail("internal: free face counts disagree");
+      // Both counts come from the state apply_patch keeps, whatever the
+      // input: a mismatch is a bug here, not a bad stream.
+      return make_error(ErrorCode::kInternal,
+                        "free face counts disagree at vertex " + std::to_string(u));
     }
     if (count > free_faces || inserted + count > h.insertions) {
       return fail("vertex " + std::to_string(u) + " claims " + std::to_string(count) +
