@@ -93,6 +93,11 @@ struct RefinementFormatInfo {
 // stream's quantization bits.
 inline constexpr int kMaxBaseShift = 12;
 
+// The largest valence of a vertex a structure record inserts (the decoder
+// refuses larger ones); the encoder removes no vertex of higher valence
+// (decimate.h's kMaxRemovalValence must not exceed it).
+inline constexpr uint32_t kMaxInsertedValence = 16;
+
 // Flags: the first payload byte of a refinement record. A structure record
 // has 0 or kRecordStartsLayer, a plane record exactly kRecordPlane.
 inline constexpr uint8_t kRecordStartsLayer = 1;

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "common/codec/container.h"
+#include "common/codec/decimate.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/codec/range_coder.h"
@@ -105,6 +106,12 @@ TEST(RefinementFormat, BitModelVRoundTripsAndFollowsItsSchedule) {
   }
   EXPECT_FALSE(dec.exhausted_badly());
 }
+
+// The decoder's valence limit is the format's (stream_format.h), no longer
+// decimate.h's; the encoder must stay within it or its streams would not
+// decode.
+static_assert(kMaxRemovalValence <= kMaxInsertedValence,
+              "the encoder would remove vertices the decoder cannot insert");
 
 }  // namespace
 }  // namespace meshstream
