@@ -47,12 +47,9 @@ Result<Mesh> quantized_reference(const Mesh& mesh, int quant_bits) {
   return out;
 }
 
-Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
-  return encode_hcs(mesh, options, nullptr);
-}
+namespace {
 
-Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,
-                                        EncodeReport* report) {
+Status check_options(const EncodeOptions& options) {
   if (options.refinement_format != 0 && options.refinement_format != kRefinementFormatEmbedded &&
       options.refinement_format != kRefinementFormat) {
     return make_error(ErrorCode::kInvalidArgument, "refinement format " +
@@ -64,19 +61,12 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
         ErrorCode::kInvalidArgument,
         "distortion estimate " + std::to_string(options.distortion_estimate) + " is not 0, 1 or 2");
   }
-  auto grid = make_grid(mesh, options.quant_bits);
-  if (!grid) return tl::unexpected(grid.error());
-  if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
-  if (mesh.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "mesh has no triangles");
-  std::vector<Vec3i> q = quantize_positions(mesh, *grid);
-  auto editable = EditableMesh::build(q, mesh.triangles);
-  if (!editable) return tl::unexpected(editable.error());
+  return {};
+}
 
-  DecimateOptions dopt;
-  dopt.target_vertices = options.target_base_vertices;
-  const DecimationResult dec = decimate_layers(std::move(*editable), dopt);
-  // The orderings to encode: every candidate that agrees with the fixed
-  // options, or the one the options fix.
+// The orderings to encode: every candidate that agrees with the fixed
+// options, or the one the options fix.
+std::vector<RecordOrdering> orderings_to_try(const EncodeOptions& options) {
   const bool measured = options.embedded && options.plane_calibration <= 0;
   std::vector<RecordOrdering> orderings;
   if (measured) {
@@ -86,108 +76,175 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   } else {
     orderings.push_back({options.plane_calibration, options.distortion_estimate == 2 ? 2 : 1});
   }
-  // The original in grid units, for the surface-distance estimate.
-  TriangleBvh grid_surface;
-  if (std::any_of(orderings.begin(), orderings.end(),
-                  [](const RecordOrdering& o) { return o.distortion_estimate == 2; })) {
-    Mesh grid_mesh;
-    grid_mesh.triangles = mesh.triangles;
-    grid_mesh.positions.reserve(q.size());
-    for (const Vec3i& p : q) grid_mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
-    grid_surface = TriangleBvh::build(grid_mesh);
-  }
-  auto surface_for = [&](const RecordOrdering& o) {
-    return o.distortion_estimate == 2 ? &grid_surface : nullptr;
-  };
+  return orderings;
+}
 
-  // Granularity (issue II): at least min(n / 50, 200) record boundaries and
-  // no refinement record above 2 % of the stream. Automatic record sizes
-  // start from an estimate of the stream (about 20 bits per vertex) and
-  // shrink when the result misses either bound.
-  const uint32_t n = mesh.vertex_count();
-  const bool automatic = options.record_bytes == 0;
-  const double estimate = 20.0 * n / 8.0;
-  // Plane records add to the count; each record costs an index entry (about
-  // 1.5 bytes, container 3) and a 4-byte CRC trailer.
-  const double wanted = std::max(50.0, 1.1 * std::min<double>(n / 50, 200));
-  const size_t wanted_records = std::min<size_t>(n / 50, 200) + 1;  // + the base
-  auto granular = [&](const EncodedStream& e) {
+// The original in grid units, for the surface-distance estimate.
+TriangleBvh grid_surface(const Mesh& mesh, const std::vector<Vec3i>& q) {
+  Mesh grid_mesh;
+  grid_mesh.triangles = mesh.triangles;
+  grid_mesh.positions.reserve(q.size());
+  for (const Vec3i& p : q) grid_mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
+  return TriangleBvh::build(grid_mesh);
+}
+
+// Granularity (docs/hcs-format.md): at least min(n / 50, 200) record
+// boundaries and no refinement record above 2 % of the stream. Automatic
+// record sizes start from an estimate of the stream (about 20 bits per
+// vertex) and shrink when the result misses either bound.
+struct RecordSizing {
+  bool automatic = true;
+  size_t wanted_records = 0;  // the base included
+  uint32_t first_bytes = 0;   // the record size tried first
+
+  RecordSizing(uint32_t n, const EncodeOptions& options) {
+    automatic = options.record_bytes == 0;
+    const double estimate = 20.0 * n / 8.0;
+    // Plane records add to the count; each record costs an index entry
+    // (about 1.5 bytes, container 3) and a 4-byte CRC trailer.
+    const double wanted = std::max(50.0, 1.1 * std::min<double>(n / 50, 200));
+    wanted_records = std::min<size_t>(n / 50, 200) + 1;
+    first_bytes = automatic ? static_cast<uint32_t>(std::clamp(estimate / wanted, 32.0, 8192.0))
+                            : std::max<uint32_t>(options.record_bytes, 16);
+  }
+
+  bool granular(const EncodedStream& e) const {
     return e.records >= wanted_records &&
            double(e.largest_refinement) <= 0.02 * double(e.bytes.size());
-  };
-  uint32_t record_bytes = automatic
-                              ? static_cast<uint32_t>(std::clamp(estimate / wanted, 32.0, 8192.0))
-                              : std::max<uint32_t>(options.record_bytes, 16);
-  auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report) {
-    return encode_once(mesh, *grid, q, dec, options, bytes, orderings[i].plane_calibration,
-                       candidate_report, surface_for(orderings[i]));
-  };
-  // The other candidates run on their own threads (they share only
-  // read-only inputs) at the first record size while the first candidate
-  // settles the record size; one that settles elsewhere is encoded again.
-  const bool parallel =
-      orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
-  const uint32_t first_record_bytes = record_bytes;
-  std::vector<EncodeReport> candidate_reports(orderings.size());
-  auto report_of = [&](size_t i) { return report ? &candidate_reports[i] : nullptr; };
+  }
+};
+
+// The candidate streams, one per ordering, all at the record size the
+// first one settles on; reports[0] is the caller's report.
+struct CandidateStreams {
+  std::vector<EncodedStream> streams;
+  std::vector<EncodeReport> reports;  // [i > 0] when a report is wanted
+};
+
+// Encodes every ordering (encode(i, record_bytes, report) for ordering i).
+// The first one settles the record size (smaller records while an automatic
+// size misses the granularity bound, at most three times); the others run
+// on their own threads (they share only read-only inputs) at the first
+// record size meanwhile, and one that settles elsewhere is encoded again.
+template <class EncodeCandidate>
+Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t count,
+                                           const RecordSizing& sizing, bool parallel,
+                                           EncodeReport* report) {
+  CandidateStreams out;
+  out.streams.resize(count);
+  out.reports.resize(count);
+  auto report_of = [&](size_t i) { return report ? &out.reports[i] : nullptr; };
   std::vector<std::future<Result<EncodedStream>>> early;  // destroyed (joined) before what it reads
   if (parallel) {
-    for (size_t i = 1; i < orderings.size(); ++i)
-      early.push_back(
-          std::async(std::launch::async, encode_candidate, i, first_record_bytes, report_of(i)));
+    for (size_t i = 1; i < count; ++i)
+      early.push_back(std::async(std::launch::async, encode, i, sizing.first_bytes, report_of(i)));
   }
-  EncodedStream chosen;
+  uint32_t record_bytes = sizing.first_bytes;
   for (int attempt = 0;; ++attempt) {
-    auto encoded = encode_candidate(0, record_bytes, report);
+    auto encoded = encode(0, record_bytes, report);
     if (!encoded) return tl::unexpected(encoded.error());
-    chosen = std::move(*encoded);
-    if (!automatic || granular(chosen) || attempt >= 3 || record_bytes <= 16) break;
+    out.streams[0] = std::move(*encoded);
+    if (!sizing.automatic || sizing.granular(out.streams[0]) || attempt >= 3 || record_bytes <= 16)
+      break;
     record_bytes = std::max<uint32_t>(16, static_cast<uint32_t>(record_bytes * 0.75));
   }
-  if (orderings.size() < 2) return std::move(chosen.bytes);
-  std::vector<EncodedStream> candidates(orderings.size());
-  for (size_t i = 1; i < orderings.size(); ++i) {
-    auto candidate =
-        parallel ? early[i - 1].get() : encode_candidate(i, record_bytes, report_of(i));
-    if (parallel && record_bytes != first_record_bytes)
-      candidate = encode_candidate(i, record_bytes, report_of(i));
+  for (size_t i = 1; i < count; ++i) {
+    auto candidate = parallel ? early[i - 1].get() : encode(i, record_bytes, report_of(i));
+    if (parallel && record_bytes != sizing.first_bytes)
+      candidate = encode(i, record_bytes, report_of(i));
     if (!candidate) return tl::unexpected(candidate.error());
-    candidates[i] = std::move(*candidate);
+    out.streams[i] = std::move(*candidate);
   }
+  return out;
+}
 
-  // Rate-distortion by measurement (rd_measure.h): the other orderings at
-  // the same record size, judged at the same byte budgets by the surface
-  // distance of their decoded prefixes to the original (in parallel too).
-  Mesh reference;  // the quantized original, from the positions already quantized
+// Rate-distortion by measurement (rd_measure.h): the index of the stream
+// whose decoded prefixes lie closest to the original (the quantized one,
+// from the positions already quantized), all judged at the same byte
+// budgets (fractions of the first stream's size). A stream that misses the
+// granularity bound the current choice meets cannot win. The other streams
+// are measured on their own threads when `parallel`.
+Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
+                             const std::vector<EncodedStream>& streams, const RecordSizing& sizing,
+                             bool parallel) {
+  Mesh reference;
   reference.triangles = mesh.triangles;
   reference.positions.reserve(q.size());
-  for (const Vec3i& p : q) reference.positions.push_back(grid->dequantize(p));
+  for (const Vec3i& p : q) reference.positions.push_back(grid.dequantize(p));
   auto measure = RdMeasure::prepare(reference);
   if (!measure) return tl::unexpected(measure.error());
-  const uint64_t reference_bytes = chosen.bytes.size();
+  const uint64_t reference_bytes = streams[0].bytes.size();
   auto score_of = [&](const std::vector<uint8_t>& bytes) -> Result<double> {
     auto curve = measure->curve(bytes, reference_bytes);
     if (!curve) return tl::unexpected(curve.error());
     return RdMeasure::score(*curve);
   };
   std::vector<std::future<Result<double>>> other_scores;  // joined before `measure` goes
-  for (size_t i = 1; i < orderings.size(); ++i) {
+  for (size_t i = 1; i < streams.size(); ++i) {
     other_scores.push_back(std::async(parallel ? std::launch::async : std::launch::deferred,
-                                      score_of, std::cref(candidates[i].bytes)));
+                                      score_of, std::cref(streams[i].bytes)));
   }
-  auto chosen_score = score_of(chosen.bytes);
-  if (!chosen_score) return tl::unexpected(chosen_score.error());
-  for (size_t i = 1; i < orderings.size(); ++i) {
+  auto best_score = score_of(streams[0].bytes);
+  if (!best_score) return tl::unexpected(best_score.error());
+  size_t best = 0;
+  for (size_t i = 1; i < streams.size(); ++i) {
     auto score = other_scores[i - 1].get();
     if (!score) return tl::unexpected(score.error());
-    if (automatic && granular(chosen) && !granular(candidates[i])) continue;
-    if (*score < *chosen_score) {
-      chosen_score = *score;
-      chosen = std::move(candidates[i]);
-      if (report) *report = std::move(candidate_reports[i]);
+    if (sizing.automatic && sizing.granular(streams[best]) && !sizing.granular(streams[i]))
+      continue;
+    if (*score < *best_score) {
+      best_score = *score;
+      best = i;
     }
   }
-  return std::move(chosen.bytes);
+  return best;
+}
+
+}  // namespace
+
+Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
+  return encode_hcs(mesh, options, nullptr);
+}
+
+Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,
+                                        EncodeReport* report) {
+  if (auto st = check_options(options); !st) return tl::unexpected(st.error());
+  // Quantize and decimate once for every candidate.
+  auto grid = make_grid(mesh, options.quant_bits);
+  if (!grid) return tl::unexpected(grid.error());
+  if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
+  if (mesh.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "mesh has no triangles");
+  std::vector<Vec3i> q = quantize_positions(mesh, *grid);
+  auto editable = EditableMesh::build(q, mesh.triangles);
+  if (!editable) return tl::unexpected(editable.error());
+  DecimateOptions dopt;
+  dopt.target_vertices = options.target_base_vertices;
+  const DecimationResult dec = decimate_layers(std::move(*editable), dopt);
+
+  // The candidates.
+  const std::vector<RecordOrdering> orderings = orderings_to_try(options);
+  TriangleBvh surface;
+  if (std::any_of(orderings.begin(), orderings.end(),
+                  [](const RecordOrdering& o) { return o.distortion_estimate == 2; })) {
+    surface = grid_surface(mesh, q);
+  }
+  auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report) {
+    const RecordOrdering& o = orderings[i];
+    return encode_once(mesh, *grid, q, dec, options, bytes, o.plane_calibration, candidate_report,
+                       o.distortion_estimate == 2 ? &surface : nullptr);
+  };
+  const RecordSizing sizing(mesh.vertex_count(), options);
+  const bool parallel =
+      orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
+  auto candidates = encode_candidates(encode_candidate, orderings.size(), sizing, parallel, report);
+  if (!candidates) return tl::unexpected(candidates.error());
+  if (orderings.size() < 2) return std::move(candidates->streams[0].bytes);
+
+  // The measured choice among them.
+  auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel);
+  if (!best) return tl::unexpected(best.error());
+  if (report && *best > 0) *report = std::move(candidates->reports[*best]);
+  return std::move(candidates->streams[*best].bytes);
 }
 
 }  // namespace meshstream

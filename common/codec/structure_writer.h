@@ -56,6 +56,19 @@ class StructureWriter {
                       std::vector<std::pair<uint32_t, uint32_t>>& inserted);
 
  private:
+  // The phases of a walk step. The walk's next vertex u, skipping the ones
+  // this layer inserted.
+  Status next_walk_vertex(uint32_t& u);
+  // The removals with apex u, by their first face in u's star (order_).
+  Status find_patches_at(uint32_t u);
+  // Codes how many patches u gets among its free faces.
+  Status code_patch_count(RangeEncoder& enc, uint32_t u, uint32_t& free_faces);
+  // Codes patch j of u: valence, start rank, open edge, coarse residual.
+  Status code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, int min_shift, uint32_t& free_left);
+  // Inserts the coded patches as the decoder will; returns their estimated
+  // distortion drop.
+  double apply_patches(std::vector<std::pair<uint32_t, uint32_t>>& inserted);
+
   RefinementState& s_;
   EncoderTruth& t_;
   uint8_t format_;
