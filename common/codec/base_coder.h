@@ -1,6 +1,6 @@
 // Coding the base mesh (record 0 of an `.hcs` stream).
 //
-// Two coders, id in the stream header (`base_coder`):
+// Two coders, id in the stream header (`base_coder`, stream_format.h):
 // - kBaseCoderDraco: Draco's edgebreaker with the positions given to Draco as
 //   INT32 grid coordinates, so Draco's integer prediction path codes them
 //   losslessly (no Draco quantization at all): exact by construction. Draco
@@ -20,12 +20,10 @@
 
 #include "common/base/result.h"
 #include "common/codec/quantize.h"
+#include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
-
-inline constexpr uint8_t kBaseCoderOwn = 1;
-inline constexpr uint8_t kBaseCoderDraco = 2;
 
 struct BaseMesh {
   std::vector<Vec3i> positions;

@@ -3,7 +3,7 @@
 //
 // Layout (all integers little-endian):
 //   offset 0   magic "MHCS" (4 bytes)
-//          4   u16 format version (kContainerVersion), u16 flags (0)
+//          4   u16 format version (kContainerVersion, stream_format.h), u16 flags (0)
 //          8   u32 header_size H, then H header bytes (StreamHeader, see
 //              container.cpp; fields added later go at the end, so a reader
 //              skips what it does not know), then u32 CRC-32 of those H bytes
@@ -31,17 +31,15 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/codec/record_entry.h"
+#include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
 
 inline constexpr char kContainerMagic[4] = {'M', 'H', 'C', 'S'};
-inline constexpr uint16_t kContainerVersion =
-    3;  // 1 and 2 (index CRCs, bare payloads) are still read
-// Version 3 records end in a CRC-32 of their payload.
-inline constexpr uint32_t kRecordTrailerBytes = 4;
-// Refuse absurd counts before allocating anything for them.
-inline constexpr uint32_t kMaxRecords = 1u << 22;
+// Refuse absurd sizes before allocating anything for them (kMaxRecords:
+// record_entry.h).
 inline constexpr uint32_t kMaxHeaderBytes = 1u << 16;
 
 struct StreamHeader {
@@ -51,23 +49,11 @@ struct StreamHeader {
   uint32_t base_face_count = 0;
   BoundingBox bounds;  // quantization grid spans this box
   uint8_t quant_bits = 12;
-  uint8_t base_coder = 0;       // which coder made record 0 (codec-defined ids)
+  uint8_t base_coder = 0;       // which coder made record 0 (kBaseCoder*, stream_format.h)
   uint8_t structure_coder = 0;  // coder of refinement structure symbols
   uint8_t geometry_coder = 0;   // coder of refinement residuals
   uint32_t layer_count = 0;     // decimation layers in the stream
   std::vector<uint8_t> extra;   // header bytes this version does not interpret
-};
-
-struct RecordEntry {
-  uint64_t offset = 0;    // from the start of the stream
-  uint32_t size = 0;      // bytes in the stream (payload and trailer, if any)
-  uint32_t vertices = 0;  // cumulative, after this record
-  uint32_t faces = 0;
-  // CRC-32 of the record's payload. Versions 1-2: from the index. Version 3:
-  // the record's trailer as read_stream_index found it (0 when the record's
-  // bytes were not in the span it read).
-  uint32_t crc32 = 0;
-  bool crc_trailer = false;  // version 3: the last 4 bytes are the CRC-32
 };
 
 struct StreamIndex {

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "common/codec/base_coder.h"
-#include "common/codec/encoder.h"
 #include "common/codec/quantize.h"
 #include "common/codec/refinement_codec.h"
+#include "common/codec/stream_format.h"
 
 namespace meshstream {
 
@@ -26,7 +26,7 @@ struct IncrementalDecoder::State {
   Mesh mesh;
   std::vector<RecordDelta> deltas;
   std::optional<Error> error;
-  uint8_t format = kRefinementFormat;
+  RefinementFormatInfo format;  // of the stream, from its header (check_header)
   int base_shift = 0;
   // The error left the decoded state as it was (damaged index, a record
   // that failed its checksum before being applied): fetching the bytes again
@@ -56,17 +56,15 @@ struct IncrementalDecoder::State {
       return make_error(ErrorCode::kUnsupported,
                         "unknown base mesh coder " + std::to_string(h.base_coder));
     }
-    if (h.extra.empty() || h.extra[0] < kRefinementFormatPlain || h.extra[0] > kRefinementFormat) {
-      return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
-    }
-    format = h.extra[0];
-    const bool embedded = format >= kRefinementFormatEmbedded;
-    const uint8_t geometry_id = embedded ? kGeometryCoderEmbedded : kGeometryCoderRangeAverage;
-    if (h.structure_coder != kStructureCoderRange || h.geometry_coder != geometry_id) {
+    const auto known =
+        h.extra.empty() ? std::nullopt : RefinementFormatInfo::from_header_byte(h.extra[0]);
+    if (!known) return make_error(ErrorCode::kUnsupported, "unknown refinement record format");
+    format = *known;
+    if (h.structure_coder != kStructureCoderRange || h.geometry_coder != format.geometry_coder()) {
       return make_error(ErrorCode::kUnsupported, "unknown refinement coder ids");
     }
     base_shift = 0;
-    if (embedded) {
+    if (format.embedded) {
       if (h.extra.size() < 2 || h.extra[1] > kMaxBaseShift || h.extra[1] >= h.quant_bits) {
         return make_error(ErrorCode::kCorrupt, "stream header has no valid base shift");
       }
@@ -114,7 +112,7 @@ struct IncrementalDecoder::State {
           RefinementState::from_coarse_base(base->positions, base->faces, h.quant_bits, base_shift);
       if (!state) return where(state.error());
       refine = std::move(*state);
-      refine->format = format;
+      refine->format = format.header_byte();
       // Reserve for the final size, but never more than the bytes received
       // so far could describe (every inserted vertex costs well over a bit):
       // neither a hostile header nor a hostile index (records claiming a

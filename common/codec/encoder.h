@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
@@ -72,27 +73,6 @@ struct RecordOrdering {
   int distortion_estimate;  // 1 or 2, as EncodeOptions
 };
 inline constexpr RecordOrdering kOrderingCandidates[] = {{1.0, 1}, {1.0, 2}};
-
-// Ids written in the stream header (`structure_coder`, `geometry_coder`).
-inline constexpr uint8_t kStructureCoderRange = 1;  // adaptive binary range coder
-inline constexpr uint8_t kGeometryCoderRangeAverage =
-    1;  // ring average + range-coded residual (format 1)
-inline constexpr uint8_t kGeometryCoderEmbedded =
-    2;  // ring average, coarse residual + context-coded bit planes
-inline constexpr uint8_t kRefinementFormatPlain = 1;  // header extra[0]: issue I's records
-inline constexpr uint8_t kRefinementFormatEmbedded =
-    2;  // header extra[0]: embedded records; extra[1] = base shift
-// Header extra[0] of what the encoder writes: format 2's records with finer
-// contexts for counts, valences and start ranks (refinement_codec.h).
-inline constexpr uint8_t kRefinementFormat = 3;
-inline constexpr int kMaxBaseShift = 12;
-
-// Bumped whenever the bytes an encoder writes for the same input change, so
-// caches keyed by (content hash, encoder version) stay correct.
-inline constexpr uint32_t kEncoderVersion =
-    8;  // 3: container 2 index, embedded records; 4: measured plane calibration; 5: container 3
-        // (compact index, CRC trailers); 6: refinement format 3 (BitModelV, valence and rank
-        // contexts); 7: 8-bit base by default; 8: surface-distance ordering candidate
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "common/base/result.h"
-#include "common/codec/container.h"
+#include "common/codec/record_entry.h"
 
 namespace meshstream {
 

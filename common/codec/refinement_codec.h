@@ -37,6 +37,7 @@
 #include "common/codec/editable_mesh.h"
 #include "common/codec/embedded_geometry.h"
 #include "common/codec/range_coder.h"
+#include "common/codec/stream_format.h"
 
 namespace meshstream {
 
@@ -276,9 +277,6 @@ struct RecordHeader {
   uint32_t insertions = 0;
   uint32_t min_shift = 0;  // format 2 only
 };
-// Record flags (first payload byte).
-inline constexpr uint8_t kRecordStartsLayer = 1;
-inline constexpr uint8_t kRecordPlane = 2;
 void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format = 2);
 void write_varint(uint32_t value, std::vector<uint8_t>& out);
 
