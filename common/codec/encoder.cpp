@@ -50,16 +50,23 @@ Result<Mesh> quantized_reference(const Mesh& mesh, int quant_bits) {
 namespace {
 
 Status check_options(const EncodeOptions& options) {
-  if (options.refinement_format != 0 && options.refinement_format != kRefinementFormatEmbedded &&
-      options.refinement_format != kRefinementFormat) {
-    return make_error(ErrorCode::kInvalidArgument, "refinement format " +
-                                                       std::to_string(options.refinement_format) +
-                                                       " cannot be written (2 or 3)");
+  if (options.refinement_format != RefinementFormat::kEmbedded &&
+      options.refinement_format != RefinementFormat::kEmbeddedFastStart) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "refinement format " + std::to_string(int(options.refinement_format)) +
+                          " cannot be written (2 or 3)");
   }
-  if (options.distortion_estimate < 0 || options.distortion_estimate > 2) {
-    return make_error(
-        ErrorCode::kInvalidArgument,
-        "distortion estimate " + std::to_string(options.distortion_estimate) + " is not 0, 1 or 2");
+  if (options.distortion_estimate != DistortionEstimate::kAutomatic &&
+      options.distortion_estimate != DistortionEstimate::kDisplacement &&
+      options.distortion_estimate != DistortionEstimate::kSurfaceDistance) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "distortion estimate " + std::to_string(int(options.distortion_estimate)) +
+                          " is not 0 (automatic), 1 (displacement) or 2 (surface distance)");
+  }
+  if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "base shift " + std::to_string(*options.base_shift) + " is not 0.." +
+                          std::to_string(kMaxBaseShift));
   }
   return {};
 }
@@ -71,10 +78,14 @@ std::vector<RecordOrdering> orderings_to_try(const EncodeOptions& options) {
   std::vector<RecordOrdering> orderings;
   if (measured) {
     for (const RecordOrdering& c : kOrderingCandidates)
-      if (options.distortion_estimate == 0 || options.distortion_estimate == c.distortion_estimate)
+      if (options.distortion_estimate == DistortionEstimate::kAutomatic ||
+          options.distortion_estimate == c.distortion_estimate)
         orderings.push_back(c);
   } else {
-    orderings.push_back({options.plane_calibration, options.distortion_estimate == 2 ? 2 : 1});
+    orderings.push_back({options.plane_calibration,
+                         options.distortion_estimate == DistortionEstimate::kSurfaceDistance
+                             ? DistortionEstimate::kSurfaceDistance
+                             : DistortionEstimate::kDisplacement});
   }
   return orderings;
 }
@@ -224,14 +235,16 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   // The candidates.
   const std::vector<RecordOrdering> orderings = orderings_to_try(options);
   TriangleBvh surface;
-  if (std::any_of(orderings.begin(), orderings.end(),
-                  [](const RecordOrdering& o) { return o.distortion_estimate == 2; })) {
+  if (std::any_of(orderings.begin(), orderings.end(), [](const RecordOrdering& o) {
+        return o.distortion_estimate == DistortionEstimate::kSurfaceDistance;
+      })) {
     surface = grid_surface(mesh, q);
   }
   auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report) {
     const RecordOrdering& o = orderings[i];
-    return encode_once(mesh, *grid, q, dec, options, bytes, o.plane_calibration, candidate_report,
-                       o.distortion_estimate == 2 ? &surface : nullptr);
+    return encode_once(
+        mesh, *grid, q, dec, options, bytes, o.plane_calibration, candidate_report,
+        o.distortion_estimate == DistortionEstimate::kSurfaceDistance ? &surface : nullptr);
   };
   const RecordSizing sizing(mesh.vertex_count(), options);
   const bool parallel =

@@ -29,9 +29,9 @@ struct PlaneGroup {
 // surface-distance cache it fills). O(g.count) error evaluations.
 void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g);
 
-// Issue I's kind of coder for plane bits (EncodeReport::plane_bytes_plain):
-// one adaptive model per plane and one for signs, persisting across records
-// like the context models.
+// A plain coder for plane bits, the comparison EncodeReport::plane_bytes_plain
+// measures: one adaptive model per plane and one for signs, persisting across
+// records like the context models.
 struct PlainPlaneModels {
   BitModel bit[kMaxShift + 1];
   BitModel sign;

@@ -21,8 +21,7 @@ namespace {
 // 8-bit base; none for a stream without bit planes.
 int effective_base_shift(const EncodeOptions& options, int bits) {
   if (!options.embedded) return 0;
-  return std::clamp(options.base_shift < 0 ? bits - 8 : options.base_shift, 0,
-                    std::min(kMaxBaseShift, bits - 1));
+  return std::clamp(options.base_shift.value_or(bits - 8), 0, std::min(kMaxBaseShift, bits - 1));
 }
 
 // The grid points with their low `shift` bits dropped: what the base coder
@@ -72,8 +71,9 @@ class RecordScheduler {
   // `state` is the decoder's state after the base, `truth` the encoder's
   // knowledge of it; `to_decoder` maps input ids of the base vertices to
   // decoder ids (kNone elsewhere). `records` receives the records.
-  RecordScheduler(const Inputs& in, uint8_t format, RefinementState& state, EncoderTruth& truth,
-                  std::vector<uint32_t> to_decoder, std::vector<WrittenRecord>& records)
+  RecordScheduler(const Inputs& in, RefinementFormatInfo format, RefinementState& state,
+                  EncoderTruth& truth, std::vector<uint32_t> to_decoder,
+                  std::vector<WrittenRecord>& records)
       : in_(in),
         state_(state),
         truth_(truth),
@@ -278,16 +278,16 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                   const TriangleBvh* surface) {
   // The base: coarse positions, the smaller coder, the decoder's state.
   const int bits = grid.bits;
-  const uint8_t format = options.refinement_format == 0
-                             ? kRefinementFormat
-                             : static_cast<uint8_t>(options.refinement_format);
+  // check_options let only writable formats through.
+  const RefinementFormatInfo format =
+      *RefinementFormatInfo::from_header_byte(uint8_t(options.refinement_format));
   const int base_shift = effective_base_shift(options, bits);
   const ChosenBase base = choose_base(dec, coarse_positions(q, base_shift), bits - base_shift,
                                       options.allow_draco_base);
   auto state = RefinementState::from_coarse_base(base.decoded.positions, base.decoded.faces, bits,
                                                  base_shift);
   if (!state) return tl::unexpected(state.error());
-  state->format = format;
+  state->format = format.header_byte();
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
   const uint32_t base_faces = static_cast<uint32_t>(base.decoded.faces.size());
 
@@ -308,7 +308,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   if (report) {
     report->records.clear();
     report->base_shift = static_cast<uint32_t>(base_shift);
-    report->ordering = {plane_calibration, surface ? 2 : 1};
+    report->ordering = {plane_calibration, surface ? DistortionEstimate::kSurfaceDistance
+                                                   : DistortionEstimate::kDisplacement};
     report->plane_bits_raw = report->plane_bytes_coded = report->plane_bytes_plain =
         report->structure_bytes = 0;
     report->structure_bits = StructureBits{};
@@ -328,7 +329,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   header.structure_coder = kStructureCoderRange;
   header.geometry_coder = kGeometryCoderEmbedded;
   header.layer_count = static_cast<uint32_t>(dec.layers.size());
-  header.extra = {format, static_cast<uint8_t>(base_shift)};
+  header.extra = {format.header_byte(), static_cast<uint8_t>(base_shift)};
   return write_stream(header, std::move(records));
 }
 

@@ -52,7 +52,7 @@ Status StructureWriter::write_record(uint32_t target, int min_shift, WrittenReco
   }
   out = WrittenRecord{};
   write_record_header({starts_layer_, walk_steps, insertions, uint32_t(min_shift)}, out.payload,
-                      format_);
+                      format_.header_byte());
   starts_layer_ = false;
   std::vector<uint8_t> coded = enc.finish();
   out.payload.insert(out.payload.end(), coded.begin(), coded.end());
@@ -143,7 +143,7 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
     return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
   if (bits_) enc.set_cost_sink(&bits_->rank);
   const uint32_t rank = static_cast<uint32_t>(it - candidates_.begin());
-  if (format_ >= 3) {
+  if (format_.fast_start_structure_models) {
     const size_t c = candidates_.size();
     encode_start_rank3(m, enc, start_rank_context(k, c, scores_[0], c > 1 ? scores_[1] : -1), c,
                        rank);
@@ -179,7 +179,7 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   // Coarse residual of the new vertex against its prediction.
   InsertionPrediction prediction;
   predict_insertion(s_, patches_[j].ring, min_shift, prediction);
-  const int shift = format_ >= 2 ? prediction.shift : 0;
+  const int shift = format_.embedded ? prediction.shift : 0;
   if (bits_) enc.set_cost_sink(&bits_->residual);
   encode_coarse_residual(m, enc, prediction.ctx, r.position, prediction.predicted, shift,
                          geometry_[j]);

@@ -18,6 +18,7 @@
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/encoder.h"
 #include "common/codec/refinement_codec.h"
+#include "common/codec/stream_format.h"
 
 namespace meshstream {
 
@@ -36,9 +37,10 @@ class StructureWriter {
   // the encoder's knowledge of it (both grow with every inserted vertex);
   // `format` the refinement format written; `bits` (optional) receives the
   // cost of each symbol class.
-  StructureWriter(RefinementState& state, EncoderTruth& truth, uint8_t format, StructureBits* bits)
+  StructureWriter(RefinementState& state, EncoderTruth& truth, RefinementFormatInfo format,
+                  StructureBits* bits)
       : s_(state), t_(truth), format_(format), bits_(bits) {
-    s_.models.v_models = format >= 3;
+    s_.models.v_models = format.fast_start_structure_models;
   }
 
   // Whether the layer started last still has vertices to put back.
@@ -71,7 +73,7 @@ class StructureWriter {
 
   RefinementState& s_;
   EncoderTruth& t_;
-  uint8_t format_;
+  RefinementFormatInfo format_;
   StructureBits* bits_;
   std::vector<Removal> removals_;
   size_t remaining_ = 0;
