@@ -95,7 +95,7 @@ TriangleBvh grid_surface(const Mesh& mesh, const std::vector<Vec3i>& q) {
   Mesh grid_mesh;
   grid_mesh.triangles = mesh.triangles;
   grid_mesh.positions.reserve(q.size());
-  for (const Vec3i& p : q) grid_mesh.positions.push_back({float(p.x), float(p.y), float(p.z)});
+  for (const Vec3i& p : q) grid_mesh.positions.push_back(vec3_cast<float>(p));
   return TriangleBvh::build(grid_mesh);
 }
 

@@ -50,7 +50,7 @@ EncoderTruth base_truth(const Mesh& mesh, const std::vector<Vec3i>& q, const Cho
     const uint32_t in = base.to_input[d];
     truth.position.push_back(q[in]);
     const Vec3i anchor = state.geometry[d].anchor;
-    truth.residual.push_back({q[in].x - anchor.x, q[in].y - anchor.y, q[in].z - anchor.z});
+    truth.residual.push_back(q[in] - anchor);
     truth.weight.push_back(star_area[d] * std::sqrt(double(base_n)));
   }
   return truth;

@@ -200,16 +200,14 @@ double StructureWriter::apply_patches(std::vector<std::pair<uint32_t, uint32_t>>
     const double area = ring_area(s_.mesh.positions(), patches_[j].ring);
     const Vec3f nrm = t_.input_normal[r.vertex];
     const Vec3i pred = g.anchor;
-    const double d[3] = {double(r.position.x) - pred.x, double(r.position.y) - pred.y,
-                         double(r.position.z) - pred.z};
-    const double dn = d[0] * nrm.x + d[1] * nrm.y + d[2] * nrm.z;
+    const double dn = dot(to_double(r.position - pred), to_double(nrm));
     const Vec3i recon = reconstruct(g, s_.max_coordinate);
     const double before =
         t_.surface ? fan_distance2(s_.mesh.positions(), patches_[j].ring, r.position) : dn * dn;
     const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
     inserted.push_back({r.vertex, v});
     t_.position.push_back(r.position);
-    t_.residual.push_back({r.position.x - pred.x, r.position.y - pred.y, r.position.z - pred.z});
+    t_.residual.push_back(r.position - pred);
     t_.weight.push_back(area * std::sqrt(double(vertices_before + count)));
     drop += area * (before - vertex_error2(t_, v, recon)) / 6.0;
   }
