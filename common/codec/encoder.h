@@ -1,9 +1,10 @@
 // Encoding a mesh into one progressive `.hcs` stream (container.h for the
-// layout): quantize, decimate layer by layer, code the base mesh with Draco,
-// then refinement records from coarse to fine. An embedded stream (the
-// default) also sends positions by successive approximation (bit planes,
-// embedded_geometry.h) and orders structure and plane records by estimated
-// distortion decrease per byte (docs/hcs-format.md).
+// layout): quantize, decimate layer by layer (decimate.h), code the base mesh
+// (base_choice.h), then refinement records from coarse to fine. An embedded
+// stream (the default) also sends positions by successive approximation (bit
+// planes, embedded_geometry.h) and orders structure and plane records by
+// estimated distortion decrease per byte (record_schedule.h,
+// docs/hcs-format.md).
 #pragma once
 
 #include <cstdint>
@@ -56,9 +57,9 @@ struct EncodeOptions {
   // outside the enum is kInvalidArgument.
   DistortionEstimate distortion_estimate = DistortionEstimate::kAutomatic;
   // Low residual bits of inserted vertices left to plane records (at least;
-  // a vertex is never sharper than its ring). Embedded only. 1-8 measured
-  // worse than 0 on every mesh tried (more plane records and index entries,
-  // see docs/hcs-format.md); kept for experiments.
+  // a vertex is never sharper than its ring). Embedded only; 0 measured best
+  // (docs/hcs-format.md, "Record order and size"), the others are kept for
+  // experiments.
   int insertion_shift = 0;
   // Threads for the automatic ordering's candidates: 0 = as many as help
   // (one a candidate, when the machine has more than one core), 1 = one
@@ -71,15 +72,11 @@ struct EncodeOptions {
   RefinementFormat refinement_format = RefinementFormat::kEmbeddedFastStart;
 };
 
-// The record orderings the automatic choice tries (EncodeOptions), the
-// first is encoded first. Measured on the 13 real meshes
-// (bench/encoder_options_bench, bench/report/codec.md): the surface-distance
-// estimate is kept for 8, among them every CAD part, where vertices slide
-// within flat faces and displacement overvalues new vertices (fandisk at
-// the LOD chain's 1/16 point: 3.7 -> 1.1 x the chain's RMS); displacement
-// for 5 scans (skull: 0.86 against 1.09 at the 1/64 point). Balance 3, the
-// earlier choice's other candidate, no longer won with these two; balances
-// 0.5 and 2 did not pay either.
+// The record orderings the automatic choice tries (EncodeOptions): each
+// candidate's stream is measured and the best kept; the first is encoded
+// first and settles the record size. Why these two (the surface distance
+// wins on CAD parts, displacement on some scans) and which balances were
+// dropped: docs/hcs-format.md, "Record order and size".
 struct RecordOrdering {
   double plane_calibration;
   DistortionEstimate distortion_estimate;  // kDisplacement or kSurfaceDistance

@@ -1,7 +1,7 @@
-// Issue II: the embedded stream. The decoder's mesh at every record boundary
-// is the encoder's model bit for bit; plane records only move vertices; the
-// granularity bounds hold; budgets pick the right boundary; issue I's
-// ordering stays available and exact.
+// The embedded stream. The decoder's mesh at every record boundary is the
+// encoder's model bit for bit; plane records only move vertices; the
+// granularity bounds hold; budgets pick the right boundary; the stream
+// without bit planes stays available and exact.
 #include <gtest/gtest.h>
 
 #include <algorithm>
