@@ -23,6 +23,9 @@ enum class ErrorCode {
   kTruncated = 7,        // the input ended before a unit was complete
   kUnsupported = 8,      // a valid input using a feature or version we lack
   kLimit = 9,            // a size or count limit was exceeded
+  // Our own bug, not the input's: an invariant the code keeps did not hold
+  // (the encoder's and decoder's views of a record disagree, say).
+  kInternal = 10,
 };
 
 const char* to_string(ErrorCode code);
@@ -68,6 +71,8 @@ inline const char* to_string(ErrorCode code) {
       return "unsupported";
     case ErrorCode::kLimit:
       return "limit exceeded";
+    case ErrorCode::kInternal:
+      return "internal error";
   }
   return "unknown error";
 }

@@ -9,17 +9,11 @@
 #include <optional>
 #include <string>
 
+#include "common/codec/byte_io.h"
 #include "common/codec/range_coder.h"
 
 namespace meshstream {
 namespace {
-
-void put_u32(std::vector<uint8_t>& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
-}
-uint32_t get_u32(const uint8_t* p) {
-  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
 
 Status check_ranges(const BaseMesh& base, uint32_t vertex_count, uint32_t face_count,
                     int quant_bits, const char* coder) {
@@ -50,17 +44,6 @@ struct OwnModels {
   AdaptiveIntModel other;
 };
 
-bool read_draco_varint(std::span<const uint8_t> in, size_t& pos, uint64_t& value) {
-  value = 0;
-  for (int shift = 0; shift < 35; shift += 7) {
-    if (pos >= in.size()) return false;
-    const uint8_t b = in[pos++];
-    value |= uint64_t(b & 0x7F) << shift;
-    if (!(b & 0x80)) return true;
-  }
-  return false;
-}
-
 // Reads the Draco header and the edgebreaker connectivity counts (Draco
 // bitstream 2.2: "DRACO", major, minor, encoder type, method, u16 flags, u8
 // traversal type, varint vertices, varint faces, u8 attribute data, varint
@@ -80,9 +63,11 @@ Status check_draco_header(std::span<const uint8_t> in, uint32_t vertex_count, ui
   if (in[9] != 0 || in[10] != 0) return refuse("header flags set (metadata is never written)");
   if (in[11] > 2) return refuse("unknown edgebreaker traversal " + std::to_string(in[11]));
   size_t pos = 12;
-  uint64_t vertices = 0, faces = 0, symbols = 0, splits = 0;
-  if (!read_draco_varint(in, pos, vertices) || !read_draco_varint(in, pos, faces)) {
-    return refuse("connectivity counts cut short");
+  uint32_t vertices = 0, faces = 0, symbols = 0, splits = 0;
+  // Draco's varints are ours (LEB128); counts beyond 32 bits are refused
+  // with the rest.
+  if (!get_varint(in, pos, vertices) || !get_varint(in, pos, faces)) {
+    return refuse("connectivity counts cut short or over 32 bits");
   }
   if (vertices != vertex_count || faces != face_count) {
     return refuse("it declares " + std::to_string(vertices) + " vertices and " +
@@ -91,8 +76,8 @@ Status check_draco_header(std::span<const uint8_t> in, uint32_t vertex_count, ui
   }
   if (pos >= in.size()) return refuse("connectivity counts cut short");
   ++pos;  // attribute data count
-  if (!read_draco_varint(in, pos, symbols) || !read_draco_varint(in, pos, splits)) {
-    return refuse("symbol counts cut short");
+  if (!get_varint(in, pos, symbols) || !get_varint(in, pos, splits)) {
+    return refuse("symbol counts cut short or over 32 bits");
   }
   if (symbols > faces || splits > symbols) return refuse("more edgebreaker symbols than faces");
   // Even rANS-coded, every face costs some bits: refuse counts far beyond

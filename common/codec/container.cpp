@@ -2,6 +2,7 @@
 
 #include <cstring>
 
+#include "common/codec/byte_io.h"
 #include "common/codec/crc32.h"
 #include "common/codec/record_index_coder.h"
 
@@ -11,49 +12,6 @@ namespace {
 constexpr size_t kIndexEntryBytes = 24;
 // The header fields this version writes, in order; `extra` follows.
 constexpr size_t kHeaderFixedBytes = 4 * 4 + 6 * 4 + 4 + 4;
-
-void put_u16(std::vector<uint8_t>& out, uint16_t v) {
-  out.push_back(uint8_t(v));
-  out.push_back(uint8_t(v >> 8));
-}
-void put_u32(std::vector<uint8_t>& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
-}
-void put_f32(std::vector<uint8_t>& out, float f) {
-  uint32_t v;
-  std::memcpy(&v, &f, 4);
-  put_u32(out, v);
-}
-
-uint32_t get_u32(const uint8_t* p) {
-  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-void put_varint(std::vector<uint8_t>& out, uint32_t v) {
-  while (v >= 0x80) {
-    out.push_back(uint8_t(v | 0x80));
-    v >>= 7;
-  }
-  out.push_back(uint8_t(v));
-}
-bool get_varint(const uint8_t* p, size_t end, size_t& pos, uint32_t& value) {
-  value = 0;
-  for (int shift = 0; shift < 35; shift += 7) {
-    if (pos >= end) return false;
-    const uint8_t b = p[pos++];
-    if (shift == 28 && (b & 0x70)) return false;
-    value |= uint32_t(b & 0x7F) << shift;
-    if (!(b & 0x80)) return true;
-  }
-  return false;
-}
-uint16_t get_u16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
-uint64_t get_u64(const uint8_t* p) { return uint64_t(get_u32(p)) | uint64_t(get_u32(p + 4)) << 32; }
-float get_f32(const uint8_t* p) {
-  uint32_t v = get_u32(p);
-  float f;
-  std::memcpy(&f, &v, 4);
-  return f;
-}
 
 std::vector<uint8_t> encode_header(const StreamHeader& h) {
   std::vector<uint8_t> out;
@@ -297,14 +255,15 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     if (auto s = check_index_and_set_payload_offset(index_end); !s)
       return tl::unexpected(s.error());
     index.records.resize(record_count);
+    const std::span<const uint8_t> entries =
+        in.first(index_end);  // pos counts from the stream start
     size_t pos = entries_at;
     uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
     for (uint32_t i = 0; i < record_count; ++i) {
       RecordEntry& r = index.records[i];
       uint32_t size = 0, dv = 0, zigzag = 0;
-      if (!get_varint(in.data(), index_end, pos, size) ||
-          !get_varint(in.data(), index_end, pos, dv) ||
-          !get_varint(in.data(), index_end, pos, zigzag) || pos + 4 > index_end) {
+      if (!get_varint(entries, pos, size) || !get_varint(entries, pos, dv) ||
+          !get_varint(entries, pos, zigzag) || pos + 4 > index_end) {
         return make_error(ErrorCode::kParse,
                           "record index entry " + std::to_string(i) + " is malformed");
       }

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "common/codec/base_coder.h"
+#include "common/codec/byte_io.h"
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
@@ -238,8 +239,8 @@ TEST(HostileStream, PlaneRecordOutsideTheMeshIsRefused) {
     std::vector<std::vector<uint8_t>> payloads = payloads_of(clean, *index);
     // Record 1 becomes a plane record over [first, first + 10^6).
     std::vector<uint8_t> p = {kRecordPlane};
-    write_varint(first, p);
-    write_varint(1000000, p);
+    put_varint(p, first);
+    put_varint(p, 1000000);
     p.insert(p.end(), 16, 0x55);
     payloads[1] = p;
     const std::vector<uint8_t> stream = rebuild(*index, payloads);

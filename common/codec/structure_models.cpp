@@ -1,0 +1,31 @@
+// Start-rank coding: see structure_models.h.
+#include "common/codec/structure_models.h"
+
+namespace meshstream {
+
+void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint32_t rank) {
+  BitTreeModel<4>& tree = m.start_rank[std::min(k - 3, 5u)];
+  if (rank < 15) {
+    tree.encode(enc, rank);
+  } else {
+    tree.encode(enc, 15);
+    m.start_rank_big.encode(enc, rank - 15);
+  }
+}
+
+void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context, size_t candidates,
+                        uint32_t rank) {
+  if (candidates <= 1) return;
+  BitTreeModel<4, BitModelV>& tree = m.start_rank3[context];
+  if (rank < 15) {
+    tree.encode(enc, rank);
+  } else {
+    tree.encode(enc, 15);
+    m.start_rank_big3.encode(enc, rank - 15);
+  }
+}
+
+uint32_t decode_start_rank(RefinementModels& m, RangeDecoder& dec, uint32_t k) {
+  return decode_start_rank_inline(m, dec, k);
+}
+}  // namespace meshstream
