@@ -128,7 +128,8 @@ struct EncodeReport {
 };
 
 // Encodes a clean manifold mesh (see import.h). kInvalidArgument for bad
-// options, kNonManifold / kInvalidMesh for a mesh the codec cannot take.
+// options, kNonManifold / kInvalidMesh for a mesh the codec cannot take;
+// kInternal is a bug of the encoder (its replay of the decoder disagreed).
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options = {});
 // The same, also filling `report` (costs O(vertices) per record for the hashes).
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,

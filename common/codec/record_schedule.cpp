@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "common/codec/base_choice.h"
@@ -254,8 +255,11 @@ Result<EncodedStream> write_stream(const StreamHeader& header, std::vector<Writt
     payloads.push_back(std::move(r.payload));
   }
   if (counts.back().vertices != header.vertex_count || counts.back().faces != header.face_count) {
-    return make_error(ErrorCode::kInvalidMesh,
-                      "internal: the records do not rebuild the whole mesh");
+    return make_error(ErrorCode::kInternal,
+                      "encoder: the records rebuild " + std::to_string(counts.back().vertices) +
+                          " vertices and " + std::to_string(counts.back().faces) + " faces, not " +
+                          std::to_string(header.vertex_count) + " and " +
+                          std::to_string(header.face_count));
   }
   auto written = write_container(header, payloads, counts);
   if (!written) return tl::unexpected(written.error());

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace meshstream {
 
@@ -66,7 +67,9 @@ Status StructureWriter::next_walk_vertex(uint32_t& u) {
   while (s_.cursor != kNone && s_.vertices[s_.cursor].layer == s_.layer)
     s_.cursor = s_.vertices[s_.cursor].next;
   if (s_.cursor == kNone)
-    return make_error(ErrorCode::kInvalidMesh, "internal: walk ended with patches left");
+    return make_error(ErrorCode::kInternal, "encoder replay: the walk ended with " +
+                                                std::to_string(remaining_) + " patches of layer " +
+                                                std::to_string(s_.layer) + " left");
   u = s_.cursor;
   s_.cursor = s_.vertices[u].next;
   return {};
@@ -84,7 +87,9 @@ Status StructureWriter::find_patches_at(uint32_t u) {
       if (star_ring_[f] == r.ring[1] && star_ring_[(f + 1) % ring_size] == r.ring[2]) pos = f;
     }
     if (pos == kNone)
-      return make_error(ErrorCode::kInvalidMesh, "internal: patch not found at its apex");
+      return make_error(ErrorCode::kInternal, "encoder replay: the patch of input vertex " +
+                                                  std::to_string(r.vertex) +
+                                                  " not found at its apex " + std::to_string(u));
     order_.push_back({pos, i});
   }
   std::sort(order_.begin(), order_.end());
@@ -97,7 +102,8 @@ Status StructureWriter::code_patch_count(RangeEncoder& enc, uint32_t u, uint32_t
   RefinementModels& m = s_.models;
   free_faces = mark_taken_faces(s_, star_ring_, faces, used_);
   if (free_faces != free_face_count(s_, u)) {
-    return make_error(ErrorCode::kInvalidMesh, "internal: free face counts disagree");
+    return make_error(ErrorCode::kInternal,
+                      "encoder replay: free face counts disagree at vertex " + std::to_string(u));
   }
   if (free_faces > 0) {
     if (bits_) {
@@ -112,7 +118,8 @@ Status StructureWriter::code_patch_count(RangeEncoder& enc, uint32_t u, uint32_t
       if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
     }
   } else if (count > 0) {
-    return make_error(ErrorCode::kInvalidMesh, "internal: patch at a vertex without free faces");
+    return make_error(ErrorCode::kInternal, "encoder replay: vertex " + std::to_string(u) +
+                                                " has patches but no free faces");
   }
   s_.last_count = count;
   return {};
@@ -140,7 +147,9 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   rank_patch_starts(s_.mesh, u, star_ring_, used_, k, candidates_, scores_);
   const auto it = std::find(candidates_.begin(), candidates_.end(), order_[j].first);
   if (it == candidates_.end())
-    return make_error(ErrorCode::kInvalidMesh, "internal: patch start not a candidate");
+    return make_error(ErrorCode::kInternal, "encoder replay: the patch of input vertex " +
+                                                std::to_string(r.vertex) +
+                                                " starts at no candidate face");
   if (bits_) enc.set_cost_sink(&bits_->rank);
   const uint32_t rank = static_cast<uint32_t>(it - candidates_.begin());
   if (format_.fast_start_structure_models) {
@@ -153,7 +162,9 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   for (uint32_t f = 0; f + 2 < k; ++f) used_[(order_[j].first + f) % faces] = 1;
   if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k, patches_[j]) ||
       patches_[j].ring != r.ring) {
-    return make_error(ErrorCode::kInvalidMesh, "internal: patch does not resolve to its ring");
+    return make_error(ErrorCode::kInternal, "encoder replay: the patch of input vertex " +
+                                                std::to_string(r.vertex) +
+                                                " does not resolve to its ring");
   }
   // Open edge of a boundary patch.
   patch_boundary_edges(s_.mesh, patches_[j], open_edges_);
@@ -162,8 +173,9 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
     for (uint32_t e = 0; e < open_edges_.size(); ++e)
       if (open_edges_[e] == r.open) choice = e + 1;
     if (r.open != kNone && choice == 0)
-      return make_error(ErrorCode::kInvalidMesh,
-                        "internal: open edge of a boundary patch not on the boundary");
+      return make_error(ErrorCode::kInternal, "encoder replay: the open edge of input vertex " +
+                                                  std::to_string(r.vertex) +
+                                                  "'s boundary patch is not on the boundary");
     if (bits_) {
       ++bits_->open_choices;
       enc.set_cost_sink(&bits_->open_edge);
@@ -174,7 +186,9 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
       m.open_edge.encode(enc, choice);
     }
   } else if (r.open != kNone) {
-    return make_error(ErrorCode::kInvalidMesh, "internal: boundary patch without boundary edges");
+    return make_error(ErrorCode::kInternal, "encoder replay: the boundary patch of input vertex " +
+                                                std::to_string(r.vertex) +
+                                                " has no boundary edges");
   }
   // Coarse residual of the new vertex against its prediction.
   InsertionPrediction prediction;

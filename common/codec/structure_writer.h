@@ -52,8 +52,8 @@ class StructureWriter {
 
   // Writes the next record of the open layer, about `target` bytes.
   // `inserted` gets (input id, decoder id) of every vertex it put back.
-  // A kInvalidMesh "internal: ..." error means the replay disagrees with
-  // the decimation (a bug, not bad input).
+  // kInternal when the replay disagrees with the decimation (a bug, not
+  // bad input).
   Status write_record(uint32_t target, int min_shift, WrittenRecord& out,
                       std::vector<std::pair<uint32_t, uint32_t>>& inserted);
 

@@ -2,6 +2,7 @@
 // --no-bit-planes and --base-shift write, and that --issue1-order (the old
 // name of --no-bit-planes, kept as a hidden alias) still gives the same bytes.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -33,10 +34,10 @@ std::string read_text(const fs::path& path) {
 class EncodeCommand : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ =
-        fs::temp_directory_path() /
-        ("ms_encode_command_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    // Per process and test: other checkouts may run the same tests at once.
+    dir_ = fs::temp_directory_path() /
+           ("ms_encode_command_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     mesh_ = dir_ / "sphere.ply";
     ASSERT_EQ(shell(tool() + " generate icosphere --size 3 -o " + mesh_.string()), 0);
