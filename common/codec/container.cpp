@@ -135,19 +135,24 @@ Result<WrittenContainer> write_container(const StreamHeader& header,
   return out;
 }
 
-Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
-  auto need = [&](size_t bytes) -> Status {
-    if (in.size() < bytes) {
-      return make_error(ErrorCode::kTruncated, "stream ends after " + std::to_string(in.size()) +
-                                                   " bytes, inside its header or record index");
-    }
-    return {};
-  };
-  if (auto s = need(12); !s) return tl::unexpected(s.error());
+namespace {
+
+// kTruncated unless `in` holds at least `bytes`: feed more and call again.
+Status need_bytes(std::span<const uint8_t> in, size_t bytes) {
+  if (in.size() < bytes) {
+    return make_error(ErrorCode::kTruncated, "stream ends after " + std::to_string(in.size()) +
+                                                 " bytes, inside its header or record index");
+  }
+  return {};
+}
+
+// Phase 1: magic, version, flags and the header's size (the first 12 bytes).
+Status read_preamble(std::span<const uint8_t> in, uint16_t& version, uint32_t& header_size) {
+  if (auto s = need_bytes(in, 12); !s) return s;
   if (std::memcmp(in.data(), kContainerMagic, 4) != 0) {
     return make_error(ErrorCode::kParse, "not an .hcs stream (bad magic bytes)");
   }
-  const uint16_t version = get_u16(in.data() + 4);
+  version = get_u16(in.data() + 4);
   if (version < 1 || version > kContainerVersion) {
     return make_error(ErrorCode::kUnsupported, "unsupported .hcs version " +
                                                    std::to_string(version) + " (this build reads " +
@@ -157,20 +162,22 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   if (get_u16(in.data() + 6) != 0) {
     return make_error(ErrorCode::kUnsupported, ".hcs stream uses flags this build does not know");
   }
-  const uint32_t header_size = get_u32(in.data() + 8);
+  header_size = get_u32(in.data() + 8);
   if (header_size < kHeaderFixedBytes || header_size > kMaxHeaderBytes) {
     return make_error(ErrorCode::kParse,
                       "implausible .hcs header size " + std::to_string(header_size));
   }
-  if (auto s = need(12 + size_t(header_size) + 8); !s) return tl::unexpected(s.error());
+  return {};
+}
+
+// Phase 2: the header's bytes, checked against their CRC, as fields. Waits
+// (kTruncated) also for the record count after the CRC.
+Status read_header(std::span<const uint8_t> in, uint32_t header_size, StreamHeader& hd) {
+  if (auto s = need_bytes(in, 12 + size_t(header_size) + 8); !s) return s;
   const uint8_t* h = in.data() + 12;
   if (crc32(0, h, header_size) != get_u32(h + header_size)) {
     return make_error(ErrorCode::kCorrupt, ".hcs header checksum mismatch");
   }
-
-  StreamIndex index;
-  index.version = version;
-  StreamHeader& hd = index.header;
   hd.vertex_count = get_u32(h);
   hd.face_count = get_u32(h + 4);
   hd.base_vertex_count = get_u32(h + 8);
@@ -183,112 +190,130 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
   hd.geometry_coder = h[43];
   hd.layer_count = get_u32(h + 44);
   hd.extra.assign(h + kHeaderFixedBytes, h + header_size);
+  return {};
+}
 
-  const size_t count_at = 12 + size_t(header_size) + 4;
-  const uint32_t record_count = get_u32(in.data() + count_at);
-  if (record_count == 0 || record_count > kMaxRecords) {
+// Where an index starts (its u32 record count, which the index CRC covers
+// too) and how many records it lists.
+struct IndexStart {
+  size_t count_at = 0;
+  uint32_t record_count = 0;
+};
+
+// The tail every version's index shares: wait until the index (ending at
+// `index_end`) and its u32 CRC are all there, check that CRC, and note
+// that record 0 starts right after it. Every version allocates the entries
+// only after this: a hostile count costs no memory before.
+Status check_index_crc(std::span<const uint8_t> in, const IndexStart& at, size_t index_end,
+                       StreamIndex& index) {
+  if (auto s = need_bytes(in, index_end + 4); !s) return s;
+  if (crc32(0, in.data() + at.count_at, index_end - at.count_at) !=
+      get_u32(in.data() + index_end)) {
+    return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
+  }
+  index.payload_offset = index_end + 4;
+  return {};
+}
+
+// Version 1: fixed 24-byte entries (u64 offset, u32 size, vertices, faces,
+// CRC).
+Status read_index_v1(std::span<const uint8_t> in, const IndexStart& at, StreamIndex& index) {
+  const size_t entries_at = at.count_at + 4;
+  const size_t index_end = entries_at + size_t(at.record_count) * kIndexEntryBytes;
+  if (auto s = check_index_crc(in, at, index_end, index); !s) return s;
+  index.records.resize(at.record_count);
+  for (uint32_t i = 0; i < at.record_count; ++i) {
+    const uint8_t* e = in.data() + entries_at + size_t(i) * kIndexEntryBytes;
+    RecordEntry& r = index.records[i];
+    r.offset = get_u64(e);
+    r.size = get_u32(e + 8);
+    r.vertices = get_u32(e + 12);
+    r.faces = get_u32(e + 16);
+    r.crc32 = get_u32(e + 20);
+  }
+  return {};
+}
+
+// Version 2: u32 length, then per record varint size, varint vertices
+// added, zigzag varint (2 x vertices added - faces added), u32 CRC.
+Status read_index_v2(std::span<const uint8_t> in, const IndexStart& at, StreamIndex& index) {
+  if (auto s = need_bytes(in, at.count_at + 8); !s) return s;
+  const uint32_t record_count = at.record_count;
+  const uint32_t index_bytes = get_u32(in.data() + at.count_at + 4);
+  if (index_bytes < 7ull * record_count || index_bytes > 19ull * record_count) {  // 3 varints + CRC
     return make_error(ErrorCode::kParse,
-                      "implausible record count " + std::to_string(record_count));
+                      "implausible record index length " + std::to_string(index_bytes));
   }
-  const size_t index_start = count_at;  // the index CRC covers the count too
-  // The tail every version's index shares: wait until the index (ending at
-  // `index_end`) and its u32 CRC are all there, check that CRC, and note
-  // that record 0 starts right after it.
-  auto check_index_and_set_payload_offset = [&](size_t index_end) -> Status {
-    if (auto s = need(index_end + 4); !s) return s;
-    if (crc32(0, in.data() + index_start, index_end - index_start) !=
-        get_u32(in.data() + index_end)) {
-      return make_error(ErrorCode::kCorrupt, ".hcs record index checksum mismatch");
-    }
-    index.payload_offset = index_end + 4;
-    return {};
-  };
-  // Every version allocates the entries only once the index bytes are there
-  // and checked: a hostile count costs no memory before.
-  if (version == 1) {
-    const size_t index_end = count_at + 4 + size_t(record_count) * kIndexEntryBytes;
-    if (auto s = check_index_and_set_payload_offset(index_end); !s)
-      return tl::unexpected(s.error());
-    index.records.resize(record_count);
-    for (uint32_t i = 0; i < record_count; ++i) {
-      const uint8_t* e = in.data() + count_at + 4 + size_t(i) * kIndexEntryBytes;
-      RecordEntry& r = index.records[i];
-      r.offset = get_u64(e);
-      r.size = get_u32(e + 8);
-      r.vertices = get_u32(e + 12);
-      r.faces = get_u32(e + 16);
-      r.crc32 = get_u32(e + 20);
-    }
-  } else if (version == 3) {
-    if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
-    // Bounds before waiting for the bytes: a hostile length is an error
-    // now, not a wait for gigabytes.
-    const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
-    if (index_bytes == 0 || index_bytes > uint64_t(kMaxIndexBytesPerRecord) * record_count ||
-        record_count > uint64_t(kMaxRecordsPerIndexByte) * index_bytes) {
-      return make_error(ErrorCode::kParse, "implausible record index length " +
-                                               std::to_string(index_bytes) + " for " +
-                                               std::to_string(record_count) + " records");
-    }
-    const size_t entries_at = count_at + 8;
-    const size_t index_end = entries_at + index_bytes;
-    if (auto s = check_index_and_set_payload_offset(index_end); !s)
-      return tl::unexpected(s.error());
-    auto records = decode_record_index(in.subspan(entries_at, index_bytes), record_count,
-                                       index.payload_offset);
-    if (!records) return tl::unexpected(records.error());
-    index.records = std::move(*records);
-    for (RecordEntry& r : index.records) {
-      if (r.offset + r.size > in.size()) break;  // contiguous: the rest lie beyond too
-      r.crc32 = get_u32(in.data() + r.offset + r.size - kRecordTrailerBytes);
-    }
-  } else {
-    if (auto s = need(count_at + 8); !s) return tl::unexpected(s.error());
-    const uint32_t index_bytes = get_u32(in.data() + count_at + 4);
-    if (index_bytes < 7ull * record_count ||
-        index_bytes > 19ull * record_count) {  // 3 varints + CRC
-      return make_error(ErrorCode::kParse,
-                        "implausible record index length " + std::to_string(index_bytes));
-    }
-    const size_t entries_at = count_at + 8;
-    const size_t index_end = entries_at + index_bytes;
-    if (auto s = check_index_and_set_payload_offset(index_end); !s)
-      return tl::unexpected(s.error());
-    index.records.resize(record_count);
-    const std::span<const uint8_t> entries =
-        in.first(index_end);  // pos counts from the stream start
-    size_t pos = entries_at;
-    uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
-    for (uint32_t i = 0; i < record_count; ++i) {
-      RecordEntry& r = index.records[i];
-      uint32_t size = 0, dv = 0, zigzag = 0;
-      if (!get_varint(entries, pos, size) || !get_varint(entries, pos, dv) ||
-          !get_varint(entries, pos, zigzag) || pos + 4 > index_end) {
-        return make_error(ErrorCode::kParse,
-                          "record index entry " + std::to_string(i) + " is malformed");
-      }
-      const int64_t gap = zigzag & 1 ? -(int64_t(zigzag) + 1) / 2 : int64_t(zigzag) / 2;
-      const int64_t df = 2 * int64_t(dv) - gap;
-      if (df < 0)
-        return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " removes faces");
-      vertices += dv;
-      faces += uint64_t(df);
-      if (vertices > UINT32_MAX || faces > UINT32_MAX) {
-        return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " counts overflow");
-      }
-      r.offset = offset;
-      r.size = size;
-      r.vertices = static_cast<uint32_t>(vertices);
-      r.faces = static_cast<uint32_t>(faces);
-      r.crc32 = get_u32(in.data() + pos);
-      pos += 4;
-      offset += size;
-    }
-    if (pos != index_end) return make_error(ErrorCode::kParse, "record index has trailing bytes");
-  }
-  uint64_t expected_offset = index.payload_offset;
+  const size_t entries_at = at.count_at + 8;
+  const size_t index_end = entries_at + index_bytes;
+  if (auto s = check_index_crc(in, at, index_end, index); !s) return s;
+  index.records.resize(record_count);
+  const std::span<const uint8_t> entries = in.first(index_end);  // pos counts from the stream start
+  size_t pos = entries_at;
+  uint64_t offset = index.payload_offset, vertices = 0, faces = 0;
   for (uint32_t i = 0; i < record_count; ++i) {
     RecordEntry& r = index.records[i];
+    uint32_t size = 0, dv = 0, zigzag = 0;
+    if (!get_varint(entries, pos, size) || !get_varint(entries, pos, dv) ||
+        !get_varint(entries, pos, zigzag) || pos + 4 > index_end) {
+      return make_error(ErrorCode::kParse,
+                        "record index entry " + std::to_string(i) + " is malformed");
+    }
+    const int64_t gap = zigzag & 1 ? -(int64_t(zigzag) + 1) / 2 : int64_t(zigzag) / 2;
+    const int64_t df = 2 * int64_t(dv) - gap;
+    if (df < 0)
+      return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " removes faces");
+    vertices += dv;
+    faces += uint64_t(df);
+    if (vertices > UINT32_MAX || faces > UINT32_MAX) {
+      return make_error(ErrorCode::kParse, "record " + std::to_string(i) + " counts overflow");
+    }
+    r.offset = offset;
+    r.size = size;
+    r.vertices = static_cast<uint32_t>(vertices);
+    r.faces = static_cast<uint32_t>(faces);
+    r.crc32 = get_u32(in.data() + pos);
+    pos += 4;
+    offset += size;
+  }
+  if (pos != index_end) return make_error(ErrorCode::kParse, "record index has trailing bytes");
+  return {};
+}
+
+// Version 3: u32 length, then the range-coded index (record_index_coder.h);
+// each record's CRC is its trailer, filled in for the records inside `in`.
+Status read_index_v3(std::span<const uint8_t> in, const IndexStart& at, StreamIndex& index) {
+  if (auto s = need_bytes(in, at.count_at + 8); !s) return s;
+  const uint32_t record_count = at.record_count;
+  // Bounds before waiting for the bytes: a hostile length is an error
+  // now, not a wait for gigabytes.
+  const uint32_t index_bytes = get_u32(in.data() + at.count_at + 4);
+  if (index_bytes == 0 || index_bytes > uint64_t(kMaxIndexBytesPerRecord) * record_count ||
+      record_count > uint64_t(kMaxRecordsPerIndexByte) * index_bytes) {
+    return make_error(ErrorCode::kParse, "implausible record index length " +
+                                             std::to_string(index_bytes) + " for " +
+                                             std::to_string(record_count) + " records");
+  }
+  const size_t entries_at = at.count_at + 8;
+  const size_t index_end = entries_at + index_bytes;
+  if (auto s = check_index_crc(in, at, index_end, index); !s) return s;
+  auto records =
+      decode_record_index(in.subspan(entries_at, index_bytes), record_count, index.payload_offset);
+  if (!records) return tl::unexpected(records.error());
+  index.records = std::move(*records);
+  for (RecordEntry& r : index.records) {
+    if (r.offset + r.size > in.size()) break;  // contiguous: the rest lie beyond too
+    r.crc32 = get_u32(in.data() + r.offset + r.size - kRecordTrailerBytes);
+  }
+  return {};
+}
+
+// Last phase, any version: records follow each other from the end of the
+// index, vertex counts never decrease and the last counts are the header's.
+Status check_records(const StreamIndex& index) {
+  uint64_t expected_offset = index.payload_offset;
+  for (uint32_t i = 0; i < index.records.size(); ++i) {
+    const RecordEntry& r = index.records[i];
     if (r.offset != expected_offset) {
       return make_error(ErrorCode::kParse, "record " + std::to_string(i) +
                                                " does not start where record " +
@@ -300,10 +325,33 @@ Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
     }
     expected_offset += r.size;
   }
-  if (index.records.back().vertices != hd.vertex_count ||
-      index.records.back().faces != hd.face_count) {
+  if (index.records.back().vertices != index.header.vertex_count ||
+      index.records.back().faces != index.header.face_count) {
     return make_error(ErrorCode::kParse, "the last record's counts do not match the header's");
   }
+  return {};
+}
+
+}  // namespace
+
+Result<StreamIndex> read_stream_index(std::span<const uint8_t> in) {
+  StreamIndex index;
+  uint32_t header_size = 0;
+  if (auto s = read_preamble(in, index.version, header_size); !s) return tl::unexpected(s.error());
+  if (auto s = read_header(in, header_size, index.header); !s) return tl::unexpected(s.error());
+
+  IndexStart at;
+  at.count_at = 12 + size_t(header_size) + 4;
+  at.record_count = get_u32(in.data() + at.count_at);
+  if (at.record_count == 0 || at.record_count > kMaxRecords) {
+    return make_error(ErrorCode::kParse,
+                      "implausible record count " + std::to_string(at.record_count));
+  }
+  const Status entries = index.version == 1   ? read_index_v1(in, at, index)
+                         : index.version == 3 ? read_index_v3(in, at, index)
+                                              : read_index_v2(in, at, index);
+  if (!entries) return tl::unexpected(entries.error());
+  if (auto s = check_records(index); !s) return tl::unexpected(s.error());
   return index;
 }
 

@@ -112,7 +112,7 @@ struct IncrementalDecoder::State {
           RefinementState::from_coarse_base(base->positions, base->faces, h.quant_bits, base_shift);
       if (!state) return where(state.error());
       refine = std::move(*state);
-      refine->format = format.header_byte();
+      refine->format = format;
       // Reserve for the final size, but never more than the bytes received
       // so far could describe (every inserted vertex costs well over a bit):
       // neither a hostile header nor a hostile index (records claiming a

@@ -58,7 +58,8 @@ class IncrementalDecoder {
 
   // The current mesh: dequantized positions and triangles.
   const Mesh& mesh() const;
-  // What the most recent record changed.
+  // What each record the last feed() applied changed, in order: one delta a
+  // record, empty when that call completed none (feed clears them first).
   const std::vector<RecordDelta>& last_deltas() const;
 
   // True after an error that left the decoded state untouched: a record

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "common/codec/decimate.h"
+#include "common/codec/stream_format.h"
 
 namespace meshstream {
 
@@ -11,7 +11,7 @@ bool resolve_patch(const EditableMesh& mesh, uint32_t apex, const std::vector<ui
                    const std::vector<uint32_t>& star_corners, uint32_t r, uint32_t k,
                    ResolvedPatch& out) {
   const uint32_t faces = static_cast<uint32_t>(star_corners.size());
-  if (k < 3 || k > kMaxRemovalValence || r >= faces) return false;
+  if (k < 3 || k > kMaxInsertedValence || r >= faces) return false;
   const uint32_t fan = k - 2;
   if (mesh.is_boundary(apex)) {
     if (r + fan > faces) return false;  // would cross the boundary

@@ -21,7 +21,7 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
   applied.moved_vertices.clear();
   size_t pos = 1;
   uint32_t first = 0, count = 0;
-  if (state.format < 2) return bad("plane record in a stream of refinement format 1");
+  if (!state.format.embedded) return bad("plane record in a stream of refinement format 1");
   if (!get_varint(payload, pos, first) || !get_varint(payload, pos, count)) {
     return bad("plane record header is cut short or malformed");
   }

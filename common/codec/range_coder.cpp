@@ -60,9 +60,9 @@ void RangeEncoder::encode_bit(BitModel& model, uint32_t bit) {
   }
 }
 
-void RangeEncoder::encode_bit(BitModelV& model, uint32_t bit) {
+void RangeEncoder::encode_bit(FastStartBitModel& model, uint32_t bit) {
   encode_with_probability(model.state & ((1u << kModelBits) - 1), bit);
-  model.state = bit_model_next(model.state, bit);
+  model.state = fast_start_next(model.state, bit);
 }
 
 void RangeEncoder::encode_direct(uint32_t value, int count) {
@@ -132,8 +132,8 @@ void AdaptiveIntModelT<Model>::encode(RangeEncoder& enc, int32_t value) {
 }
 
 template struct AdaptiveUIntModelT<BitModel>;
-template struct AdaptiveUIntModelT<BitModelV>;
+template struct AdaptiveUIntModelT<FastStartBitModel>;
 template struct AdaptiveIntModelT<BitModel>;
-template struct AdaptiveIntModelT<BitModelV>;
+template struct AdaptiveIntModelT<FastStartBitModel>;
 
 }  // namespace meshstream

@@ -28,48 +28,50 @@ struct BitModel {
 
 // A bit model whose adaptation slows as it learns (refinement format 3):
 // the first 2 bits move the probability by 1/4 of the error, the next 4 by
-// 1/8, the next 8 by 1/16, then by 1/32 as BitModel. A fixed 1/32 learns
-// the many sparsely used contexts slowly (small meshes); a fixed 1/16
-// measured better there but worse on large meshes, and a final 1/64 or 1/16
-// after the same start lost 0.3-1.1 % of the stream on the real meshes.
+// 1/8, the next 8 by 1/16, then by 1/32 as BitModel: a fixed 1/32 learns
+// the many sparsely used contexts slowly (small meshes), a faster fixed rate
+// loses on large ones (the rates measured: docs/hcs-format.md, "Entropy
+// coder").
 // `state` holds the probability of a 0 in its low 11 bits (as BitModel's p)
 // and the number of bits seen, saturating at 14, in its top bits: the same
 // 2 bytes as a BitModel (a wider model measured slower to decode).
-struct BitModelV {
+struct FastStartBitModel {
   uint16_t state = 1024;
 };
-inline constexpr uint32_t kBitModelVSeenShift = 11;
-inline constexpr uint32_t kBitModelVSeenMax = 14;
-// Adaptation shift of a BitModelV that has seen `n` bits (n <= 14).
-inline constexpr uint32_t bit_model_rate(uint32_t n) { return 2 + (n >= 2) + (n >= 6) + (n >= 14); }
+inline constexpr uint32_t kFastStartSeenShift = 11;
+inline constexpr uint32_t kFastStartSeenMax = 14;
+// Adaptation shift of a FastStartBitModel that has seen `n` bits (n <= 14).
+inline constexpr uint32_t fast_start_rate(uint32_t n) {
+  return 2 + (n >= 2) + (n >= 6) + (n >= 14);
+}
 // The model's state after coding a 0 / a 1 (one function per bit, so the
 // decoder updates inside the branch that found the bit).
-MESHSTREAM_MODEL_INLINE uint16_t bit_model_after0(uint32_t state) {
+MESHSTREAM_MODEL_INLINE uint16_t fast_start_after0(uint32_t state) {
   const uint32_t p = state & 2047u;
-  if (state >= (kBitModelVSeenMax << kBitModelVSeenShift)) {
+  if (state >= (kFastStartSeenMax << kFastStartSeenShift)) {
     // Learned (most bits of a large mesh): BitModel's update, which keeps
     // p within 11 bits, so the count bits above stay as they are.
     return static_cast<uint16_t>(state + ((2048u - p) >> 5));
   }
-  const uint32_t n = state >> kBitModelVSeenShift;  // < kBitModelVSeenMax
-  return static_cast<uint16_t>((p + ((2048u - p) >> bit_model_rate(n))) |
-                               ((n + 1) << kBitModelVSeenShift));
+  const uint32_t n = state >> kFastStartSeenShift;  // < kFastStartSeenMax
+  return static_cast<uint16_t>((p + ((2048u - p) >> fast_start_rate(n))) |
+                               ((n + 1) << kFastStartSeenShift));
 }
-MESHSTREAM_MODEL_INLINE uint16_t bit_model_after1(uint32_t state) {
+MESHSTREAM_MODEL_INLINE uint16_t fast_start_after1(uint32_t state) {
   const uint32_t p = state & 2047u;
-  if (state >= (kBitModelVSeenMax << kBitModelVSeenShift))
+  if (state >= (kFastStartSeenMax << kFastStartSeenShift))
     return static_cast<uint16_t>(state - (p >> 5));
-  const uint32_t n = state >> kBitModelVSeenShift;
-  return static_cast<uint16_t>((p - (p >> bit_model_rate(n))) | ((n + 1) << kBitModelVSeenShift));
+  const uint32_t n = state >> kFastStartSeenShift;
+  return static_cast<uint16_t>((p - (p >> fast_start_rate(n))) | ((n + 1) << kFastStartSeenShift));
 }
-MESHSTREAM_MODEL_INLINE uint16_t bit_model_next(uint32_t state, uint32_t bit) {
-  return bit == 0 ? bit_model_after0(state) : bit_model_after1(state);
+MESHSTREAM_MODEL_INLINE uint16_t fast_start_next(uint32_t state, uint32_t bit) {
+  return bit == 0 ? fast_start_after0(state) : fast_start_after1(state);
 }
 
 class RangeEncoder {
  public:
   void encode_bit(BitModel& model, uint32_t bit);
-  void encode_bit(BitModelV& model, uint32_t bit);
+  void encode_bit(FastStartBitModel& model, uint32_t bit);
   // Equiprobable bits, most significant first (count <= 32).
   void encode_direct(uint32_t value, int count);
   // Ends the stream; returns the bytes. The encoder is spent afterwards.
@@ -122,17 +124,17 @@ class RangeDecoder {
     normalize();
     return bit;
   }
-  MESHSTREAM_DECODE_INLINE uint32_t decode_bit(BitModelV& model) {
+  MESHSTREAM_DECODE_INLINE uint32_t decode_bit(FastStartBitModel& model) {
     const uint32_t bound = (range_ >> 11) * (model.state & 2047u);
     uint32_t bit;
     if (code_ < bound) {
       range_ = bound;
-      model.state = bit_model_after0(model.state);
+      model.state = fast_start_after0(model.state);
       bit = 0;
     } else {
       code_ -= bound;
       range_ -= bound;
-      model.state = bit_model_after1(model.state);
+      model.state = fast_start_after1(model.state);
       bit = 1;
     }
     normalize();
@@ -167,7 +169,7 @@ class RangeDecoder {
   // One byte in at most per coded bit: a range of at least 2^24 before the
   // bit leaves at least 2^24 * 31 / 2048 > 2^16 after it (every model's
   // probability stays within [31, 2017] / 2048: the updates by 1/32 of the
-  // error stop there, and a BitModelV's 14 faster first steps cannot get
+  // error stop there, and a FastStartBitModel's 14 faster first steps cannot get
   // that far from 1024), and a direct bit halves it, so one shift restores
   // 2^24. An `if` instead of LZMA's `while` saves a test per bit.
   MESHSTREAM_DECODE_INLINE void normalize() {
@@ -233,7 +235,7 @@ struct AdaptiveUIntModelT {
   }
 };
 using AdaptiveUIntModel = AdaptiveUIntModelT<BitModel>;
-using AdaptiveUIntModelV = AdaptiveUIntModelT<BitModelV>;
+using FastStartUIntModel = AdaptiveUIntModelT<FastStartBitModel>;
 
 // Signed integers: zero flag, sign, then magnitude - 1 as above.
 template <class Model>
@@ -251,6 +253,6 @@ struct AdaptiveIntModelT {
   }
 };
 using AdaptiveIntModel = AdaptiveIntModelT<BitModel>;
-using AdaptiveIntModelV = AdaptiveIntModelT<BitModelV>;
+using FastStartIntModel = AdaptiveIntModelT<FastStartBitModel>;
 
 }  // namespace meshstream

@@ -5,10 +5,16 @@
 
 namespace meshstream {
 
-void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format) {
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
+                         RefinementFormatInfo format) {
   out.push_back(header.starts_layer ? kRecordStartsLayer : 0);
   put_varint(out, header.walk_steps);
   put_varint(out, header.insertions);
-  if (format >= 2) put_varint(out, header.min_shift);
+  if (format.embedded) put_varint(out, header.min_shift);
 }
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
+                         uint8_t header_byte) {
+  write_record_header(header, out, RefinementFormatInfo::from_header_byte(header_byte).value());
+}
+
 }  // namespace meshstream

@@ -14,8 +14,17 @@ struct RecordHeader {
   bool starts_layer = false;
   uint32_t walk_steps = 0;
   uint32_t insertions = 0;
-  uint32_t min_shift = 0;  // format 2 only
+  // The embedded formats (2, 3) only: the coarsest shift an insertion of
+  // the record starts with (insertion_prediction.h).
+  uint32_t min_shift = 0;
 };
-void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out, uint8_t format = 2);
+// Appends the header as `format` has it (min_shift in the embedded formats).
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
+                         RefinementFormatInfo format);
+// The same for a header byte (extra[0]) the caller has validated; throws
+// std::bad_optional_access for one no format has. The encoder's spelling
+// until it holds a RefinementFormatInfo.
+void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
+                         uint8_t header_byte);
 
 }  // namespace meshstream

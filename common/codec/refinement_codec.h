@@ -26,9 +26,10 @@
 //
 // A record covers a run of the walk (a batch); the first record of a layer
 // restarts the walk. Record payload: u8 flags (bit 0: starts a layer),
-// varint walk steps, varint insertions, then one range-coded block.
+// varint walk steps, varint insertions, in the embedded formats varint min
+// shift (record_header.h), then one range-coded block.
 // Format 3 (kRefinementFormat) keeps this layout and codes the same symbols
-// through models that learn faster at first (BitModelV), with the valence
+// through models that learn faster at first (FastStartBitModel), with the valence
 // also by the apex's free faces and the start rank by the number of
 // candidate runs and the lead of the best (docs/hcs-format.md).
 #pragma once
@@ -42,3 +43,22 @@
 #include "common/codec/structure_contexts.h"
 #include "common/codec/structure_models.h"
 #include "common/codec/structure_record_reader.h"
+
+namespace meshstream {
+
+// The old names the encoder side (structure_writer) still calls; they go
+// once it uses the names above.
+inline BitTreeModel<2, FastStartBitModel>& count_model3(RefinementState& s, uint32_t u,
+                                                        uint32_t free_faces) {
+  return fast_start_count_model(s, u, free_faces);
+}
+inline BitTreeModel<4, FastStartBitModel>& valence_model3(RefinementState& s, uint32_t ring_size,
+                                                          uint32_t free_left) {
+  return fast_start_valence_model(s, ring_size, free_left);
+}
+inline void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context,
+                               size_t candidates, uint32_t rank) {
+  encode_start_rank_in_context(m, enc, context, candidates, rank);
+}
+
+}  // namespace meshstream

@@ -11,6 +11,7 @@
 #include "common/base/result.h"
 #include "common/codec/editable_mesh.h"
 #include "common/codec/embedded_geometry.h"
+#include "common/codec/stream_format.h"
 #include "common/codec/structure_models.h"
 
 namespace meshstream {
@@ -49,10 +50,9 @@ struct RefinementState {
   // mesh.positions() holds reconstruct() of each entry.
   std::vector<VertexGeometry> geometry;
   GeometryModels geometry_models;
-  // Refinement record format (header extra[0]): 1 = issue I's records (no
-  // shift field, no plane records), 2 = embedded geometry, 3 = the same
-  // records through RefinementModels' format-3 models and contexts.
-  uint8_t format = 2;
+  // The stream's refinement record format (header extra[0], stream_format.h);
+  // both coders set it before the first record.
+  RefinementFormatInfo format;
 
   // Starts from a base mesh (vertices in base order). Errors as EditableMesh::build.
   static Result<RefinementState> from_base(std::vector<Vec3i> positions,

@@ -67,6 +67,12 @@ struct RefinementFormatInfo {
   uint8_t geometry_coder() const {
     return embedded ? kGeometryCoderEmbedded : kGeometryCoderRangeAverage;
   }
+  // Assigning a header byte the caller has validated (throws
+  // std::bad_optional_access for one no format has): the encoder's spelling
+  // until it holds a RefinementFormatInfo itself.
+  RefinementFormatInfo& operator=(uint8_t header_byte) {
+    return *this = from_header_byte(header_byte).value();
+  }
   // The format of header byte extra[0]; nullopt for a byte no format has.
   static constexpr std::optional<RefinementFormatInfo> from_header_byte(uint8_t byte) {
     switch (byte) {
@@ -86,6 +92,11 @@ struct RefinementFormatInfo {
 // the base positions left to plane records); it must also stay below the
 // stream's quantization bits.
 inline constexpr int kMaxBaseShift = 12;
+
+// The largest valence of a vertex a structure record inserts (the decoder
+// refuses larger ones); the encoder removes no vertex of higher valence
+// (decimate.h's kMaxRemovalValence must not exceed it).
+inline constexpr uint32_t kMaxInsertedValence = 16;
 
 // Flags: the first payload byte of a refinement record. A structure record
 // has 0 or kRecordStartsLayer, a plane record exactly kRecordPlane.

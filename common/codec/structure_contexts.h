@@ -22,21 +22,19 @@ inline uint32_t count_context(const RefinementState& s, uint32_t u, uint32_t fre
 }
 
 // Format 3's model of the patch count: count_context's, adapting by
-// BitModelV. (Tried and dropped, no gain over 13 meshes: whether u has
-// faces taken in this layer — never, the layers' removals are independent
-// — the count two walk steps back, and the number of u's free faces whose
-// two other vertices the walk has already visited, which only a patch at u
-// could still use.)
-inline BitTreeModel<2, BitModelV>& count_model3(RefinementState& s, uint32_t u,
-                                                uint32_t free_faces) {
+// FastStartBitModel (other contexts tried: docs/hcs-format.md, "Entropy
+// coder").
+inline BitTreeModel<2, FastStartBitModel>& fast_start_count_model(RefinementState& s, uint32_t u,
+                                                                  uint32_t free_faces) {
   return s.models.patch_count3[count_context(s, u, free_faces)];
 }
 
 // Format 3's model of k - 3 for a patch at apex u: by u's ring size (as
 // format 2) and the free faces of u left for it (min 7; k - 2 of them
 // become the fan, after the patches already read at u).
-inline BitTreeModel<4, BitModelV>& valence_model3(RefinementState& s, uint32_t ring_size,
-                                                  uint32_t free_left) {
+inline BitTreeModel<4, FastStartBitModel>& fast_start_valence_model(RefinementState& s,
+                                                                    uint32_t ring_size,
+                                                                    uint32_t free_left) {
   return s.models.valence3[std::min(ring_size, 12u) * 8 + std::min<uint32_t>(free_left, 7)];
 }
 

@@ -13,10 +13,10 @@ void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint3
   }
 }
 
-void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context, size_t candidates,
-                        uint32_t rank) {
+void encode_start_rank_in_context(RefinementModels& m, RangeEncoder& enc, uint32_t context,
+                                  size_t candidates, uint32_t rank) {
   if (candidates <= 1) return;
-  BitTreeModel<4, BitModelV>& tree = m.start_rank3[context];
+  BitTreeModel<4, FastStartBitModel>& tree = m.start_rank3[context];
   if (rank < 15) {
     tree.encode(enc, rank);
   } else {

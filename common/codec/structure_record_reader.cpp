@@ -24,11 +24,10 @@ Status bad(const std::string& what) { return make_error(ErrorCode::kCorrupt, wha
 // then the rank is read (nothing for a single candidate) and its start
 // picked, the best by a linear scan. kNone when the rank is out of range.
 template <class DecodeRank>
-MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, uint32_t apex,
-                                                      const std::vector<uint32_t>& star_ring,
-                                                      const std::vector<uint8_t>& used, uint32_t k,
-                                                      StartScratch& scratch,
-                                                      DecodeRank&& decode_rank, uint32_t& rank) {
+MESHSTREAM_DECODE_INLINE uint32_t score_then_select_patch_start(
+    const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
+    const std::vector<uint8_t>& used, uint32_t k, StartScratch& scratch, DecodeRank&& decode_rank,
+    uint32_t& rank) {
   scratch.prepare(static_cast<uint32_t>(used.size()));
   const size_t n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
   const uint32_t* starts = scratch.start;
@@ -59,9 +58,18 @@ MESHSTREAM_DECODE_INLINE uint32_t select_patch_start3(const EditableMesh& mesh, 
 }  // namespace
 
 // The range-coded block of a structure record, after its header: one
-// instance per model family (V: format 3's models), so the decoding loop,
-// inlined whole, holds no per-symbol format branches.
-template <bool V>
+// instance per model family (kFastStartModels: format 3's models and
+// contexts, RefinementFormatInfo::fast_start_structure_models), so the
+// decoding loop, inlined whole, holds no per-symbol format branches.
+// One function of 160 lines on purpose: its phases per walk step are the
+// next walk vertex, its patch count, its star (prefetched), each patch
+// (valence, start rank, open edge, residual), then applying them. As
+// forced-inline functions (next_walk_vertex, decode_patch_count,
+// load_star, decode_patch) the same code measured 2.9-3.7 % more decoder
+// instructions (callgrind, dragon_res2: 458.7 M -> 471.9 M with decode_patch
+// returning a bool, 475.5 M with a Status), so the phases stay marked by
+// the comments inside.
+template <bool kFastStartModels>
 Status decode_structure_block(RefinementState& state, std::span<const uint8_t> block,
                               const RecordHeader& h, uint32_t expected_vertices,
                               uint32_t expected_faces, AppliedRecord& applied) {
@@ -101,8 +109,8 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
     const uint32_t free_faces = free_face_count(state, u);
     uint32_t count = 0;
     if (free_faces > 0) {
-      if constexpr (V) {
-        count = count_model3(state, u, free_faces).decode(dec);
+      if constexpr (kFastStartModels) {
+        count = fast_start_count_model(state, u, free_faces).decode(dec);
         if (count == 3) count += m.patch_count_extra3.decode(dec);
       } else {
         count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
@@ -150,23 +158,23 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
     uint32_t free_left = free_faces;
     for (uint32_t i = 0; i < count; ++i) {
       uint32_t k;
-      if constexpr (V) {
-        k = valence_model3(state, ring_size, free_left).decode(dec) + 3;
+      if constexpr (kFastStartModels) {
+        k = fast_start_valence_model(state, ring_size, free_left).decode(dec) + 3;
       } else {
         k = m.valence[std::min(ring_size, 12u)].decode(dec) + 3;
       }
       uint32_t rank = 0, r = kNone;
-      if constexpr (!V) {
+      if constexpr (!kFastStartModels) {
         // The rank depends only on k, so it is read first: the decoder then
         // needs only the start of that rank, most often the best one (a
         // linear scan), not the whole ordered list the encoder searches.
         rank = decode_start_rank_inline(m, dec, k);
         r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
       } else {
-        r = select_patch_start3(
+        r = score_then_select_patch_start(
             mesh, u, star_ring, used_faces, k, start_scratch,
             [&](uint32_t context) __attribute__((always_inline)) {
-              return decode_start_rank_inline3(m, dec, context);
+              return decode_start_rank_in_context_inline(m, dec, context);
             },
             rank);
       }
@@ -185,7 +193,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
       patch_boundary_edges(mesh, patches[i], open_edges);
       if (!open_edges.empty()) {
         uint32_t choice;
-        if constexpr (V) {
+        if constexpr (kFastStartModels) {
           choice = m.open_edge3.decode(dec);
         } else {
           choice = m.open_edge.decode(dec);
@@ -248,7 +256,7 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
   if (!get_varint(payload, pos, h.walk_steps) || !get_varint(payload, pos, h.insertions)) {
     return bad("refinement record header is cut short or malformed");
   }
-  if (state.format >= 2) {
+  if (state.format.embedded) {
     if (!get_varint(payload, pos, h.min_shift))
       return bad("refinement record header is cut short or malformed");
     if (h.min_shift > kMaxShift)
@@ -273,11 +281,11 @@ Status apply_refinement_record(RefinementState& state, std::span<const uint8_t> 
     return bad("first refinement record does not start a layer");
   }
 
-  state.models.v_models = state.format >= 3;
   const std::span<const uint8_t> block = payload.subspan(pos);
-  return state.models.v_models ? decode_structure_block<true>(state, block, h, expected_vertices,
-                                                              expected_faces, applied)
-                               : decode_structure_block<false>(state, block, h, expected_vertices,
-                                                               expected_faces, applied);
+  return state.format.fast_start_structure_models
+             ? decode_structure_block<true>(state, block, h, expected_vertices, expected_faces,
+                                            applied)
+             : decode_structure_block<false>(state, block, h, expected_vertices, expected_faces,
+                                             applied);
 }
 }  // namespace meshstream

@@ -70,14 +70,14 @@ TEST(RangeDecoderNormalize, BitModelStaysInBoundAndDecodes) {
 }
 
 TEST(RangeDecoderNormalize, BitModelVStaysInBoundAndDecodes) {
-  check_bound_and_round_trip<BitModelV>();
+  check_bound_and_round_trip<FastStartBitModel>();
 }
 
-// Every state a BitModelV can reach from its start, by exhaustive search
+// Every state a FastStartBitModel can reach from its start, by exhaustive search
 // over the (probability, count) pairs: the bound holds for all of them.
 TEST(RangeDecoderNormalize, EveryReachableBitModelVStateIsInBound) {
   std::vector<uint8_t> seen(1u << 16, 0);
-  std::vector<uint16_t> todo = {BitModelV{}.state};
+  std::vector<uint16_t> todo = {FastStartBitModel{}.state};
   seen[todo[0]] = 1;
   size_t reached = 0;
   while (!todo.empty()) {
@@ -86,7 +86,7 @@ TEST(RangeDecoderNormalize, EveryReachableBitModelVStateIsInBound) {
     ++reached;
     ASSERT_GE(s & 2047u, kMinP) << "state " << s;
     ASSERT_LE(s & 2047u, kMaxP) << "state " << s;
-    for (uint16_t next : {bit_model_after0(s), bit_model_after1(s)}) {
+    for (uint16_t next : {fast_start_after0(s), fast_start_after1(s)}) {
       if (!seen[next]) {
         seen[next] = 1;
         todo.push_back(next);

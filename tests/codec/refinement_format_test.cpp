@@ -1,13 +1,14 @@
 // Refinement format 3 (faster-learning models, finer valence and rank
 // contexts) against format 2, which the encoder still writes on request:
 // both decode to the quantized input exactly, carry their format in the
-// header, and differ in bytes; an unknown format is refused. BitModelV's
+// header, and differ in bytes; an unknown format is refused. FastStartBitModel's
 // schedule is checked against the coder it replaces.
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "common/codec/container.h"
+#include "common/codec/decimate.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/codec/range_coder.h"
@@ -60,23 +61,23 @@ TEST(RefinementFormat, DefaultIsFormat3AndUnknownFormatsAreRefused) {
   }
 }
 
-// Random skewed bits through BitModelV and BitModel trees round-trip, and
-// BitModelV adapts as documented: 1/4 of the error for the first two bits,
+// Random skewed bits through FastStartBitModel and BitModel trees round-trip, and
+// FastStartBitModel adapts as documented: 1/4 of the error for the first two bits,
 // then 1/8, 1/16, and 1/32 (BitModel's rate) from the 14th bit on.
 TEST(RefinementFormat, BitModelVRoundTripsAndFollowsItsSchedule) {
-  EXPECT_EQ(bit_model_rate(0), 2u);
-  EXPECT_EQ(bit_model_rate(1), 2u);
-  EXPECT_EQ(bit_model_rate(2), 3u);
-  EXPECT_EQ(bit_model_rate(5), 3u);
-  EXPECT_EQ(bit_model_rate(6), 4u);
-  EXPECT_EQ(bit_model_rate(13), 4u);
-  EXPECT_EQ(bit_model_rate(14), 5u);
-  BitModelV m;
-  m.state = bit_model_next(m.state, 0);
+  EXPECT_EQ(fast_start_rate(0), 2u);
+  EXPECT_EQ(fast_start_rate(1), 2u);
+  EXPECT_EQ(fast_start_rate(2), 3u);
+  EXPECT_EQ(fast_start_rate(5), 3u);
+  EXPECT_EQ(fast_start_rate(6), 4u);
+  EXPECT_EQ(fast_start_rate(13), 4u);
+  EXPECT_EQ(fast_start_rate(14), 5u);
+  FastStartBitModel m;
+  m.state = fast_start_next(m.state, 0);
   EXPECT_EQ(m.state & 2047u, 1024u + 256u);
-  EXPECT_EQ(m.state >> kBitModelVSeenShift, 1u);
-  for (int i = 0; i < 40; ++i) m.state = bit_model_next(m.state, 1);
-  EXPECT_EQ(m.state >> kBitModelVSeenShift, kBitModelVSeenMax);
+  EXPECT_EQ(m.state >> kFastStartSeenShift, 1u);
+  for (int i = 0; i < 40; ++i) m.state = fast_start_next(m.state, 1);
+  EXPECT_EQ(m.state >> kFastStartSeenShift, kFastStartSeenMax);
   EXPECT_GT(m.state & 2047u, 0u);
   EXPECT_LT(m.state & 2047u, 200u);
 
@@ -85,9 +86,9 @@ TEST(RefinementFormat, BitModelVRoundTripsAndFollowsItsSchedule) {
   for (uint32_t& s : symbols)
     s = std::min<uint32_t>(15, std::geometric_distribution<uint32_t>(0.4)(rng));
   RangeEncoder enc;
-  BitTreeModel<4, BitModelV> tree_v[3];
+  BitTreeModel<4, FastStartBitModel> tree_v[3];
   BitTreeModel<4> tree[3];
-  AdaptiveIntModelV ints;
+  FastStartIntModel ints;
   for (size_t i = 0; i < symbols.size(); ++i) {
     tree_v[i % 3].encode(enc, symbols[i]);
     tree[i % 3].encode(enc, symbols[i]);
@@ -95,9 +96,9 @@ TEST(RefinementFormat, BitModelVRoundTripsAndFollowsItsSchedule) {
   }
   const std::vector<uint8_t> bytes = enc.finish();
   RangeDecoder dec(bytes);
-  BitTreeModel<4, BitModelV> dtree_v[3];
+  BitTreeModel<4, FastStartBitModel> dtree_v[3];
   BitTreeModel<4> dtree[3];
-  AdaptiveIntModelV dints;
+  FastStartIntModel dints;
   for (size_t i = 0; i < symbols.size(); ++i) {
     ASSERT_EQ(dtree_v[i % 3].decode(dec), symbols[i]) << i;
     ASSERT_EQ(dtree[i % 3].decode(dec), symbols[i]) << i;
@@ -105,6 +106,12 @@ TEST(RefinementFormat, BitModelVRoundTripsAndFollowsItsSchedule) {
   }
   EXPECT_FALSE(dec.exhausted_badly());
 }
+
+// The decoder's valence limit is the format's (stream_format.h), no longer
+// decimate.h's; the encoder must stay within it or its streams would not
+// decode.
+static_assert(kMaxRemovalValence <= kMaxInsertedValence,
+              "the encoder would remove vertices the decoder cannot insert");
 
 }  // namespace
 }  // namespace meshstream
