@@ -291,7 +291,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   auto state = RefinementState::from_coarse_base(base.decoded.positions, base.decoded.faces, bits,
                                                  base_shift);
   if (!state) return tl::unexpected(state.error());
-  state->format = format.header_byte();
+  state->format = format;
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
   const uint32_t base_faces = static_cast<uint32_t>(base.decoded.faces.size());
 

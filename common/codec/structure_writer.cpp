@@ -53,7 +53,7 @@ Status StructureWriter::write_record(uint32_t target, int min_shift, WrittenReco
   }
   out = WrittenRecord{};
   write_record_header({starts_layer_, walk_steps, insertions, uint32_t(min_shift)}, out.payload,
-                      format_.header_byte());
+                      format_);
   starts_layer_ = false;
   std::vector<uint8_t> coded = enc.finish();
   out.payload.insert(out.payload.end(), coded.begin(), coded.end());
@@ -111,7 +111,7 @@ Status StructureWriter::code_patch_count(RangeEncoder& enc, uint32_t u, uint32_t
       enc.set_cost_sink(&bits_->count);
     }
     if (m.v_models) {
-      count_model3(s_, u, free_faces).encode(enc, std::min(count, 3u));
+      fast_start_count_model(s_, u, free_faces).encode(enc, std::min(count, 3u));
       if (count >= 3) m.patch_count_extra3.encode(enc, count - 3);
     } else {
       m.patch_count[count_context(s_, u, free_faces)].encode(enc, std::min(count, 3u));
@@ -138,7 +138,7 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
     enc.set_cost_sink(&bits_->valence);
   }
   if (m.v_models) {
-    valence_model3(s_, ring_size, free_left).encode(enc, k - 3);
+    fast_start_valence_model(s_, ring_size, free_left).encode(enc, k - 3);
   } else {
     m.valence[std::min(ring_size, 12u)].encode(enc, k - 3);
   }
@@ -154,8 +154,8 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   const uint32_t rank = static_cast<uint32_t>(it - candidates_.begin());
   if (format_.fast_start_structure_models) {
     const size_t c = candidates_.size();
-    encode_start_rank3(m, enc, start_rank_context(k, c, scores_[0], c > 1 ? scores_[1] : -1), c,
-                       rank);
+    encode_start_rank_in_context(
+        m, enc, start_rank_context(k, c, scores_[0], c > 1 ? scores_[1] : -1), c, rank);
   } else {
     encode_start_rank(m, enc, k, rank);
   }
