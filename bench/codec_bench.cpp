@@ -318,7 +318,7 @@ int main(int argc, char** argv) {
   app.add_option("--mesh-dir", settings.mesh_dir, "folder of the test meshes");
   app.add_option("--samples", settings.samples, "area samples per direction for distances");
   app.add_option("--base-shift", settings.encode.base_shift,
-                 "EncodeOptions::base_shift (-1 automatic)");
+                 "EncodeOptions::base_shift (default automatic)");
   app.add_option("--base-vertices", settings.encode.target_base_vertices,
                  "EncodeOptions::target_base_vertices");
   app.add_option("--record-bytes", settings.encode.record_bytes,

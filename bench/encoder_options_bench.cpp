@@ -75,13 +75,13 @@ std::vector<Variant> all_variants() {
       [](EncodeOptions& o) { o.plane_calibration = 3; });
   add("surface-1", "surface-distance estimate, plane balance 1 (no measured choice)",
       [](EncodeOptions& o) {
-        o.distortion_estimate = 2;
+        o.distortion_estimate = DistortionEstimate::kSurfaceDistance;
         o.plane_calibration = 1;
       });
   add("displacement-auto",
       "displacement estimate, balance 1 or 3 by measurement (the encoder before the surface "
       "estimate)",
-      [](EncodeOptions& o) { o.distortion_estimate = 1; });
+      [](EncodeOptions& o) { o.distortion_estimate = DistortionEstimate::kDisplacement; });
   add("issue-1-order", "no bit planes: every position exact at insertion",
       [](EncodeOptions& o) { o.embedded = false; });
   return v;

@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
     for (int f = 0; f < 2; ++f) {
       EncodeOptions options;
       if (fixed) options.plane_calibration = 3.0;
-      options.refinement_format = f == 0 ? kRefinementFormatEmbedded : kRefinementFormat;
+      options.refinement_format =
+          f == 0 ? RefinementFormat::kEmbedded : RefinementFormat::kEmbeddedFastStart;
       EncodeReport report;
       auto stream = encode_hcs(imported->mesh, options, &report);
       if (!stream) {

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "common/codec/encoder.h"
+
 namespace meshstream::bench {
 
 // One point of a rate-distortion curve: a mesh a client can show after
@@ -51,11 +53,12 @@ struct MeshMeasurements {
 
   // Embedded stream details (issue 5).
   uint64_t ours_structure_bytes = 0, ours_plane_bytes = 0, ours_plane_raw_bytes = 0;
-  uint64_t ours_plane_plain_bytes = 0;  // the plane bits through issue I's kind of coder
+  uint64_t ours_plane_plain_bytes = 0;  // the plane bits through a plain coder (EncodeReport)
   uint32_t ours_plane_records = 0;
   uint64_t ours_largest_record = 0;  // beyond the base
   uint32_t ours_base_shift = 0;
-  int ours_distortion_estimate = 0;  // the ordering the encoder's measured choice kept (1 or 2)
+  // The ordering the encoder's measured choice kept.
+  DistortionEstimate ours_distortion_estimate = DistortionEstimate::kAutomatic;
   // Prefix equals the encoder's model at every record boundary (hashes).
   bool ours_model_matches = false;
   // RMS along the measured curve: the largest rise between consecutive

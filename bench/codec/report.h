@@ -148,9 +148,9 @@ inline void write_markdown(const std::filesystem::path& path,
        << std::min<uint32_t>(m.vertices / 50, 200) + 1 << " | "
        << fmt("%.2f %%", 100.0 * m.ours_largest_record / m.ours_bytes) << " | " << m.ours_base_shift
        << " | "
-       << (m.ours_distortion_estimate == 2   ? "surface"
-           : m.ours_distortion_estimate == 1 ? "displacement"
-                                             : "?")
+       << (m.ours_distortion_estimate == DistortionEstimate::kSurfaceDistance ? "surface"
+           : m.ours_distortion_estimate == DistortionEstimate::kDisplacement  ? "displacement"
+                                                                              : "?")
        << " | " << m.ours_structure_bytes << " | " << m.ours_plane_bytes << " / "
        << m.ours_plane_plain_bytes << " / " << m.ours_plane_raw_bytes << " | "
        << (m.ours_model_matches ? "matches" : "**differs**") << " | "

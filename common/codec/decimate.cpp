@@ -26,17 +26,9 @@ constexpr double kValenceWeight = 0.25;
 constexpr double kPredictionWeight = 0.05;
 constexpr double kShapeWeight = 10.0;
 
-struct Vec3l {
-  int64_t x, y, z;
-};
-Vec3l sub(Vec3i a, Vec3i b) { return {int64_t(a.x) - b.x, int64_t(a.y) - b.y, int64_t(a.z) - b.z}; }
-Vec3l cross_l(Vec3l a, Vec3l b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-double dot_d(Vec3l a, Vec3d b) { return double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z; }
-double norm_l(Vec3l a) {
-  return std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
-}
+// Edge vectors and their cross products in 64 bits: exact for 20-bit grids.
+Vec3l sub(Vec3i a, Vec3i b) { return vec3_cast<int64_t>(a) - vec3_cast<int64_t>(b); }
+double norm(Vec3l a) { return length(vec3_cast<double>(a)); }
 
 // Plane quadric (Garland & Heckbert 1997): sum of w (n.p + d)^2 over planes,
 // in grid units; `weight` is the summed plane weight (area).
@@ -97,17 +89,17 @@ class LayerBuilder {
     for (uint32_t f = 0; f < m_.face_slot_count(); ++f) {
       if (m_.face_dead(f)) continue;
       const Triangle& t = m_.faces()[f];
-      const Vec3l n = cross_l(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
-      const double len = norm_l(n);
+      const Vec3l n = cross(sub(p[t[1]], p[t[0]]), sub(p[t[2]], p[t[0]]));
+      const double len = norm(n);
       if (len == 0) continue;
-      const Vec3d u{n.x / len, n.y / len, n.z / len};
-      const Vec3d p0{double(p[t[0]].x), double(p[t[0]].y), double(p[t[0]].z)};
+      const Vec3d u = vec3_cast<double>(n) / len;
+      const Vec3d p0 = to_double(p[t[0]]);
       for (uint32_t v : t) quadrics[v].add_plane(u, -dot(u, p0), 0.5 * len);
       for (int i = 0; i < 3; ++i) {
         if (m_.opposite(3 * f + i) != kNone) continue;
         const uint32_t a = t[(i + 1) % 3], b = t[(i + 2) % 3];
-        const Vec3d pa{double(p[a].x), double(p[a].y), double(p[a].z)};
-        const Vec3d e = Vec3d{double(p[b].x), double(p[b].y), double(p[b].z)} - pa;
+        const Vec3d pa = to_double(p[a]);
+        const Vec3d e = to_double(p[b]) - pa;
         const Vec3d side = normalized(cross(e, u));
         const double w = 2.0 * dot(e, e);
         quadrics[a].add_plane(side, -dot(side, pa), w);
@@ -129,9 +121,9 @@ class LayerBuilder {
     const size_t k = ring_.size();
     const auto& p = m_.positions();
     Vec3d centroid{};
-    for (uint32_t r : ring_) centroid += Vec3d{double(p[r].x), double(p[r].y), double(p[r].z)};
+    for (uint32_t r : ring_) centroid += to_double(p[r]);
     centroid = centroid / double(k);
-    const Vec3d d = Vec3d{double(p[v].x), double(p[v].y), double(p[v].z)} - centroid;
+    const Vec3d d = to_double(p[v]) - centroid;
     // The squared distance times the area it spreads over (the quadric's
     // plane weight: original area now represented around v), relative to
     // the mean star: a removal's share of the squared surface RMS. The
@@ -159,13 +151,11 @@ class LayerBuilder {
         return kNone;
     }
     Vec3l star_normal{0, 0, 0};
-    for (uint32_t i = 0; i < corners_.size(); ++i) {
-      Vec3l n = cross_l(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
-      star_normal = {star_normal.x + n.x, star_normal.y + n.y, star_normal.z + n.z};
-    }
-    const double snl = norm_l(star_normal);
+    for (uint32_t i = 0; i < corners_.size(); ++i)
+      star_normal += cross(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
+    const double snl = norm(star_normal);
     if (snl == 0) return kNone;
-    const Vec3d sn{star_normal.x / snl, star_normal.y / snl, star_normal.z / snl};
+    const Vec3d sn = vec3_cast<double>(star_normal) / snl;
 
     double best_quality = -1;
     uint32_t best_apex = kNone;
@@ -175,20 +165,19 @@ class LayerBuilder {
       double worst = 1e300;
       for (uint32_t j = 1; j + 1 < k && ok; ++j) {
         const Vec3i A = p[apex], B = p[ring_[(a + j) % k]], C = p[ring_[(a + j + 1) % k]];
-        const Vec3l n = cross_l(sub(B, A), sub(C, A));
-        const double area2 = norm_l(n);
+        const Vec3l n = cross(sub(B, A), sub(C, A));
+        const double area2 = norm(n);
         if (area2 == 0) {
           ok = false;
           break;
         }
-        if (dot_d(n, sn) <= kMinFanCosine * area2) {
+        if (dot(vec3_cast<double>(n), sn) <= kMinFanCosine * area2) {
           ok = false;
           break;
         }
-        const Vec3l e0 = sub(B, A), e1 = sub(C, B), e2 = sub(A, C);
-        const double s = double(e0.x) * e0.x + double(e0.y) * e0.y + double(e0.z) * e0.z +
-                         double(e1.x) * e1.x + double(e1.y) * e1.y + double(e1.z) * e1.z +
-                         double(e2.x) * e2.x + double(e2.y) * e2.y + double(e2.z) * e2.z;
+        // Squared edge lengths: integers below 2^53, so exact in any order.
+        const double s = squared_length(to_double(B - A)) + squared_length(to_double(C - B)) +
+                         squared_length(to_double(A - C));
         worst = std::min(worst, area2 / s);  // 2*sqrt(3)*this = 1 for equilateral
       }
       if (!ok) continue;

@@ -65,17 +65,8 @@ struct DecimateOptions {
   uint32_t max_layers = 200;
   // The base keeps at most this share of the vertices (never fewer than
   // kMinBaseTarget; 0 or >= 1: off), so a small mesh's base does not
-  // outweigh its first refinements. Measured (bench/decimation_bench): 1/16
-  // changes only hemisphere.off (1 861 vertices: base 300 -> 116), whose
-  // 300-vertex base with header and index (1.3 KB) exceeds the LOD chain's
-  // whole 1/16 point (834 bytes): that point goes from lost to 0.88 x the
-  // chain's RMS, nothing else moves. 1/64 and 1/128 were worse (fandisk,
-  // casting at 1/16: coarse layers cost more bits a vertex than the base).
-  // Off, and not an EncodeOptions setting: measured again with the 8-bit
-  // base and the surface-distance ordering (bench/encoder_options_bench,
-  // 1/64 to 1/16), no share brought a lost 1/64 point within budget, since
-  // header and record index alone (275-300 bytes on those meshes) take
-  // most of it; at 1/16 and 1/4 the results were mixed.
+  // outweigh its first refinements. Off, and not an EncodeOptions setting:
+  // no share paid on the real meshes (docs/hcs-format.md, "Layers").
   double max_base_share = 0;
 };
 

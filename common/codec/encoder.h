@@ -1,12 +1,14 @@
 // Encoding a mesh into one progressive `.hcs` stream (container.h for the
-// layout): quantize, decimate layer by layer, code the base mesh with Draco,
-// then refinement records from coarse to fine. An embedded stream (the
-// default) also sends positions by successive approximation (bit planes,
-// embedded_geometry.h) and orders structure and plane records by estimated
-// distortion decrease per byte (docs/hcs-format.md).
+// layout): quantize, decimate layer by layer (decimate.h), code the base mesh
+// (base_choice.h), then refinement records from coarse to fine. An embedded
+// stream (the default) also sends positions by successive approximation (bit
+// planes, embedded_geometry.h) and orders structure and plane records by
+// estimated distortion decrease per byte (record_schedule.h,
+// docs/hcs-format.md).
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "common/base/result.h"
@@ -14,6 +16,16 @@
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
+
+// How a vertex's error enters the record ordering's distortion estimate
+// (distortion_estimate.h). The numbers are what the benchmarks print.
+enum class DistortionEstimate : uint8_t {
+  // Automatic balance: measured among the candidates (kOrderingCandidates);
+  // a fixed balance: displacement.
+  kAutomatic = 0,
+  kDisplacement = 1,     // the displacement from its true position
+  kSurfaceDistance = 2,  // the squared distance to the original surface
+};
 
 struct EncodeOptions {
   int quant_bits = 12;                  // 8..20, grid over the bounding box
@@ -23,56 +35,54 @@ struct EncodeOptions {
   // of the stream; re-encoded with smaller records when missed).
   uint32_t record_bytes = 0;
   bool allow_draco_base = true;  // false: always the own base coder (tests)
-  // true: successive-approximation positions and rate-distortion ordering
-  // (issue II). false: issue I's ordering, every position exact at
-  // insertion, no plane records (kept as a peer for the benchmark).
+  // true: successive-approximation positions (plane records send their low
+  // bits later) and records ordered by estimated distortion drop per byte.
+  // false: no bit planes: every position exact when its vertex arrives,
+  // structure records only, in decimation order (the peer the benchmarks
+  // compare against; `meshstream encode --no-bit-planes`).
   bool embedded = true;
-  // Low bits of the base positions sent later as plane records; -1 =
-  // automatic (quant_bits - 8: an 8-bit base; bench/encoder_options_bench
-  // on the 13 real meshes, after container 3's small index, scores shift 4
-  // best of 0 and 2..6 at 12 bits). Embedded only.
-  int base_shift = -1;
+  // Low bits of the base positions sent later as plane records, 0 ..
+  // kMaxBaseShift (else kInvalidArgument) and at most quant_bits - 1;
+  // empty = automatic: quant_bits - 8, an 8-bit base (docs/hcs-format.md).
+  // Embedded only.
+  std::optional<int> base_shift;
   // How much the record ordering's distortion estimate values plane
-  // records against structure records (encoder.cpp). 0 = automatic: the
+  // records against structure records (record_schedule.h). 0 = automatic: the
   // streams of the kOrderingCandidates are decoded at log-spaced budgets and
   // the one with the smallest measured surface distance to the original
   // wins (rd_measure.h; one encode and 5 distance measurements a candidate).
   // A fixed balance encodes once. Embedded only.
   double plane_calibration = 0;
-  // How a vertex's error enters that estimate: 0 = as chosen (automatic:
-  // measured among the candidates; fixed balance: displacement),
-  // 1 = displacement from its true position, 2 = squared distance to the
-  // original surface. Embedded only; anything else is kInvalidArgument.
-  int distortion_estimate = 0;
+  // How a vertex's error enters that estimate. Embedded only; a value
+  // outside the enum is kInvalidArgument.
+  DistortionEstimate distortion_estimate = DistortionEstimate::kAutomatic;
   // Low residual bits of inserted vertices left to plane records (at least;
-  // a vertex is never sharper than its ring). Embedded only. 1-8 measured
-  // worse than 0 on every mesh tried (more plane records and index entries,
-  // see docs/hcs-format.md); kept for experiments.
+  // a vertex is never sharper than its ring). Embedded only; 0 measured best
+  // (docs/hcs-format.md, "Record order and size"), the others are kept for
+  // experiments.
   int insertion_shift = 0;
   // Threads for the automatic ordering's candidates: 0 = as many as help
   // (one a candidate, when the machine has more than one core), 1 = one
   // after the other. The stream is the same either way.
   uint32_t threads = 0;
-  // Refinement record format written: 0 = kRefinementFormat (3); 2 =
-  // format 2's models, kept as the peer benchmarks compare against (same
-  // records, slower-learning models). Anything else is kInvalidArgument.
-  int refinement_format = 0;
+  // Refinement record format written: kEmbeddedFastStart (what decoders
+  // expect today) or kEmbedded (format 2's models, kept as the peer
+  // benchmarks compare against: same records, slower-learning models).
+  // kExactInsertion and anything else is kInvalidArgument.
+  RefinementFormat refinement_format = RefinementFormat::kEmbeddedFastStart;
 };
 
-// The record orderings the automatic choice tries (EncodeOptions), the
-// first is encoded first. Measured on the 13 real meshes
-// (bench/encoder_options_bench, bench/report/codec.md): the surface-distance
-// estimate is kept for 8, among them every CAD part, where vertices slide
-// within flat faces and displacement overvalues new vertices (fandisk at
-// the LOD chain's 1/16 point: 3.7 -> 1.1 x the chain's RMS); displacement
-// for 5 scans (skull: 0.86 against 1.09 at the 1/64 point). Balance 3, the
-// earlier choice's other candidate, no longer won with these two; balances
-// 0.5 and 2 did not pay either.
+// The record orderings the automatic choice tries (EncodeOptions): each
+// candidate's stream is measured and the best kept; the first is encoded
+// first and settles the record size. Why these two (the surface distance
+// wins on CAD parts, displacement on some scans) and which balances were
+// dropped: docs/hcs-format.md, "Record order and size".
 struct RecordOrdering {
   double plane_calibration;
-  int distortion_estimate;  // 1 or 2, as EncodeOptions
+  DistortionEstimate distortion_estimate;  // kDisplacement or kSurfaceDistance
 };
-inline constexpr RecordOrdering kOrderingCandidates[] = {{1.0, 1}, {1.0, 2}};
+inline constexpr RecordOrdering kOrderingCandidates[] = {
+    {1.0, DistortionEstimate::kDisplacement}, {1.0, DistortionEstimate::kSurfaceDistance}};
 
 // What the encoder assumed about each record (tests and the benchmark).
 struct EncodedRecord {
@@ -106,7 +116,7 @@ struct EncodeReport {
   StructureBits structure_bits;
   uint64_t plane_bits_raw = 0;     // plane bits and signs, uncoded (one bit each)
   uint64_t plane_bytes_coded = 0;  // their context-coded payload (range-coded blocks)
-  // The same bits through issue I's kind of coder, for comparison: adaptive
+  // The same bits through a plain coder, for comparison: adaptive
   // binary models by plane only (no axis role, significance or neighbour
   // contexts), one block per record.
   uint64_t plane_bytes_plain = 0;
@@ -114,11 +124,12 @@ struct EncodeReport {
   uint32_t base_shift = 0;
   // The record ordering the stream was written with (the measured choice's
   // winner when automatic).
-  RecordOrdering ordering{0, 0};
+  RecordOrdering ordering{0, DistortionEstimate::kAutomatic};
 };
 
 // Encodes a clean manifold mesh (see import.h). kInvalidArgument for bad
-// options, kNonManifold / kInvalidMesh for a mesh the codec cannot take.
+// options, kNonManifold / kInvalidMesh for a mesh the codec cannot take;
+// kInternal is a bug of the encoder (its replay of the decoder disagreed).
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options = {});
 // The same, also filling `report` (costs O(vertices) per record for the hashes).
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options,

@@ -12,15 +12,9 @@
 
 #include "common/base/result.h"
 #include "common/mesh/mesh.h"
+#include "common/mesh/vec.h"  // Vec3i: grid points
 
 namespace meshstream {
-
-struct Vec3i {
-  int32_t x = 0, y = 0, z = 0;
-  int32_t& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
-  int32_t operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
-  friend bool operator==(const Vec3i&, const Vec3i&) = default;
-};
 
 struct QuantGrid {
   BoundingBox bounds;  // as stored in the stream header (floats)

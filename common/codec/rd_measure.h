@@ -1,15 +1,15 @@
 // Measured rate-distortion of an encoded stream: the surface distance of
-// its decoded prefixes to the original (issue 5: the encoder's ordering is
-// judged by the surface distance to the original, not by its proxy alone).
+// its decoded prefixes to the original, by which the encoder judges its
+// record orderings (not by its proxy alone).
 //
 // The encoder's record ordering uses a per-vertex distortion proxy (fast,
-// local, see encoder.cpp) whose balance between structure records (new
+// local, see distortion_estimate.h) whose balance between structure records (new
 // vertices) and plane records (sharper positions) depends on the mesh: a
 // CAD part and a scan want different mixes. The encoder therefore encodes a
 // few balances, decodes each stream at log-spaced byte budgets, measures the
 // symmetric RMS surface distance of every decoded prefix to the original and
 // keeps the stream with the lowest mean log RMS: the area under its
-// log-bytes / log-RMS curve, the plot issue 5 judges.
+// log-bytes / log-RMS curve, the plot the codec benchmark draws.
 #pragma once
 
 #include <cstdint>

@@ -31,6 +31,10 @@ using Vec2f = Vec2<float>;
 using Vec3f = Vec3<float>;
 using Vec4f = Vec4<float>;
 using Vec3d = Vec3<double>;
+// Integer grid points (the codec's quantized positions) and their exact
+// products (cross products of grid differences need 64 bits).
+using Vec3i = Vec3<int32_t>;
+using Vec3l = Vec3<int64_t>;
 
 template <class T>
 constexpr Vec3<T> operator+(Vec3<T> a, Vec3<T> b) {
@@ -95,7 +99,15 @@ inline Vec3<T> normalized(Vec3<T> a) {
   return len > T(0) ? a / len : Vec3<T>{};
 }
 
+// The same vector in another component type (static_cast per component:
+// exact for grid points to double, widening to int64).
+template <class U, class T>
+constexpr Vec3<U> vec3_cast(Vec3<T> v) {
+  return {static_cast<U>(v.x), static_cast<U>(v.y), static_cast<U>(v.z)};
+}
+
 inline Vec3d to_double(Vec3f v) { return {v.x, v.y, v.z}; }
+inline Vec3d to_double(Vec3i v) { return vec3_cast<double>(v); }
 inline Vec3f to_float(Vec3d v) {
   return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
 }

@@ -1,4 +1,4 @@
-// Issue II on real meshes (skipped when ../shared/meshes is absent): the
+// The embedded stream on real meshes (skipped when ../shared/meshes is absent): the
 // distance to the original along the record boundaries, the granularity
 // bounds, the encoder's model at every prefix and the decoder controls.
 // The distances run on every real model; the other checks on a subset (time).

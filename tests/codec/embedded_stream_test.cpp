@@ -1,7 +1,7 @@
-// Issue II: the embedded stream. The decoder's mesh at every record boundary
-// is the encoder's model bit for bit; plane records only move vertices; the
-// granularity bounds hold; budgets pick the right boundary; issue I's
-// ordering stays available and exact.
+// The embedded stream. The decoder's mesh at every record boundary is the
+// encoder's model bit for bit; plane records only move vertices; the
+// granularity bounds hold; budgets pick the right boundary; the stream
+// without bit planes stays available and exact.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,13 +26,15 @@ TEST(EmbeddedStream, EveryPrefixEqualsTheEncoderModel) {
     ++which;
     // The automatic ordering, then each distortion estimate alone (a fixed
     // balance encodes once), with either base coder.
-    for (int estimate : {0, 1, 2})
+    for (DistortionEstimate estimate :
+         {DistortionEstimate::kAutomatic, DistortionEstimate::kDisplacement,
+          DistortionEstimate::kSurfaceDistance})
       for (bool draco : {true, false}) {
         SCOPED_TRACE("mesh " + std::to_string(which) + (draco ? ", Draco base" : ", own base") +
-                     ", estimate " + std::to_string(estimate));
+                     ", estimate " + std::to_string(int(estimate)));
         EncodeOptions options;
         options.allow_draco_base = draco;
-        if (estimate != 0) {
+        if (estimate != DistortionEstimate::kAutomatic) {
           options.plane_calibration = 1;
           options.distortion_estimate = estimate;
         }
@@ -107,11 +109,44 @@ TEST(EmbeddedStream, CandidatesOnThreadsGiveTheSameStream) {
 TEST(EmbeddedStream, UnknownDistortionEstimatesAreRefused) {
   for (int estimate : {-1, 3, 100}) {
     EncodeOptions options;
-    options.distortion_estimate = estimate;
+    options.distortion_estimate = static_cast<DistortionEstimate>(estimate);
     auto refused = encode_hcs(icosphere(2), options);
     ASSERT_FALSE(refused) << estimate;
     EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
     EXPECT_NE(refused.error().message.find("distortion estimate"), std::string::npos);
+  }
+}
+
+// The base shift is automatic (quant bits - 8) unless given; a given one
+// must be 0..kMaxBaseShift and stays below the quantization bits.
+TEST(EmbeddedStream, BaseShiftIsAutomaticOrGiven) {
+  const Mesh mesh = icosphere(2);
+  auto shift_of = [&](std::optional<int> shift, int bits) -> int {
+    EncodeOptions options;
+    options.quant_bits = bits;
+    options.base_shift = shift;
+    options.plane_calibration = 1;
+    EncodeReport report;
+    auto bytes = encode_hcs(mesh, options, &report);
+    if (!bytes) return -1;
+    auto index = read_stream_index(*bytes);
+    if (!index || index->header.extra.size() < 2) return -2;
+    EXPECT_EQ(index->header.extra[1], report.base_shift);
+    return index->header.extra[1];
+  };
+  EXPECT_EQ(shift_of(std::nullopt, 12), 4);
+  EXPECT_EQ(shift_of(std::nullopt, 16), 8);
+  EXPECT_EQ(shift_of(std::nullopt, 8), 0);
+  EXPECT_EQ(shift_of(2, 12), 2);
+  EXPECT_EQ(shift_of(0, 12), 0);
+  EXPECT_EQ(shift_of(12, 10), 9);  // at most quant bits - 1
+  for (int bad : {-1, kMaxBaseShift + 1}) {
+    EncodeOptions options;
+    options.base_shift = bad;
+    auto refused = encode_hcs(mesh, options);
+    ASSERT_FALSE(refused) << bad;
+    EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
+    EXPECT_NE(refused.error().message.find("base shift"), std::string::npos);
   }
 }
 

@@ -53,7 +53,7 @@ TEST_F(RdMeasureOnDemo, AutomaticOrderingIsTheBestMeasuredCandidate) {
     ASSERT_TRUE(curve);
     EXPECT_LE(chosen_score, RdMeasure::score(*curve) + 1e-12)
         << "balance " << candidate.plane_calibration << ", estimate "
-        << candidate.distortion_estimate;
+        << int(candidate.distortion_estimate);
     equals_a_candidate = equals_a_candidate || *stream == *chosen;
   }
   EXPECT_TRUE(equals_a_candidate);

@@ -27,7 +27,7 @@ TEST(RefinementFormat, BothFormatsDecodeExactly) {
   for (int i = 0; i < 2; ++i) {
     const int format = i == 0 ? kRefinementFormatEmbedded : kRefinementFormat;
     EncodeOptions options;
-    options.refinement_format = format;
+    options.refinement_format = static_cast<RefinementFormat>(format);
     options.plane_calibration = 3.0;
     auto bytes = encode_hcs(mesh, options);
     ASSERT_TRUE(bytes) << bytes.error().message;
@@ -54,7 +54,7 @@ TEST(RefinementFormat, DefaultIsFormat3AndUnknownFormatsAreRefused) {
   EXPECT_EQ(kRefinementFormat, 3);
   for (int format : {1, 4, 255}) {
     EncodeOptions options;
-    options.refinement_format = format;
+    options.refinement_format = static_cast<RefinementFormat>(format);
     auto refused = encode_hcs(mesh, options);
     ASSERT_FALSE(refused) << format;
     EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);

@@ -9,6 +9,7 @@
 // real protoc decodes the new fields.
 #include <gtest/gtest.h>
 
+#include "common/codec/container.h"
 #include "common/codec/encoder.h"
 #include "common/codec/record_index_coder.h"
 #include "common/mesh/procedural.h"

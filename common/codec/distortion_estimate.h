@@ -1,0 +1,70 @@
+// The encoder's distortion estimate: how much closer to the original the
+// decoded mesh gets with each record, from what only the encoder knows
+// (every vertex's true position). The record schedule (record_schedule.h)
+// orders records by this estimate per byte. A vertex's error is either its
+// displacement from its true position or (with the original surface in
+// grid units) its distance to that surface; the estimate spreads it over
+// the area around the vertex (docs/hcs-format.md, "Ordering").
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/codec/quantize.h"
+#include "common/mesh/mesh.h"
+#include "common/metrics/bvh.h"
+
+namespace meshstream {
+
+// What only the encoder knows about each decoder vertex: its true position
+// (and residual against its anchor) and the weight of its error in the
+// distortion estimate; and, by input id, unit normals of the original.
+struct EncoderTruth {
+  std::vector<Vec3i> position;
+  std::vector<Vec3i> residual;
+  // Star area when the vertex got its geometry x sqrt(vertex count then):
+  // the area its error spreads over shrinks as the mesh refines around it;
+  // area(now) ~ weight / sqrt(vertices now) measured better than 1 / n
+  // (refinement is not uniform: flat regions stay coarse) or no decay.
+  std::vector<double> weight;
+  std::vector<Vec3f> input_normal;  // by input id
+  // The original surface in grid units; when set, a vertex's error is its
+  // distance to that surface instead of its displacement from its truth.
+  const TriangleBvh* surface = nullptr;
+  // Per vertex, the surface errors of the last two positions asked about
+  // (a group's next plane is evaluated again when the group grows, and its
+  // "after" becomes the next evaluation's "before"), and the triangle found
+  // last, which starts the next search nearby.
+  struct CachedError {
+    Vec3i position[2];
+    double error2[2] = {-1, -1};
+    uint32_t triangle = TriangleBvh::kNoHint;
+  };
+  std::vector<CachedError> cached;
+};
+
+// Squared error of a displaced vertex for the distortion estimate. The
+// whole vector counts: weighting tangential slip down (it mostly slides the
+// surface within itself) measured worse on CAD meshes, where a vertex on a
+// crease slides across the other face.
+double displacement_error2(Vec3i recon, Vec3i truth);
+
+// Decoder vertex v's squared error when shown at `recon`: its distance to
+// the original surface, or (no surface) its displacement from its true
+// position. Surface answers are remembered (EncoderTruth::cached), so `t`
+// changes. Precondition: v < t.position.size(). Cost: one closest-point
+// query when the answer is not cached.
+double vertex_error2(EncoderTruth& t, uint32_t v, Vec3i recon);
+
+// Squared distance from `p` to the fan of `ring` (ring[0], ring[i], ring[i+1]):
+// the faces a patch replaces. Infinite for a ring of fewer than 3 vertices.
+double fan_distance2(const std::vector<Vec3i>& pos, const std::vector<uint32_t>& ring, Vec3i p);
+
+// Area of the fan/star polygon `ring` (sum of triangle areas from ring[0]).
+double ring_area(const std::vector<Vec3i>& p, const std::vector<uint32_t>& ring);
+
+// Area-weighted vertex normals of the (quantized) input, unit length
+// ((0, 0, 1) for a vertex without area). O(V + F).
+std::vector<Vec3f> vertex_normals(const std::vector<Vec3i>& q, const std::vector<Triangle>& faces);
+
+}  // namespace meshstream
