@@ -12,9 +12,5 @@ void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
   put_varint(out, header.insertions);
   if (format.embedded) put_varint(out, header.min_shift);
 }
-void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
-                         uint8_t header_byte) {
-  write_record_header(header, out, RefinementFormatInfo::from_header_byte(header_byte).value());
-}
 
 }  // namespace meshstream

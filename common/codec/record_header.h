@@ -21,10 +21,5 @@ struct RecordHeader {
 // Appends the header as `format` has it (min_shift in the embedded formats).
 void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
                          RefinementFormatInfo format);
-// The same for a header byte (extra[0]) the caller has validated; throws
-// std::bad_optional_access for one no format has. The encoder's spelling
-// until it holds a RefinementFormatInfo.
-void write_record_header(const RecordHeader& header, std::vector<uint8_t>& out,
-                         uint8_t header_byte);
 
 }  // namespace meshstream

@@ -44,21 +44,4 @@
 #include "common/codec/structure_models.h"
 #include "common/codec/structure_record_reader.h"
 
-namespace meshstream {
-
-// The old names the encoder side (structure_writer) still calls; they go
-// once it uses the names above.
-inline BitTreeModel<2, FastStartBitModel>& count_model3(RefinementState& s, uint32_t u,
-                                                        uint32_t free_faces) {
-  return fast_start_count_model(s, u, free_faces);
-}
-inline BitTreeModel<4, FastStartBitModel>& valence_model3(RefinementState& s, uint32_t ring_size,
-                                                          uint32_t free_left) {
-  return fast_start_valence_model(s, ring_size, free_left);
-}
-inline void encode_start_rank3(RefinementModels& m, RangeEncoder& enc, uint32_t context,
-                               size_t candidates, uint32_t rank) {
-  encode_start_rank_in_context(m, enc, context, candidates, rank);
-}
-
-}  // namespace meshstream
+namespace meshstream {}  // namespace meshstream

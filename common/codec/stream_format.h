@@ -67,12 +67,6 @@ struct RefinementFormatInfo {
   uint8_t geometry_coder() const {
     return embedded ? kGeometryCoderEmbedded : kGeometryCoderRangeAverage;
   }
-  // Assigning a header byte the caller has validated (throws
-  // std::bad_optional_access for one no format has): the encoder's spelling
-  // until it holds a RefinementFormatInfo itself.
-  RefinementFormatInfo& operator=(uint8_t header_byte) {
-    return *this = from_header_byte(header_byte).value();
-  }
   // The format of header byte extra[0]; nullopt for a byte no format has.
   static constexpr std::optional<RefinementFormatInfo> from_header_byte(uint8_t byte) {
     switch (byte) {

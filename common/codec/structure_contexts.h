@@ -26,7 +26,7 @@ inline uint32_t count_context(const RefinementState& s, uint32_t u, uint32_t fre
 // coder").
 inline BitTreeModel<2, FastStartBitModel>& fast_start_count_model(RefinementState& s, uint32_t u,
                                                                   uint32_t free_faces) {
-  return s.models.patch_count3[count_context(s, u, free_faces)];
+  return s.models.fast_start_patch_count[count_context(s, u, free_faces)];
 }
 
 // Format 3's model of k - 3 for a patch at apex u: by u's ring size (as
@@ -35,7 +35,8 @@ inline BitTreeModel<2, FastStartBitModel>& fast_start_count_model(RefinementStat
 inline BitTreeModel<4, FastStartBitModel>& fast_start_valence_model(RefinementState& s,
                                                                     uint32_t ring_size,
                                                                     uint32_t free_left) {
-  return s.models.valence3[std::min(ring_size, 12u) * 8 + std::min<uint32_t>(free_left, 7)];
+  return s.models
+      .fast_start_valence[std::min(ring_size, 12u) * 8 + std::min<uint32_t>(free_left, 7)];
 }
 
 // Format 3's context of a start rank: k, the number of candidate runs

@@ -16,12 +16,12 @@ void encode_start_rank(RefinementModels& m, RangeEncoder& enc, uint32_t k, uint3
 void encode_start_rank_in_context(RefinementModels& m, RangeEncoder& enc, uint32_t context,
                                   size_t candidates, uint32_t rank) {
   if (candidates <= 1) return;
-  BitTreeModel<4, FastStartBitModel>& tree = m.start_rank3[context];
+  BitTreeModel<4, FastStartBitModel>& tree = m.fast_start_start_rank[context];
   if (rank < 15) {
     tree.encode(enc, rank);
   } else {
     tree.encode(enc, 15);
-    m.start_rank_big3.encode(enc, rank - 15);
+    m.fast_start_start_rank_big.encode(enc, rank - 15);
   }
 }
 

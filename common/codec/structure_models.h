@@ -17,7 +17,7 @@ inline constexpr int kScaleContexts = 20;
 
 // The models of one stream. The structure symbols have two families:
 // format 2's (BitModel, also format 1's) and format 3's (FastStartBitModel,
-// the members ending in 3, with finer valence and start-rank contexts:
+// the fast_start_ members, with finer valence and start-rank contexts:
 // structure_contexts.h); RefinementFormatInfo::fast_start_structure_models
 // says which one a stream uses. The coarse residuals use `residual` in
 // every format, plane records GeometryModels (embedded_geometry.h); why the
@@ -34,13 +34,13 @@ struct RefinementModels {
   // Format 3 structure symbols.
   // True when the models below are in use: the encoder's switch, set from
   // the format it writes (the decoder picks by RefinementFormatInfo).
-  bool v_models = false;
-  BitTreeModel<2, FastStartBitModel> patch_count3[8 * 2 * 3 * 4];  // by count_context
-  FastStartUIntModel patch_count_extra3;
-  BitTreeModel<4, FastStartBitModel> valence3[13 * 8];        // by fast_start_valence_model
-  BitTreeModel<4, FastStartBitModel> start_rank3[6 * 3 * 4];  // by start_rank_context
-  FastStartUIntModel start_rank_big3;
-  FastStartUIntModel open_edge3;
+  bool use_fast_start_models = false;
+  BitTreeModel<2, FastStartBitModel> fast_start_patch_count[8 * 2 * 3 * 4];  // by count_context
+  FastStartUIntModel fast_start_patch_count_extra;
+  BitTreeModel<4, FastStartBitModel> fast_start_valence[13 * 8];  // by fast_start_valence_model
+  BitTreeModel<4, FastStartBitModel> fast_start_start_rank[6 * 3 * 4];  // by start_rank_context
+  FastStartUIntModel fast_start_start_rank_big;
+  FastStartUIntModel fast_start_open_edge;
 };
 
 // The rank of a patch's start among rank_patch_starts' candidates.
@@ -63,8 +63,8 @@ MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_inline(RefinementModels& m, 
 MESHSTREAM_DECODE_INLINE uint32_t decode_start_rank_in_context_inline(RefinementModels& m,
                                                                       RangeDecoder& dec,
                                                                       uint32_t context) {
-  const uint32_t rank = m.start_rank3[context].decode(dec);
-  return rank < 15 ? rank : 15 + m.start_rank_big3.decode(dec);
+  const uint32_t rank = m.fast_start_start_rank[context].decode(dec);
+  return rank < 15 ? rank : 15 + m.fast_start_start_rank_big.decode(dec);
 }
 
 }  // namespace meshstream

@@ -111,7 +111,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
     if (free_faces > 0) {
       if constexpr (kFastStartModels) {
         count = fast_start_count_model(state, u, free_faces).decode(dec);
-        if (count == 3) count += m.patch_count_extra3.decode(dec);
+        if (count == 3) count += m.fast_start_patch_count_extra.decode(dec);
       } else {
         count = m.patch_count[count_context(state, u, free_faces)].decode(dec);
         if (count == 3) count += m.patch_count_extra.decode(dec);
@@ -194,7 +194,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
       if (!open_edges.empty()) {
         uint32_t choice;
         if constexpr (kFastStartModels) {
-          choice = m.open_edge3.decode(dec);
+          choice = m.fast_start_open_edge.decode(dec);
         } else {
           choice = m.open_edge.decode(dec);
         }

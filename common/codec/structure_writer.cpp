@@ -110,9 +110,9 @@ Status StructureWriter::code_patch_count(RangeEncoder& enc, uint32_t u, uint32_t
       ++bits_->count_steps;
       enc.set_cost_sink(&bits_->count);
     }
-    if (m.v_models) {
+    if (m.use_fast_start_models) {
       fast_start_count_model(s_, u, free_faces).encode(enc, std::min(count, 3u));
-      if (count >= 3) m.patch_count_extra3.encode(enc, count - 3);
+      if (count >= 3) m.fast_start_patch_count_extra.encode(enc, count - 3);
     } else {
       m.patch_count[count_context(s_, u, free_faces)].encode(enc, std::min(count, 3u));
       if (count >= 3) m.patch_count_extra.encode(enc, count - 3);
@@ -137,7 +137,7 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
     ++bits_->insertions;
     enc.set_cost_sink(&bits_->valence);
   }
-  if (m.v_models) {
+  if (m.use_fast_start_models) {
     fast_start_valence_model(s_, ring_size, free_left).encode(enc, k - 3);
   } else {
     m.valence[std::min(ring_size, 12u)].encode(enc, k - 3);
@@ -180,8 +180,8 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
       ++bits_->open_choices;
       enc.set_cost_sink(&bits_->open_edge);
     }
-    if (m.v_models) {
-      m.open_edge3.encode(enc, choice);
+    if (m.use_fast_start_models) {
+      m.fast_start_open_edge.encode(enc, choice);
     } else {
       m.open_edge.encode(enc, choice);
     }

@@ -40,7 +40,7 @@ class StructureWriter {
   StructureWriter(RefinementState& state, EncoderTruth& truth, RefinementFormatInfo format,
                   StructureBits* bits)
       : s_(state), t_(truth), format_(format), bits_(bits) {
-    s_.models.v_models = format.fast_start_structure_models;
+    s_.models.use_fast_start_models = format.fast_start_structure_models;
   }
 
   // Whether the layer started last still has vertices to put back.
