@@ -78,7 +78,8 @@ void add_decode_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<DecodeArgs>();
   cmd->add_option("input", args->input, ".hcs stream")->required();
   cmd->add_option("-o,--output", args->output, "mesh to write (.ply, .obj, .stl or .off)")
-      ->required();
+      ->required()
+      ->check(mesh_output_validator());
   // The budget rule of every program: common/cli/budget_options.h.
   cli::add_budget_options(
       *cmd, args->budget,

@@ -45,7 +45,8 @@ void add_generate_command(CLI::App& app, int& exit_code) {
       ->required()
       ->check(CLI::IsMember({"demo", "icosahedron", "icosphere", "grid", "components", "torus"}));
   cmd->add_option("-o,--output", args->output, "output file (.ply, .obj, .off or .stl)")
-      ->required();
+      ->required()
+      ->check(mesh_output_validator());
   cmd->add_option("--size", args->size,
                   "demo: target triangles (default 100000, up to 67M); icosphere: subdivisions "
                   "(default 4); grid: squares per side (32); components: count (5); torus: "

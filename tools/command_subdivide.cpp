@@ -68,7 +68,8 @@ void add_subdivide_command(CLI::App& app, int& exit_code) {
       "or everywhere with --uniform. Old vertices never move.");
   cmd->add_option("IN", args->input, "input mesh (OBJ, PLY, STL, OFF, DRC)")->required();
   cmd->add_option("-o,--output", args->output, "output mesh (.ply, .obj, .off or .stl)")
-      ->required();
+      ->required()
+      ->check(mesh_output_validator());
   cmd->add_option("--levels", args->options.levels,
                   "subdivision levels (flatness re-evaluated each)")
       ->check(CLI::Range(0, 8))

@@ -23,6 +23,10 @@ void add_generate_command(CLI::App& app, int& exit_code);
 int run_info_mesh(const std::string& path, bool json);
 int run_info_hcs(const std::string& path, bool json, bool list_records);
 
+// The -o check of the commands that write a mesh: a name write_mesh cannot
+// write is a usage error (exit 2) before any input is read.
+CLI::Validator mesh_output_validator();
+
 // Prints "meshstream: <message>" to stderr and returns 1, the exit code for
 // bad data and failures.
 int report_failure(const Error& error);

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "common/cli/version.h"
+#include "common/mesh/export.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
@@ -27,6 +28,15 @@ int main(int argc, char** argv) {
 }
 
 namespace meshstream::tools {
+
+CLI::Validator mesh_output_validator() {
+  return CLI::Validator(
+      [](std::string& path) {
+        Status writable = check_mesh_output_path(path);
+        return writable ? std::string() : writable.error().message;
+      },
+      "MESH", "mesh output");
+}
 
 int report_failure(const Error& error) {
   std::cerr << "meshstream: " << error.message << "\n";

@@ -297,14 +297,20 @@ Status write_stl(const Mesh& mesh, const std::string& path) {
   return {};
 }
 
+Status check_mesh_output_path(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == "ply" || ext == "obj" || ext == "off" || ext == "stl") return {};
+  return make_error(ErrorCode::kInvalidArgument,
+                    path + ": cannot write '." + ext + "' files (use .ply, .obj, .off or .stl)");
+}
+
 Status write_mesh(const Mesh& mesh, const std::string& path) {
+  if (auto writable = check_mesh_output_path(path); !writable) return writable;
   const std::string ext = lower_extension(path);
   if (ext == "ply") return write_ply(mesh, path, PlyEncoding::kBinary);
   if (ext == "obj") return write_obj(mesh, path);
   if (ext == "off") return write_off(mesh, path);
-  if (ext == "stl") return write_stl(mesh, path);
-  return make_error(ErrorCode::kInvalidArgument,
-                    path + ": cannot write '." + ext + "' files (use .ply, .obj, .off or .stl)");
+  return write_stl(mesh, path);
 }
 
 }  // namespace meshstream

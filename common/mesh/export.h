@@ -25,7 +25,11 @@ Status write_off(const Mesh& mesh, const std::string& path);
 // not written, and vertices no face uses are lost.
 Status write_stl(const Mesh& mesh, const std::string& path);
 // By extension (any case): .ply (binary), .obj, .off, .stl (binary).
-// kInvalidArgument for anything else.
+// kInvalidArgument for anything else (the same error as
+// check_mesh_output_path).
 Status write_mesh(const Mesh& mesh, const std::string& path);
+// Whether write_mesh can write `path` (its extension only; the folder is not
+// looked at), so a command can refuse a name before it does the work.
+Status check_mesh_output_path(const std::string& path);
 
 }  // namespace meshstream

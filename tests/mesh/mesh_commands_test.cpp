@@ -187,7 +187,7 @@ TEST(MeshCommands, BadDataExitsOneAndBadUsageTwo) {
   }
   EXPECT_EQ(run("generate nosuchshape -o " + temp_path("x.ply")).exit_code, 2);
   EXPECT_EQ(run("generate demo").exit_code, 2);                           // -o is required
-  EXPECT_EQ(run("generate grid -o " + temp_path("x.xyz")).exit_code, 1);  // no such format
+  EXPECT_EQ(run("generate grid -o " + temp_path("x.xyz")).exit_code, 2);  // no such format
 }
 
 }  // namespace
