@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <thread>
 
+#include "common/cli/version.h"
+
 namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
@@ -87,7 +89,7 @@ Status handshake(Connection& connection, Millis timeout, bool* server_answered) 
   const std::string peer = connection.peer();
   v1::ClientMessage hello;
   hello.mutable_hello()->set_protocol_version(proto::kProtocolVersion);
-  hello.mutable_hello()->set_client_name("meshstream-client 0.1");
+  hello.mutable_hello()->set_client_name(cli::version_line("meshstream-client"));
   if (auto s = connection.send(hello, timeout); !s) return s;
   auto reply = connection.receive(timeout);
   if (!reply) {

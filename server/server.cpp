@@ -63,10 +63,25 @@ Server::~Server() = default;
 
 Status Server::listen() {
   boost::system::error_code ec;
-  const auto address = asio::ip::make_address(options_.listen_host, ec);
+  auto address = asio::ip::make_address(options_.listen_host, ec);
   if (ec) {
-    return make_error(ErrorCode::kIo,
-                      "--listen: '" + options_.listen_host + "' is not an IP address");
+    // A host name (`localhost`, this machine's name): its first address,
+    // as a user who writes --listen localhost:7878 expects.
+    net::tcp::resolver resolver(workers_[0]->io);
+    const auto found = resolver.resolve(options_.listen_host, "", ec);
+    if (ec || found.empty()) {
+      return make_error(ErrorCode::kIo, "--listen: cannot resolve '" + options_.listen_host +
+                                            "': " + (ec ? ec.message() : "no address"));
+    }
+    // IPv4 first when the name has both (localhost: 127.0.0.1 and ::1), so
+    // the clients that write 127.0.0.1 reach it.
+    address = found.begin()->endpoint().address();
+    for (const auto& entry : found) {
+      if (entry.endpoint().address().is_v4()) {
+        address = entry.endpoint().address();
+        break;
+      }
+    }
   }
   const net::tcp::endpoint endpoint(address, options_.listen_port);
   auto acceptor = std::make_unique<net::tcp::acceptor>(workers_[0]->io);

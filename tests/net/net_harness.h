@@ -57,8 +57,8 @@ class ServerProcess {
   ~ServerProcess() { kill_now(); }
 
   // Starts the server with `args` (after the binary name, "--listen
-  // 127.0.0.1:0" is added) and waits up to `timeout` for its port. False
-  // when it did not come up (see log()).
+  // 127.0.0.1:0" is added unless `args` has a --listen) and waits up to `timeout` for its port.
+  // False when it did not come up (see log()).
   bool start(const std::vector<std::string>& args, const std::string& log_path,
              std::chrono::milliseconds timeout = 20s) {
     log_path_ = log_path;
@@ -71,7 +71,10 @@ class ServerProcess {
       if (err >= 0) ::dup2(err, 2);
       ::close(out[0]);
       ::close(out[1]);
-      std::vector<std::string> all{server_binary(), "--listen", "127.0.0.1:0"};
+      std::vector<std::string> all{server_binary()};
+      if (std::find(args.begin(), args.end(), "--listen") == args.end()) {
+        all.insert(all.end(), {"--listen", "127.0.0.1:0"});
+      }
       all.insert(all.end(), args.begin(), args.end());
       std::vector<char*> argv;
       for (auto& a : all) argv.push_back(a.data());

@@ -180,6 +180,26 @@ TEST(ServerStartup, AnAddressThatIsNotLocalFailsAtOnceNamingIt) {
   EXPECT_TRUE(lines_with(e.err, "serving small").empty()) << e.err;
 }
 
+// A host name is resolved, as a user who writes --listen localhost:7878
+// expects (it used to be refused: "'localhost' is not an IP address"); a
+// name that does not resolve fails at once, naming it.
+TEST(ServerStartup, AHostNameIsResolvedAndABadOneNamed) {
+  const std::string work = fresh_dir("host_name");
+  const std::string models = fresh_dir("host_name/models");
+  write_file(models + "/small.hcs", server::make_synthetic_hcs({}));
+  ServerProcess server;
+  ASSERT_TRUE(server.start({"--models", models, "--cache", "none", "--listen", "localhost:0"},
+                           work + "/log.txt"))
+      << server.log();
+  TestClient client = greeted_client(server.port());  // 127.0.0.1: the name's IPv4 address
+
+  const Exit e = run_to_exit(
+      {"--models", models, "--cache", "none", "--listen", "no-such-host.invalid:7878"}, work);
+  EXPECT_EQ(e.status, 1) << e.err;
+  EXPECT_NE(e.err.find("--listen: cannot resolve 'no-such-host.invalid'"), std::string::npos)
+      << e.err;
+}
+
 // ------------------------------------------- row 12: clashes and skipped files
 
 TEST(ModelsFolderScan, NamesHcsFirstThenMeshesInFileOrderAndSaysWhyItSkips) {
