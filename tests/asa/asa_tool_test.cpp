@@ -35,7 +35,7 @@ TEST(AsaTool, SubdivideCommand) {
   EXPECT_EQ(run("subdivide " + in + " -o " + out + " --flatness 3"), 2);
   EXPECT_EQ(run("subdivide " + in), 2);
   EXPECT_EQ(run("subdivide /nonexistent/mesh.off -o " + out), 1);
-  EXPECT_EQ(run("subdivide " + in + " -o /tmp/unsupported.xyz"), 1);
+  EXPECT_EQ(run("subdivide " + in + " -o /tmp/unsupported.xyz"), 2);  // a usage error, found first
   std::filesystem::remove(out);
 }
 
