@@ -54,6 +54,15 @@ class Writer {
     maybe_flush();
   }
   void put(char c) { buffer_.push_back(c); }
+  // "x y z" (a position or a normal) and "u v", shortest round-trip floats:
+  // the text writers' vertex fields.
+  void numbers(const Vec3f& v) { number(v.x), put(' '), number(v.y), put(' '), number(v.z); }
+  void numbers(const Vec2f& v) { number(v.x), put(' '), number(v.y); }
+  // "3 a b c\n": a triangle of the PLY and OFF text bodies.
+  void triangle_line(const Triangle& t) {
+    text("3 ");
+    number(t[0]), put(' '), number(t[1]), put(' '), number(t[2]), put('\n');
+  }
   bool finish() {
     flush();
     return ok_ && std::fflush(file_) == 0;
@@ -144,19 +153,13 @@ Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding
       if (texcoords) out.raw(&mesh.texcoords[v], 8);
       continue;
     }
-    const Vec3f& p = mesh.positions[v];
-    out.number(p.x), out.put(' '), out.number(p.y), out.put(' '), out.number(p.z);
-    if (normals) {
-      const Vec3f& n = mesh.normals[v];
-      out.put(' '), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '), out.number(n.z);
-    }
+    out.numbers(mesh.positions[v]);
+    if (normals) out.put(' '), out.numbers(mesh.normals[v]);
     if (colors) {
       const Vec4f& c = mesh.colors[v];
       for (float x : {c.x, c.y, c.z, c.w}) out.put(' '), out.number(uint32_t{to_byte(x)});
     }
-    if (texcoords) {
-      out.put(' '), out.number(mesh.texcoords[v].x), out.put(' '), out.number(mesh.texcoords[v].y);
-    }
+    if (texcoords) out.put(' '), out.numbers(mesh.texcoords[v]);
     out.put('\n');
     out.maybe_flush();
   }
@@ -168,8 +171,7 @@ Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding
       out.raw(record, sizeof(record));
       continue;
     }
-    out.text("3 ");
-    out.number(t[0]), out.put(' '), out.number(t[1]), out.put(' '), out.number(t[2]), out.put('\n');
+    out.triangle_line(t);
   }
   if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
   return {};
@@ -188,19 +190,16 @@ Status write_obj(const Mesh& mesh, const std::string& path) {
            std::to_string(mesh.face_count()) + " triangles\n");
   if (!mesh.colors.empty()) out.text("# per-vertex colours are not stored in OBJ\n");
   for (const Vec3f& p : mesh.positions) {
-    out.text("v "), out.number(p.x), out.put(' '), out.number(p.y), out.put(' '), out.number(p.z);
-    out.put('\n');
+    out.text("v "), out.numbers(p), out.put('\n');
   }
   if (texcoords) {
     for (const Vec2f& t : mesh.texcoords) {
-      out.text("vt "), out.number(t.x), out.put(' '), out.number(t.y), out.put('\n');
+      out.text("vt "), out.numbers(t), out.put('\n');
     }
   }
   if (normals) {
     for (const Vec3f& n : mesh.normals) {
-      out.text("vn "), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '),
-          out.number(n.z);
-      out.put('\n');
+      out.text("vn "), out.numbers(n), out.put('\n');
     }
   }
   for (const Triangle& t : mesh.triangles) {
@@ -236,28 +235,20 @@ Status write_off(const Mesh& mesh, const std::string& path) {
            "OFF\n# written by meshstream\n");
   out.text(std::to_string(mesh.vertex_count()) + " " + std::to_string(mesh.face_count()) + " 0\n");
   for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    const Vec3f& p = mesh.positions[v];
-    out.number(p.x), out.put(' '), out.number(p.y), out.put(' '), out.number(p.z);
-    if (normals) {
-      const Vec3f& n = mesh.normals[v];
-      out.put(' '), out.number(n.x), out.put(' '), out.number(n.y), out.put(' '), out.number(n.z);
-    }
+    out.numbers(mesh.positions[v]);
+    if (normals) out.put(' '), out.numbers(mesh.normals[v]);
     if (colors) {
       const Vec4f& c = mesh.colors[v];
       for (float x : {c.x, c.y, c.z, c.w}) {
         out.put(' '), out.number(std::clamp(std::isnan(x) ? 0.0f : x, 0.0f, 1.0f));
       }
     }
-    if (texcoords) {
-      out.put(' '), out.number(mesh.texcoords[v].x), out.put(' '), out.number(mesh.texcoords[v].y);
-    }
+    if (texcoords) out.put(' '), out.numbers(mesh.texcoords[v]);
     out.put('\n');
     out.maybe_flush();
   }
   for (const Triangle& t : mesh.triangles) {
-    out.text("3 ");
-    out.number(t[0]), out.put(' '), out.number(t[1]), out.put(' '), out.number(t[2]), out.put('\n');
-    out.maybe_flush();
+    out.triangle_line(t);
   }
   if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
   return {};
