@@ -52,15 +52,7 @@ class ClientCliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TempDir();
-    fs::create_directories(*dir_ / "models");
-    ASSERT_EQ(run({tool_bin(), "generate", "demo", "--size", "20000", "-o", *dir_ / "demo.ply"},
-                  *dir_ / "gen.out", *dir_ / "gen.err"),
-              0)
-        << read_text(*dir_ / "gen.err");
-    ASSERT_EQ(run({tool_bin(), "encode", *dir_ / "demo.ply", "-o", hcs()}, *dir_ / "enc.out",
-                  *dir_ / "enc.err"),
-              0)
-        << read_text(*dir_ / "enc.err");
+    ASSERT_EQ(make_demo_model(dir_->path()), "");
     fast_ = new Server();
     ASSERT_TRUE(
         fast_->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, dir_->path()))

@@ -132,6 +132,23 @@ inline int run(const std::vector<std::string>& argv, const std::string& out,
   return status ? *status : -1001;
 }
 
+// The client tests' model: the procedural demo mesh at 20k triangles,
+// written by the offline tool to DIR/demo.ply and encoded by it to
+// DIR/models/demo.hcs, the peer the client is checked against. Empty when
+// both commands succeeded, else what failed and its stderr.
+inline std::string make_demo_model(const std::string& dir) {
+  std::filesystem::create_directories(dir + "/models");
+  if (run({tool_bin(), "generate", "demo", "--size", "20000", "-o", dir + "/demo.ply"},
+          dir + "/gen.out", dir + "/gen.err") != 0) {
+    return "generate: " + read_text(dir + "/gen.err");
+  }
+  if (run({tool_bin(), "encode", dir + "/demo.ply", "-o", dir + "/models/demo.hcs"},
+          dir + "/enc.out", dir + "/enc.err") != 0) {
+    return "encode: " + read_text(dir + "/enc.err");
+  }
+  return "";
+}
+
 // A port nobody listens on right now (bind to 0, read it, close).
 inline uint16_t free_port() {
   const int s = ::socket(AF_INET, SOCK_STREAM, 0);

@@ -22,17 +22,7 @@ class ClientStreamTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TempDir();
-    fs::create_directories(*dir_ / "models");
-    // A procedural mesh, encoded by the offline tool: the peer the client
-    // is checked against.
-    ASSERT_EQ(run({tool_bin(), "generate", "demo", "--size", "20000", "-o", *dir_ / "demo.ply"},
-                  *dir_ / "gen.out", *dir_ / "gen.err"),
-              0)
-        << read_text(*dir_ / "gen.err");
-    ASSERT_EQ(run({tool_bin(), "encode", *dir_ / "demo.ply", "-o", hcs()}, *dir_ / "enc.out",
-                  *dir_ / "enc.err"),
-              0)
-        << read_text(*dir_ / "enc.err");
+    ASSERT_EQ(make_demo_model(dir_->path()), "");  // the peer the client is checked against
     server_ = new Server();
     ASSERT_TRUE(
         server_->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, dir_->path()))

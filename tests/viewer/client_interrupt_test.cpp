@@ -18,13 +18,7 @@ TEST(ClientInterrupt, CtrlCClosesTheWindowAndEndsTheStreamCleanly) {
   const std::string display = xvfb.start();
   ASSERT_FALSE(display.empty()) << "Xvfb did not start";
   TempDir dir;
-  fs::create_directories(dir / "models");
-  ASSERT_EQ(run({tool_bin(), "generate", "demo", "--size", "20000", "-o", dir / "demo.ply"},
-                dir / "gen.out", dir / "gen.err"),
-            0);
-  ASSERT_EQ(run({tool_bin(), "encode", dir / "demo.ply", "-o", dir / "models/demo.hcs"},
-                dir / "enc.out", dir / "enc.err"),
-            0);
+  ASSERT_EQ(make_demo_model(dir.path()), "");
   Server server;  // ~31 KB at 8 kB/s: about four seconds
   ASSERT_TRUE(server.start({"--models", dir / "models", "--cache", "none", "--rate", "8000",
                             "--max-chunk-bytes", "1024"},
