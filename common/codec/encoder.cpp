@@ -228,9 +228,14 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   std::vector<Vec3i> q = quantize_positions(mesh, *grid);
   auto editable = EditableMesh::build(q, mesh.triangles);
   if (!editable) return tl::unexpected(editable.error());
+  auto report_progress = [&](std::string_view stage, double fraction) {
+    if (options.progress) options.progress(EncodeProgress{stage, fraction});
+  };
+  report_progress("decimating", 0.0);
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
   const DecimationResult dec = decimate_layers(std::move(*editable), dopt);
+  report_progress("coding records", 0.4);
 
   // The candidates.
   const std::vector<RecordOrdering> orderings = orderings_to_try(options);
@@ -251,11 +256,16 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
       orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
   auto candidates = encode_candidates(encode_candidate, orderings.size(), sizing, parallel, report);
   if (!candidates) return tl::unexpected(candidates.error());
-  if (orderings.size() < 2) return std::move(candidates->streams[0].bytes);
+  if (orderings.size() < 2) {
+    report_progress("done", 1.0);
+    return std::move(candidates->streams[0].bytes);
+  }
 
   // The measured choice among them.
+  report_progress("measuring", 0.8);
   auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel);
   if (!best) return tl::unexpected(best.error());
+  report_progress("done", 1.0);
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
   return std::move(candidates->streams[*best].bytes);
 }

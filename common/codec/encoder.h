@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/codec/encode_progress.h"
 #include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
 
@@ -70,6 +71,9 @@ struct EncodeOptions {
   // benchmarks compare against: same records, slower-learning models).
   // kExactInsertion and anything else is kInvalidArgument.
   RefinementFormat refinement_format = RefinementFormat::kEmbeddedFastStart;
+  // Called as the encode advances (encode_progress.h); empty = no calls. It
+  // does not change the stream.
+  EncodeProgressCallback progress;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each

@@ -1,0 +1,19 @@
+// How far an encode has got, for a progress bar (`meshstream encode` on a
+// terminal) or a server log line. The encoder calls the callback from the
+// thread that called encode_hcs, at stage changes and often enough within a
+// long stage (a few hundred calls per encode at most), never concurrently.
+#pragma once
+
+#include <functional>
+#include <string_view>
+
+namespace meshstream {
+
+struct EncodeProgress {
+  std::string_view stage;  // "decimating", "coding records", "measuring", "done"
+  double fraction = 0;     // of the whole encode, 0..1, never decreasing
+};
+
+using EncodeProgressCallback = std::function<void(const EncodeProgress&)>;
+
+}  // namespace meshstream
