@@ -36,21 +36,36 @@ int run_list(const ClientOptions& o) {
   if (o.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& m : *models) {
-      list.push_back({{"name", m.name()},
-                      {"vertices", m.vertices()},
-                      {"faces", m.faces()},
-                      {"stream_bytes", m.stream_bytes()},
-                      {"records", m.records()},
-                      {"source", m.source()}});
+      nlohmann::json entry{{"name", m.name()},
+                           {"vertices", m.vertices()},
+                           {"faces", m.faces()},
+                           {"stream_bytes", m.stream_bytes()},
+                           {"records", m.records()},
+                           {"source", m.source()},
+                           {"state", model_state_name(m.state())}};
+      if (m.state() == v1::ModelInfo::ENCODING) {
+        entry["percent"] = m.percent();
+        entry["stage"] = m.stage();
+      }
+      if (m.state() == v1::ModelInfo::FAILED) entry["reason"] = m.reason();
+      list.push_back(std::move(entry));
     }
     std::cout << nlohmann::json{{"event", "models"}, {"models", list}}.dump() << std::endl;
     return 0;
   }
-  std::printf("%-24s %10s %10s %12s %8s  %s\n", "model", "vertices", "faces", "bytes", "records",
-              "source");
+  std::printf("%-24s %10s %10s %12s %8s  %-6s  %s\n", "model", "vertices", "faces", "bytes",
+              "records", "source", "state");
   for (const auto& m : *models) {
-    std::printf("%-24s %10u %10u %12llu %8u  %s\n", m.name().c_str(), m.vertices(), m.faces(),
-                static_cast<unsigned long long>(m.stream_bytes()), m.records(), m.source().c_str());
+    std::string state = model_state_name(m.state());
+    if (m.state() == v1::ModelInfo::ENCODING) {
+      char percent[32];
+      std::snprintf(percent, sizeof percent, " %.0f %%", m.percent());
+      state += percent;
+    }
+    if (m.state() == v1::ModelInfo::FAILED) state += ": " + m.reason();
+    std::printf("%-24s %10u %10u %12llu %8u  %-6s  %s\n", m.name().c_str(), m.vertices(), m.faces(),
+                static_cast<unsigned long long>(m.stream_bytes()), m.records(), m.source().c_str(),
+                state.c_str());
   }
   return 0;
 }
@@ -180,6 +195,7 @@ class StreamingRun {
     target.budget = o.budget;
     target.max_chunk_bytes = o.max_chunk_bytes;
     target.reconnect = o.reconnect;
+    target.wait = o.wait;
     return target;
   }
   static PipelineSettings settings_of(const ClientOptions& o) {
@@ -256,6 +272,7 @@ class StreamingRun {
   void stream() {
     decoded_.on_record([this](const AppliedRecord& r) { log_.record(r, elapsed()); });
     client_.on_retry([this](const Error& e, int attempt) { log_.reconnecting(e, attempt); });
+    client_.on_waiting([this](const v1::ModelInfo& m) { log_.waiting(m, elapsed()); });
     client_.check_header([this](const StreamFacts& f) { return check_header(f); });
     std::thread network(
         [this] { client_.run(decoded_, [this](const StreamFacts& f) { on_header(f); }); });

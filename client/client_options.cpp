@@ -103,6 +103,9 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   app.add_flag("--quiet", o.quiet, "no progress line");
+  app.add_flag("--wait", o.wait,
+               "a model the server is still encoding (NOT_READY) is asked for again every half "
+               "second until it is ready, then streamed; without it the client exits 1");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -123,6 +126,7 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   o.port = hp->port;
   if (!o.list && o.model.empty()) return usage("name a MODEL to stream, or use --list");
   if (o.list && !o.model.empty()) return usage("--list takes no MODEL");
+  if (o.list && o.wait) return usage("--wait is for streaming a MODEL, not --list");
   if (o.snapshot_at && o.snapshot_png.empty())
     return usage("--snapshot-at needs --snapshot FILE.png");
   if (!o.snapshot_png.empty() && extension_of(o.snapshot_png) != ".png") {

@@ -5,7 +5,7 @@
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
 //     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
-//     [--exit-after N] [--exit-after-records N]
+//     [--exit-after N] [--exit-after-records N] [--wait]
 #pragma once
 
 #include <cstdint>
@@ -46,6 +46,7 @@ struct ClientOptions {
   uint32_t max_chunk_bytes = 0;
   ReconnectPolicy reconnect;
   bool quiet = false;  // no progress line
+  bool wait = false;   // --wait: a model still being encoded is waited for
 };
 
 // Options to run with, or the exit code to return now (0 after --help, 2
