@@ -238,6 +238,9 @@ StreamClient::Attempt StreamClient::attempt(
         continue;
       }
       error = Error{ErrorCode::kIo, server_error_text(c.peer(), e)};
+      // Resuming a stream after a lost connection: a server that restarted
+      // may still be loading the model (from its cache); try again.
+      if (e.code() == v1::Error::NOT_READY && facts_) return Attempt::kRetry;
       if (e.code() == v1::Error::NOT_READY) error.message += " (--wait waits until it is ready)";
       return transient(e.code()) ? Attempt::kRetry : Attempt::kFatal;
     }

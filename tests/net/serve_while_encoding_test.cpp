@@ -145,8 +145,9 @@ TEST(ServeWhileEncoding, ListsAtOnceRefusesNotReadyAndWaitStreamsIt) {
   if (!server::demo_models_available()) GTEST_SKIP() << "this build has no encoder";
   const std::string work = fresh_dir("not_ready");
   const std::string models = fresh_dir("not_ready/models");
-  // 100k vertices: an encode of seconds, long enough to be seen encoding.
-  ASSERT_TRUE(static_cast<bool>(write_ply(make_demo_mesh(200000), models + "/big.ply")));
+  // 50k vertices: an encode of seconds (one at least on an idle machine),
+  // long enough to be seen encoding.
+  ASSERT_TRUE(static_cast<bool>(write_ply(make_demo_mesh(100000), models + "/big.ply")));
   const std::vector<uint8_t> small = server::make_synthetic_hcs({});
   write_file(models + "/small.hcs", small);
 
@@ -156,7 +157,7 @@ TEST(ServeWhileEncoding, ListsAtOnceRefusesNotReadyAndWaitStreamsIt) {
                            work + "/log.txt", 20s, ServerProcess::Wait::kPort))
       << server.log();
   const double listening_s = std::chrono::duration<double>(Clock::now() - started).count();
-  std::printf("[ measured ] 'listening on' %.3f s after start (a 100k-vertex mesh to encode)\n",
+  std::printf("[ measured ] 'listening on' %.3f s after start (a 50k-vertex mesh to encode)\n",
               listening_s);
   EXPECT_LT(listening_s, 5.0) << "the server must not encode before it listens";
 
@@ -166,7 +167,7 @@ TEST(ServeWhileEncoding, ListsAtOnceRefusesNotReadyAndWaitStreamsIt) {
       server.port(), "big", [](const auto& m) { return m.has_value(); }, 10s, &met);
   ASSERT_TRUE(met) << server.log();
   ASSERT_NE(first->state(), v1::ModelInfo::READY)
-      << "a 100k-vertex encode finished before the first ListModels";
+      << "a 50k-vertex encode finished before the first ListModels";
   EXPECT_EQ(first->source(), "mesh");
 
   // A stream request gets NOT_READY naming the model and its progress; the
@@ -228,6 +229,10 @@ TEST(ServeWhileEncoding, ListsAtOnceRefusesNotReadyAndWaitStreamsIt) {
   const ClientRun waited = run_client(
       {"127.0.0.1:" + std::to_string(server.port()), "big", "--wait", "--no-asa", "--json"}, work);
   ASSERT_EQ(waited.status, 0) << waited.err << "\n" << server.log();
+  std::printf(
+      "[ measured ] --wait streamed the 50k-vertex model %.2f s after the server "
+      "started\n",
+      std::chrono::duration<double>(Clock::now() - started).count());
   bool done = false;
   for (const auto& e : json_lines(waited.out)) {
     if (e["event"] == "waiting") {
@@ -237,17 +242,42 @@ TEST(ServeWhileEncoding, ListsAtOnceRefusesNotReadyAndWaitStreamsIt) {
     if (e["event"] == "done") {
       done = true;
       EXPECT_EQ(e["reason"], "complete") << e;
-      EXPECT_GT(e["vertices"].get<uint32_t>(), 40000u) << e;
+      EXPECT_GT(e["vertices"].get<uint32_t>(), 20000u) << e;
     }
   }
   EXPECT_TRUE(done) << waited.out;
   const auto ready = find_model(list_models(server.port()), "big");
   ASSERT_TRUE(is_ready(ready));
-  EXPECT_GT(ready->vertices(), 40000u);
+  EXPECT_GT(ready->vertices(), 20000u);
   // The log told how the encode went, and when it was done.
   EXPECT_NE(server.log().find("catalog: ready big: encoded " + models + "/big.ply"),
             std::string::npos)
       << server.log();
+
+  // The file changes: while the new version is encoded, the old stream is
+  // still served (listed as encoding, with the old stream's counts).
+  const uint32_t old_vertices = ready->vertices();
+  ASSERT_TRUE(static_cast<bool>(write_ply(make_demo_mesh(40000), models + "/big.ply")));
+  const auto reencoding = poll_model(
+      server.port(), "big", [](const auto& m) { return m && !is_ready(m); }, 20s, &met);
+  ASSERT_TRUE(met) << server.log();
+  EXPECT_EQ(reencoding->vertices(), old_vertices);
+  const StreamResult old_stream = stream_model(server.port(), "big");
+  ASSERT_TRUE(old_stream.ok) << old_stream.problem;
+  EXPECT_EQ(old_stream.header.vertices(), old_vertices);
+  const auto renewed = poll_model(
+      server.port(), "big",
+      [&](const auto& m) { return is_ready(m) && m->vertices() != old_vertices; }, 60s, &met);
+  ASSERT_TRUE(met) << (renewed ? renewed->DebugString() : "not listed") << server.log();
+  for (const char* line : {"catalog: ready big", "catalog: changed", "catalog: encoding big"}) {
+    std::istringstream log(server.log());
+    for (std::string l; std::getline(log, l);) {
+      if (l.find(line) != std::string::npos) std::printf("[ server   ] %s\n", l.c_str());
+    }
+  }
+  const StreamResult new_stream = stream_model(server.port(), "big");
+  ASSERT_TRUE(new_stream.ok) << new_stream.problem;
+  EXPECT_EQ(new_stream.header.vertices(), renewed->vertices());
 }
 
 // ------------------------------------------------ added, changed, removed
