@@ -206,5 +206,35 @@ TEST_F(HttpServersTest, MissingFilesAndPagesAreClearErrors) {
   fs::remove(*dir_ / "www/models/page.hcs");
 }
 
+TEST_F(HttpServersTest, RecordsTheStreamDoesNotHaveAreRefusedFromItsIndex) {
+  Nginx nginx;
+  START_OR_SKIP(nginx);
+  // Checked when the index arrives, before any record is streamed, as over TCP.
+  ClientRun r = client("http://127.0.0.1:" + std::to_string(nginx.port()) + "/models/demo.hcs",
+                       {"--no-asa", "--quiet", "--out-at", "100000"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--out-at 100000: model 'demo' has records 0 to "), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(r.out_dir + "/final.ply"));
+}
+
+TEST_F(HttpServersTest, UrlUsageErrorsExitTwoNamingTheProblem) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  for (const Case& c : {Case{{"https://h/m.hcs"}, "https is not supported"},
+                        Case{{"http://h/m.hcs", "m"}, "the URL names the model already"},
+                        Case{{"http://h/m.hcs", "--list"}, "--list needs a meshstream server"},
+                        Case{{"http://h:0/m.hcs"}, "is not a port"},
+                        Case{{"http://h/"}, "names a folder, not an .hcs file"}}) {
+    const std::string out = *dir_ / "usage.out", err = *dir_ / "usage.err";
+    std::vector<std::string> argv{client_bin()};
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    EXPECT_EQ(run(argv, out, err), 2) << c.args[0];
+    EXPECT_NE(read_text(err).find(c.says), std::string::npos) << read_text(err);
+  }
+}
+
 }  // namespace
 }  // namespace meshstream::clienttest
