@@ -84,7 +84,7 @@ struct Side {
 int main(int argc, char** argv) {
   std::string report_dir = std::string(MESHSTREAM_SOURCE_DIR) + "/bench/report";
   bool quick = false;
-  int runs = 7;
+  int runs = 9;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--report-dir" && i + 1 < argc) {
