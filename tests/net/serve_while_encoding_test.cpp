@@ -189,6 +189,12 @@ TEST(ServeWhileEncoding, ListsAtOnceRefusesNotReadyAndWaitStreamsIt) {
     if (m.error().model().state() == v1::ModelInfo::ENCODING) {
       EXPECT_NE(m.error().message().find(" %"), std::string::npos) << m.error().message();
     }
+    // (A .hcs is only read and checked: ready in milliseconds, never
+    // behind the encode.)
+    poll_model(server.port(), "small", is_ready, 10s, &met);
+    ASSERT_TRUE(met) << server.log();
+    EXPECT_FALSE(is_ready(find_model(list_models(server.port()), "big")))
+        << "the .hcs waited for the encode";
     ASSERT_TRUE(c.stream("small"));
     const StreamResult r = read_stream(c);
     ASSERT_TRUE(r.ok) << r.problem;
