@@ -67,6 +67,9 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh) {
   bvh.nodes_.reserve(2 * n / kMaxLeafTriangles + 1);
   bvh.build_node(refs, 0, n, 0, mesh, centroids);
   centroids = {};
+  // Leaves hold 1..kMaxLeafTriangles triangles, so the reserve above is
+  // often outgrown (doubling the array): keep only what the tree uses.
+  bvh.nodes_.shrink_to_fit();
 
   bvh.triangles_.resize(n);
   bvh.slot_of_.resize(n);
