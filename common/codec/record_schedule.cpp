@@ -176,10 +176,7 @@ class RecordScheduler {
   Status write_structure_record() {
     if (!writer_.layer_open()) {
       --next_layer_;
-      std::vector<Removal> layer = in_.dec.layers[next_layer_];
-      for (Removal& r : layer)
-        for (uint32_t& u : r.ring) u = to_decoder_[u];
-      writer_.start_layer(std::move(layer));
+      writer_.start_layer(in_.dec.layers[next_layer_], to_decoder_);
     }
     const uint32_t first_new = state_.mesh.vertex_count();
     WrittenRecord f;
