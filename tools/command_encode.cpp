@@ -33,7 +33,7 @@ int run_encode(const EncodeArgs& args) {
   if (args.old_flag)
     std::fprintf(stderr, "meshstream encode: --issue1-order is deprecated, use --no-bit-planes\n");
   ProgressBar bar(stderr,
-                  args.progress || (!args.no_progress && ProgressBar::stderr_is_terminal()));
+                  !args.no_progress && (args.progress || ProgressBar::stderr_is_terminal()));
   bar.show_stage("reading " + args.input);
   auto imported = import_mesh(args.input);
   if (!imported) {
