@@ -6,7 +6,7 @@ namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
 
-DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamClient* client,
+DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamSource* client,
                                  LatestFrameMailbox& mailbox, PipelineSettings settings,
                                  FrameObserver observer)
     : decoded_(decoded),
