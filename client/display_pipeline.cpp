@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "client/frame_mesh_pool.h"
+
 namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
@@ -65,7 +67,8 @@ void DisplayPipeline::loop() {
   auto elapsed = [&] {
     return std::chrono::duration<double, std::milli>(Clock::now() - started).count();
   };
-  Mesh mirror;
+  Mesh mirror;                 // the decoded mesh as of the last take
+  FrameMeshPool frame_meshes;  // frames' copies of it: only the changes, where free
   MeshChanges changes;
   uint64_t seen_pokes = 0;
   bool outcome_seen = false;
@@ -122,7 +125,7 @@ void DisplayPipeline::loop() {
           (end_record > 0 && u.records_decoded >= end_record) ||
           (u.ended && decoded_.outcome() && decoded_.outcome()->ok && !decoded_.has_pending());
       info.new_records = true;
-      frame.decoded = std::make_shared<const Mesh>(mirror);
+      frame.decoded = frame_meshes.share(mirror, changes);
     } else {
       frame = *last;
       frame.decode_ms = 0;
