@@ -157,12 +157,17 @@ struct IncrementalDecoder::State {
         mesh.triangles = base->faces;
       }
       delta.full_rebuild = true;
-      delta.added_vertices.resize(base->positions.size());
-      for (uint32_t v = 0; v < delta.added_vertices.size(); ++v) delta.added_vertices[v] = v;
-      delta.touched_faces.resize(base->faces.size());
-      for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
+      if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+        delta.added_vertices.resize(base->positions.size());
+        for (uint32_t v = 0; v < delta.added_vertices.size(); ++v) delta.added_vertices[v] = v;
+        delta.touched_faces.resize(base->faces.size());
+        for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
+      }
     } else {
       AppliedRecord applied;
+      // Without an output mesh nobody follows the changes: the lists would
+      // only grow (a whole stream fed at once keeps every record's delta).
+      applied.record_changes = upkeep == DecodedMeshUpkeep::kEveryRecord;
       if (auto s = apply_refinement_record(*refine, payload, rec.vertices, rec.faces, applied);
           !s) {
         return where(s.error());
@@ -185,7 +190,8 @@ struct IncrementalDecoder::State {
       delta.added_vertices = std::move(applied.added_vertices);
       delta.touched_faces = std::move(applied.touched_faces);
       delta.moved_vertices = std::move(applied.moved_vertices);
-      delta.full_rebuild = !delta.moved_vertices.empty();  // see RecordDelta
+      // Plane records: see RecordDelta; no lists: nothing says what changed.
+      delta.full_rebuild = !delta.moved_vertices.empty() || !applied.record_changes;
     }
     deltas.push_back(std::move(delta));
     return {};

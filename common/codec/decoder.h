@@ -45,7 +45,8 @@ enum class DecodedMeshUpkeep {
   // builds the mesh once, from the decoder's own state (its triangles are
   // moved out, not copied). For one-shot decodes that write the mesh at the
   // end (the decode tool, decode_hcs): no second copy of the triangles is
-  // written record by record, and none is held in memory.
+  // written record by record, and none is held in memory. Its deltas list
+  // no vertices or faces and say full_rebuild (nothing tracks the changes).
   kOnRelease,
 };
 

@@ -287,6 +287,12 @@ TEST_P(ProceduralRoundTrip, ReleasedMeshEqualsTheMeshKeptRecordByRecord) {
     IncrementalDecoder once(DecodedMeshUpkeep::kOnRelease);
     ASSERT_TRUE(once.feed(std::span<const uint8_t>(bytes->data(), end)));
     EXPECT_EQ(once.mesh().vertex_count(), 0u);  // nothing kept while decoding
+    ASSERT_EQ(once.last_deltas().size(), i + 1);
+    for (const RecordDelta& d : once.last_deltas()) {
+      // Nothing tracks the changes: no lists, and a consumer told to rebuild.
+      EXPECT_TRUE(d.full_rebuild);
+      EXPECT_TRUE(d.added_vertices.empty() && d.touched_faces.empty() && d.moved_vertices.empty());
+    }
     auto released = once.release_mesh();
     ASSERT_TRUE(released) << released.error().message;
     ASSERT_EQ(released->positions, kept.mesh().positions) << c.name << " record " << i;
