@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -53,7 +54,7 @@ Status check_options(const AsaOptions& o) {
   if (!std::isfinite(o.crease_degrees) || o.crease_degrees < 0 || o.crease_degrees > 180) {
     return make_error(ErrorCode::kInvalidArgument, "crease angle must be in [0, 180] degrees");
   }
-  return {};
+  return check_view(o.view);
 }
 
 // Levels multiply faces by up to 4 each; refuse what cannot be indexed.
@@ -134,16 +135,17 @@ void copy_level_unchanged(const asa::SplitInput& in, bool normals, AsaResult& re
 // Level 0 tests every edge; later levels only the edges of faces the last
 // split made (their normals came with the split), unless most faces are new
 // anyway. Returns false, leaving `out` alone, when no face is a target.
-bool split_adaptive_level(int level, const AsaOptions& options, asa::SplitInput& in,
-                          AsaWorkspace::Buffers& ws, asa::LevelMesh& out,
+bool split_adaptive_level(int level, const AsaOptions& options, const asa::ViewTest* camera,
+                          asa::SplitInput& in, AsaWorkspace::Buffers& ws, asa::LevelMesh& out,
                           std::vector<FaceKind>* kinds) {
   const asa::LevelView& view = in.mesh;
   const bool mostly_fresh =
       level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
   const uint32_t targets =
       level == 0 || mostly_fresh
-          ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
-          : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
+          ? asa::mark_targets(view, ws.normals, options.flatness, ws.target, camera)
+          : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target,
+                                         camera);
   if (targets == 0) return false;
   const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
   in.normals = ws.normals.data();
@@ -226,6 +228,8 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   }
 
   const bool normals = !mesh.normals.empty();
+  std::optional<asa::ViewTest> camera;
+  if (options.view.enabled && !options.uniform) camera.emplace(options.view);
   for (int level = 0; level < options.levels; ++level) {
     const bool last = level + 1 == options.levels;
     asa::LevelMesh& out = ws.levels[level % 2];
@@ -237,7 +241,8 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
       ws.stats.targets.push_back(in.mesh.face_count);
       ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) -
                                      in.mesh.vertex_count);
-    } else if (!split_adaptive_level(level, options, in, ws, out, kinds)) {
+    } else if (!split_adaptive_level(level, options, camera ? &*camera : nullptr, in, ws, out,
+                                     kinds)) {
       // Nothing bends: this and every later level would copy the mesh
       // unchanged (same normals, same verdicts). Stop here.
       copy_level_unchanged(in, normals, result);
