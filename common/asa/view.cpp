@@ -94,8 +94,8 @@ Status parse_camera(const std::string& text, AsaCamera& camera) {
 
 std::string format_camera(const AsaCamera& c) {
   char text[256];
-  std::snprintf(text, sizeof text, "%g,%g,%g,%g,%g,%g,%g", c.eye.x, c.eye.y, c.eye.z, c.target.x,
-                c.target.y, c.target.z, c.fov_degrees);
+  std::snprintf(text, sizeof text, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", c.eye.x, c.eye.y, c.eye.z,
+                c.target.x, c.target.y, c.target.z, c.fov_degrees);
   return text;
 }
 

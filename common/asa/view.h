@@ -56,6 +56,7 @@ Status check_view(const AsaView& view);
 // and fov_degrees; width and height are left alone. kInvalidArgument naming
 // the text when it is not 6 or 7 numbers or the camera is malformed.
 Status parse_camera(const std::string& text, AsaCamera& camera);
+// The --camera form of a camera; floats round-trip exactly (9 digits).
 std::string format_camera(const AsaCamera& camera);
 
 // The snapshot camera: the viewer's default framing of `mesh` (the
