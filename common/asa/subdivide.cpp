@@ -191,6 +191,22 @@ void take_last_level(asa::LevelMesh& out, bool source, bool normals, AsaResult& 
   }
 }
 
+// With a camera: can any edge of the mesh matter on screen? Each face asks
+// for its three edges with its own normal on both sides: an interior edge
+// is asked from both its faces, so it passes here exactly when the real
+// test (both normals) would let it through from either side. One pass over
+// the faces, no adjacency: when nothing may matter, ASA is a copy.
+bool any_edge_may_matter(const Mesh& mesh, const asa::ViewTest& view) {
+  const Vec3f* p = mesh.positions.data();
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3f a = p[t[0]], b = p[t[1]], c = p[t[2]];
+    const Vec3f n = normalized(cross(b - a, c - a));
+    if (view.matters(a, b, n, n) || view.matters(b, c, n, n) || view.matters(c, a, n, n))
+      return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
@@ -204,6 +220,25 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   ws.stats.targets.clear();
   ws.stats.split_edges.clear();
   const uint32_t F = mesh.face_count();
+
+  std::optional<asa::ViewTest> camera;
+  if (options.view.enabled && !options.uniform) camera.emplace(options.view);
+  if (camera && options.levels > 0 && F > 0 && !any_edge_may_matter(mesh, *camera)) {
+    // The mesh is finer than the tolerance (or out of view) everywhere:
+    // what the levels would give, without building adjacency.
+    result.mesh.positions = mesh.positions;
+    result.mesh.triangles = mesh.triangles;
+    result.mesh.colors = mesh.colors;
+    result.mesh.texcoords = mesh.texcoords;
+    result.mesh.normals.clear();
+    if (!mesh.normals.empty()) result.mesh.normals = compute_vertex_normals(result.mesh);
+    result.face_kind.assign(F, FaceKind::kUntouched);
+    result.source_face.resize(options.track_source_faces ? F : 0);
+    for (uint32_t f = 0; f < result.source_face.size(); ++f) result.source_face[f] = f;
+    ws.stats.targets.assign(options.levels, 0);
+    ws.stats.split_edges.assign(options.levels, 0);
+    return {};
+  }
 
   asa::SplitInput in;
   if (auto built = build_base_level(mesh, options, ws, in.mesh); !built) return built;
@@ -228,8 +263,6 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   }
 
   const bool normals = !mesh.normals.empty();
-  std::optional<asa::ViewTest> camera;
-  if (options.view.enabled && !options.uniform) camera.emplace(options.view);
   for (int level = 0; level < options.levels; ++level) {
     const bool last = level + 1 == options.levels;
     asa::LevelMesh& out = ws.levels[level % 2];
