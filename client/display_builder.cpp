@@ -88,6 +88,12 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   } else if (path_ == AsaPath::kAuto && changes.full) {
     plain_full = true;
   }
+  if (plain_full && options.view.enabled && path_ != AsaPath::kFull) {
+    // A camera bounds the work: the incremental subdivider's full update
+    // subdivides only the region the screen may refine (incremental.h).
+    if (s.incremental) s.incremental->reset();
+    plain_full = false;
+  }
   report.pixel_tolerance = options.view.enabled ? options.view.pixel_tolerance : 0;
   report.levels_used = options.levels;
   auto budgeted_full_run = [&]() -> Result<DisplayMesh> {

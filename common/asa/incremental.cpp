@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/asa/view.h"
 #include "common/mesh/adjacency.h"
 
 namespace meshstream {
@@ -46,7 +47,67 @@ void IncrementalSubdivider::remember(const Mesh& input) {
   has_previous_ = true;
 }
 
+// With a camera, a "full" update need not subdivide the whole mesh: faces
+// none of whose edges can matter on screen are not targets by themselves.
+// Taking the input itself (every face its own untouched patch) as the
+// previous result, the faces that may matter are the change, and the region
+// path below subdivides them with their rings and proves the seam. False
+// when the region would be most of the mesh or cannot be proven (the caller
+// subdivides everything).
+bool IncrementalSubdivider::view_region_update(const Mesh& input) {
+  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  if (!validate_arrays(input)) return false;
+  const asa::ViewTest test(options_.view);
+  changed_vertex_.assign(Vn, 0);
+  uint32_t candidates = 0;
+  for (const Triangle& t : input.triangles) {
+    const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
+    const Vec3f n = normalized(cross(b - a, c - a));
+    if (!test.matters(a, b, n, n) && !test.matters(b, c, n, n) && !test.matters(c, a, n, n))
+      continue;
+    ++candidates;
+    for (uint32_t v : t) changed_vertex_[v] = 1;
+  }
+  // The region is the candidates grown by several rings: give up early
+  // where that is bound to be most of the mesh.
+  if (4.0 * candidates > incremental_.max_dirty_fraction * Fn) return false;
+  result_.mesh.positions.assign(input.positions.begin(), input.positions.end());
+  result_.mesh.triangles.assign(input.triangles.begin(), input.triangles.end());
+  result_.mesh.colors.assign(input.colors.begin(), input.colors.end());
+  result_.mesh.texcoords.assign(input.texcoords.begin(), input.texcoords.end());
+  result_.mesh.normals.clear();
+  result_.face_kind.assign(Fn, FaceKind::kUntouched);
+  result_.source_face.resize(Fn);
+  for (uint32_t f = 0; f < Fn; ++f) result_.source_face[f] = f;
+  remember(input);
+  if (candidates == 0) {
+    if (!input.normals.empty()) result_.mesh.normals = compute_vertex_normals(result_.mesh);
+    return true;
+  }
+  index_vertex_faces(input);
+  for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
+    stats_.attempts = attempt + 1;
+    stats_.dirty_faces = grow_region(input, attempt);
+    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn) return false;
+    extract_region(input);
+    stats_.region_faces = region_.face_count();
+    if (!subdivide_into(region_, options_, workspace_, region_result_)) return false;
+    compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
+    if (!seam_matches()) continue;
+    splice(input);
+    std::swap(result_, next_);
+    remember(input);
+    return true;
+  }
+  return false;
+}
+
 Status IncrementalSubdivider::full_update(const Mesh& input) {
+  if (options_.view.enabled && !options_.uniform && options_.levels > 0) {
+    stats_.full = false;
+    if (view_region_update(input)) return {};
+    stats_ = {};
+  }
   stats_.full = true;
   stats_.dirty_faces = input.face_count();
   stats_.region_faces = input.face_count();

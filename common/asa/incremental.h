@@ -50,7 +50,10 @@ class IncrementalSubdivider {
   // bit-identical corner positions; vertex numbering may differ beyond the
   // input vertices, which keep their indices). Errors as subdivide(); after an
   // error the next update is a full one.
-  // Cost: O(changed region) subdivision + O(output) copying.
+  // Cost: O(changed region) subdivision + O(output) copying. With a camera
+  // (options.view), even a first or full update subdivides only the region
+  // of faces whose edges may matter on screen (one pass over the faces finds
+  // them), when that region is small.
   Status update(const Mesh& input);
 
   const AsaResult& result() const { return result_; }
@@ -70,6 +73,7 @@ class IncrementalSubdivider {
 
  private:
   Status full_update(const Mesh& input);
+  bool view_region_update(const Mesh& input);
   void remember(const Mesh& input);
   // The phases of update(), in order (see incremental.cpp).
   uint32_t mark_changed_vertices(const Mesh& input);
