@@ -5,7 +5,7 @@
 // Writes bench/report/view_asa.md (or DIR/view_asa.md with --report-dir).
 //
 // Usage: view_asa_bench [--report-dir DIR] [--meshes a,b] [--big FILE[,FILE]]
-//                       [--streams DIR]
+//                       [--streams DIR] [--no-big-pictures]
 // --big: large PLY files (read only), measured on the full mesh; an HCS of
 // the same stem in --streams DIR adds its early and middle prefixes.
 #include <algorithm>
@@ -220,8 +220,10 @@ int main(int argc, char** argv) {
   std::string report_dir = std::string(MESHSTREAM_SOURCE_DIR) + "/bench/report";
   std::vector<std::string> meshes = bench::kRealMeshes, big;
   std::string streams;
+  bool big_pictures = true;  // --no-big-pictures: big models' face counts and orbit only
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--no-big-pictures") big_pictures = false;
     if (a == "--report-dir" && i + 1 < argc) report_dir = argv[++i];
     if (a == "--meshes" && i + 1 < argc) meshes = bench::split_commas(argv[++i]);
     if (a == "--big" && i + 1 < argc) big = bench::split_commas(argv[++i]);
@@ -254,10 +256,12 @@ int main(int argc, char** argv) {
     std::vector<uint8_t> stream;
     const std::string hcs = streams + "/" + fs::path(path).stem().string() + ".hcs";
     if (!streams.empty() && fs::exists(hcs)) stream = read_bytes(hcs);
-    for (const Prefix& p : prefixes(imported->mesh, stream.empty() ? nullptr : &stream))
-      pictures.push_back(picture_row(name, p, 1024, 768));
+    if (big_pictures) {
+      for (const Prefix& p : prefixes(imported->mesh, stream.empty() ? nullptr : &stream))
+        pictures.push_back(picture_row(name, p, 1024, 768));
+    }
     faces_rows.push_back(picture_row(name, {"full", imported->mesh}, 1280, 720));
-    orbits.emplace_back(name, orbit(imported->mesh, 1280, 720, 20));
+    orbits.emplace_back(name, orbit(imported->mesh, 1280, 720, 10));
     std::fprintf(stderr, "orbit %s: median %.1f ms\n", name.c_str(), median(orbits.back().second));
   }
 
