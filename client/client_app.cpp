@@ -193,6 +193,12 @@ class StreamingRun {
     settings.asa_enabled = o.asa_enabled;
     settings.asa = o.asa;
     settings.path = o.asa_path;
+    settings.view.dependent = !o.view_independent;
+    settings.view.camera = o.camera;
+    settings.view.width = o.width;
+    settings.view.height = o.height;
+    settings.view.pixel_tolerance = o.pixel_tolerance;
+    settings.view.max_display_faces = o.max_display_faces;
     return settings;
   }
 
@@ -232,6 +238,7 @@ class StreamingRun {
 
   // Pipeline thread, after each published frame: events and files.
   void on_frame(const DisplayFrame& frame, const FrameInfo& info) {
+    if (!info.new_records && info.rerun) log_.view_update(frame, info, elapsed());
     if (info.new_records) {
       last_frame_ = frame;
       ++display_updates_;
@@ -241,7 +248,8 @@ class StreamingRun {
       if (!o_.out_dir.empty() && o_.saves_record(record))
         keep_error(write_mesh(*frame.display, record_file(o_.out_dir, record)));
       if (o_.snapshot_at && !snapshot_done_ && record == *o_.snapshot_at && hooks_.snapshot) {
-        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(), o_, o_.snapshot_png));
+        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),
+                                   frame.camera ? &*frame.camera : nullptr, o_, o_.snapshot_png));
         snapshot_done_ = true;
       }
     }
@@ -253,7 +261,8 @@ class StreamingRun {
             write_mesh(*frame.decoded, (fs::path(o_.out_dir) / "final.decoded.ply").string()));
       }
       if (!o_.snapshot_png.empty() && !o_.snapshot_at && hooks_.snapshot) {
-        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(), o_, o_.snapshot_png));
+        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),
+                                   frame.camera ? &*frame.camera : nullptr, o_, o_.snapshot_png));
         snapshot_done_ = true;
       }
     }

@@ -17,9 +17,10 @@ namespace meshstream::client {
 struct ViewerHooks {
   // Runs the window on the calling (main) thread until it closes.
   std::function<Status(const ClientOptions&, LatestFrameMailbox&, StreamControls&)> run_view;
-  // Renders a display mesh to a PNG.
-  std::function<Status(const Mesh&, const std::vector<FaceKind>*, const ClientOptions&,
-                       const std::string& png)>
+  // Renders a display mesh to a PNG with the camera its display was made
+  // for (null: framed on the mesh itself).
+  std::function<Status(const Mesh&, const std::vector<FaceKind>*, const AsaCamera*,
+                       const ClientOptions&, const std::string& png)>
       snapshot;
 };
 

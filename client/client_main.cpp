@@ -25,8 +25,10 @@ int main(int argc, char** argv) {
     return run_viewer(v, frames, controls);
   };
   hooks.snapshot = [](const meshstream::Mesh& mesh, const std::vector<meshstream::FaceKind>* kinds,
-                      const ClientOptions& o, const std::string& png) {
+                      const meshstream::AsaCamera* camera, const ClientOptions& o,
+                      const std::string& png) {
     SnapshotOptions s;
+    if (camera) s.camera = *camera;
     s.width = o.width;
     s.height = o.height;
     s.crease_degrees = o.asa.crease_degrees;

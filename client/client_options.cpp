@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -72,6 +73,21 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->capture_default_str();
   bool no_asa = false;
   app.add_flag("--no-asa", no_asa, "show the decoded mesh without ASA");
+  std::string camera_text;
+  app.add_option("--camera", camera_text,
+                 "EX,EY,EZ,TX,TY,TZ[,FOV_DEG]: refine for this camera (eye, target, vertical "
+                 "field of view, default 45) at --width x --height, and render --snapshot with it "
+                 "(default: the snapshot camera, the model framed as the viewer starts)");
+  app.add_option("--pixel-tolerance", o.pixel_tolerance,
+                 "view-dependent ASA refines an edge only where its projected size exceeds PX "
+                 "pixels (and it is in view and not back-facing)")
+      ->capture_default_str();
+  app.add_flag("--view-independent", o.view_independent,
+               "refine the whole decoded mesh whatever the camera sees (ASA as before the camera)");
+  app.add_option("--max-display-faces", o.max_display_faces,
+                 "never show more faces: above it, the update raises the pixel tolerance (the "
+                 "refinement event says so)")
+      ->capture_default_str();
   app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
       ->check(CLI::IsMember({"auto", "full", "incremental"}))
       ->capture_default_str();
@@ -161,6 +177,22 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   }
   if (o.out_dir.empty() && (o.out_every || !o.out_at.empty() || o.overwrite))
     return usage("--out-every, --out-at and --overwrite need --out DIR");
+  if (!camera_text.empty()) {
+    AsaCamera camera;
+    if (auto parsed = parse_camera(camera_text, camera); !parsed)
+      return usage(parsed.error().message);
+    o.camera = camera;
+  }
+  if (!std::isfinite(o.pixel_tolerance) || o.pixel_tolerance <= 0)
+    return usage("--pixel-tolerance " + app.get_option("--pixel-tolerance")->results().front() +
+                 ": must be above 0 pixels");
+  if (o.max_display_faces == 0) return usage("--max-display-faces 0: must be at least 1");
+  if (o.view_independent && o.camera)
+    return usage("--view-independent refines the whole mesh: it takes no --camera");
+  if (o.camera) {
+    o.camera->width = o.width;
+    o.camera->height = o.height;
+  }
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
   o.asa_enabled = !no_asa;
   o.asa_path = path == "full"          ? AsaPath::kFull

@@ -4,6 +4,8 @@
 //   [--out-every N]
 //     [--out-at LIST] [--overwrite]] [--asa-levels L]
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
+//     [--camera EX,EY,EZ,TX,TY,TZ[,FOV]] [--pixel-tolerance PX] [--view-independent]
+//     [--max-display-faces N]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
 //     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
 //     [--exit-after N] [--exit-after-records N] [--wait]
@@ -35,6 +37,12 @@ struct ClientOptions {
   bool asa_enabled = true;            // --no-asa turns it off
   AsaOptions asa;                     // levels, flatness, rule, crease
   AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)
+  // View-dependent ASA (common/asa/view.h): refine for this camera (default:
+  // the snapshot camera, the viewer's framing at --width x --height).
+  std::optional<AsaCamera> camera;         // --camera
+  float pixel_tolerance = 2;               // --pixel-tolerance
+  bool view_independent = false;           // --view-independent: the whole mesh
+  uint64_t max_display_faces = 4'000'000;  // --max-display-faces
   Budget budget;
   bool json = false;
   bool view = false;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "common/asa/display_budget.h"
 #include "common/asa/incremental.h"
 
 namespace meshstream::client {
@@ -14,9 +15,11 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
+// Everything but the view (a camera move is handled incrementally).
 bool same_options(const AsaOptions& a, const AsaOptions& b) {
-  return a.levels == b.levels && a.flatness == b.flatness && a.uniform == b.uniform &&
-         a.rule == b.rule && a.tension == b.tension && a.crease_degrees == b.crease_degrees;
+  return a.view.enabled == b.view.enabled && a.levels == b.levels && a.flatness == b.flatness &&
+         a.uniform == b.uniform && a.rule == b.rule && a.tension == b.tension &&
+         a.crease_degrees == b.crease_degrees;
 }
 }  // namespace
 
@@ -89,11 +92,37 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   } else if (path_ == AsaPath::kAuto && changes.full) {
     plain_full = true;
   }
+  if (plain_full && options.view.enabled && path_ != AsaPath::kFull) {
+    // A camera bounds the work: the incremental subdivider's full update
+    // subdivides only the region the screen may refine (incremental.h).
+    if (s.incremental) s.incremental->reset();
+    plain_full = false;
+  }
+  report.pixel_tolerance = options.view.enabled ? options.view.pixel_tolerance : 0;
+  report.levels_used = options.levels;
+  auto budgeted_full_run = [&]() -> Result<DisplayMesh> {
+    s.incremental.reset();
+    AsaResult result;
+    BudgetOutcome outcome;
+    if (auto st = subdivide_within_budget(mesh, options, max_faces_, s.workspace, result, outcome);
+        !st)
+      return tl::unexpected(st.error());
+    report.pixel_tolerance = outcome.pixel_tolerance;
+    report.budget_limited = outcome.limited;
+    report.levels_used = outcome.levels;
+    report.incremental = false;
+    report.asa_ms = ms_since(start);
+    DisplayMesh out;
+    out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
+    out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
+    return out;
+  };
   if (plain_full) {
     s.incremental.reset();
     AsaResult result;
     if (auto st = subdivide_into(mesh, options, s.workspace, result); !st)
       return tl::unexpected(st.error());
+    if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();
     report.asa_ms = ms_since(start);
     if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
     DisplayMesh out;
@@ -109,10 +138,13 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
     io.max_dirty_fraction = path_ == AsaPath::kIncremental ? 1.0f : s.dirty_fraction;
     s.incremental = std::make_unique<IncrementalSubdivider>(options, io);
     s.incremental_options = options;
+  } else {
+    s.incremental->set_view(options.view);  // nothing when it is the same
   }
   if (auto st = s.incremental->update(mesh); !st) return tl::unexpected(st.error());
   const IncrementalStats& stats = s.incremental->last_update();
   const AsaResult& result = s.incremental->result();
+  if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();
   auto display = std::make_shared<const Mesh>(result.mesh);
   auto kinds = std::make_shared<const std::vector<FaceKind>>(result.face_kind);
   report.asa_ms = ms_since(start);

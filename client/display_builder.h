@@ -23,6 +23,11 @@ struct BuildReport {
   double asa_ms = 0;
   bool incremental = false;   // which path produced this display mesh
   uint32_t region_faces = 0;  // decoded faces recomputed (incremental path)
+  // View-dependent ASA: the tolerance used (0 without a camera); raised
+  // above the requested one when the display budget was reached.
+  float pixel_tolerance = 0;
+  bool budget_limited = false;  // the budget cut this update (tolerance or levels)
+  int levels_used = 0;          // ASA levels the kept run allowed
 };
 
 struct DisplayMesh {
@@ -38,11 +43,14 @@ class DisplayBuilder {
   DisplayBuilder& operator=(DisplayBuilder&&) noexcept;
 
   void set_path(AsaPath path) { path_ = path; }
+  // The display budget (--max-display-faces; 0 = none), see display_budget.h.
+  void set_max_faces(uint64_t max_faces) { max_faces_ = max_faces; }
 
   // The display mesh of `decoded`, which differs from the previous call's
   // input by `changes` (ignored when `options_changed` or on the first
-  // call). `decoded_shared` is returned as is when ASA is off. Errors: those
-  // of subdivide() (a mesh ASA cannot work on).
+  // call). A new camera or tolerance in options.view alone is not an options
+  // change: the incremental path redoes only what the views may refine. `decoded_shared` is
+  // returned as is when ASA is off. Errors: those of subdivide() (a mesh ASA cannot work on).
   Result<DisplayMesh> build(const std::shared_ptr<const Mesh>& decoded_shared,
                             const MeshChanges& changes, bool asa_enabled, const AsaOptions& options,
                             bool options_changed, BuildReport& report);
@@ -51,6 +59,7 @@ class DisplayBuilder {
   struct State;
   std::unique_ptr<State> state_;
   AsaPath path_ = AsaPath::kAuto;
+  uint64_t max_faces_ = 0;
 };
 
 }  // namespace meshstream::client

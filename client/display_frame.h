@@ -29,6 +29,11 @@ struct DisplayFrame {
   double asa_ms = 0;
   uint32_t coalesced_updates = 0;  // decoder updates merged into this frame
   bool final = false;              // the stream is complete (or its budget reached)
+  // The camera the display was refined for (view-dependent ASA) and that
+  // snapshots render with: --camera, the viewer's, or the snapshot camera.
+  std::optional<AsaCamera> camera;
+  float pixel_tolerance = 0;    // the tolerance used; 0: view-independent or no ASA
+  bool budget_limited = false;  // --max-display-faces cut this update
 };
 
 // Latest-wins mailbox: the producer never waits for the consumer, and a
@@ -88,6 +93,13 @@ class StreamControls {
   virtual void resume() = 0;
   virtual bool paused() const = 0;
   virtual double current_rate_bytes_per_s() const = 0;
+  // View-dependent ASA: refine for this camera from now on (the viewer's,
+  // as it orbits and zooms; re-runs ASA for what the move changed), and
+  // with this pixel tolerance (> 0). pixel_tolerance() is 0 when ASA
+  // refines the whole mesh (--view-independent).
+  virtual void set_view_camera(const AsaCamera& camera) { (void)camera; }
+  virtual void set_pixel_tolerance(float pixels) { (void)pixels; }
+  virtual float pixel_tolerance() const { return 0; }
 };
 
 }  // namespace meshstream::client

@@ -8,6 +8,35 @@ namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
 
+namespace {
+
+// The camera and tolerance of this update into the ASA options. The
+// snapshot camera is fitted on this very mesh, so the display of a record
+// does not depend on which updates were merged before it (--out files are
+// the same on any link). O(V + F): the fit and the facing sign.
+AsaOptions options_with_view(const PipelineSettings& settings, const Mesh& decoded,
+                             std::optional<AsaCamera>& camera) {
+  camera = settings.view.camera ? *settings.view.camera
+                                : fit_camera(decoded, settings.view.width, settings.view.height);
+  AsaOptions options = settings.asa;
+  options.view.enabled = settings.view.dependent;
+  options.view.camera = *camera;
+  options.view.pixel_tolerance = settings.view.pixel_tolerance;
+  if (options.view.enabled && settings.asa_enabled)
+    options.view.facing_sign = facing_sign_of(decoded);
+  return options;
+}
+
+// The options differ in more than the camera and tolerance.
+bool asa_settings_changed(const PipelineSettings& a, const PipelineSettings& b) {
+  const AsaOptions &x = a.asa, &y = b.asa;
+  return a.asa_enabled != b.asa_enabled || a.view.dependent != b.view.dependent ||
+         x.levels != y.levels || x.flatness != y.flatness || x.uniform != y.uniform ||
+         x.rule != y.rule || x.tension != y.tension || x.crease_degrees != y.crease_degrees;
+}
+
+}  // namespace
+
 DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamSource* client,
                                  LatestFrameMailbox& mailbox, PipelineSettings settings,
                                  FrameObserver observer)
@@ -17,6 +46,7 @@ DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamSource* client,
       observer_(std::move(observer)),
       settings_(std::move(settings)) {
   builder_.set_path(settings_.path);
+  builder_.set_max_faces(settings_.view.max_display_faces);
 }
 
 DisplayPipeline::~DisplayPipeline() { stop(); }
@@ -71,7 +101,8 @@ void DisplayPipeline::loop() {
   MeshChanges changes;
   uint64_t seen_pokes = 0;
   bool outcome_seen = false;
-  std::optional<DisplayFrame> last;  // the newest published frame
+  std::optional<DisplayFrame> last;      // the newest published frame
+  std::optional<PipelineSettings> used;  // the settings of the last build
   while (decoded_.wait(seen_pokes, outcome_seen, std::chrono::milliseconds(200))) {
     const uint64_t pokes = decoded_.pokes();
     const bool rerun = pokes != seen_pokes;
@@ -132,8 +163,13 @@ void DisplayPipeline::loop() {
     info.rerun = rerun;
     frame.records_total = records_total;
     frame.bytes_total = bytes_total;
-    auto display = builder_.build(frame.decoded, changes, settings.asa_enabled, settings.asa,
-                                  rerun || !last, info.build);
+    // A new camera or tolerance alone is no options change: the builder
+    // redoes only what the views may refine.
+    const bool options_changed = !used || asa_settings_changed(settings, *used);
+    used = settings;
+    const AsaOptions options = options_with_view(settings, *frame.decoded, frame.camera);
+    auto display = builder_.build(frame.decoded, changes, settings.asa_enabled, options,
+                                  options_changed || !last, info.build);
     changes.clear();
     if (!display) {
       decoded_.stop();
@@ -144,6 +180,8 @@ void DisplayPipeline::loop() {
     frame.display = display->mesh;
     frame.face_kind = display->face_kind;
     frame.asa_ms = info.build.asa_ms;
+    frame.pixel_tolerance = settings.asa_enabled ? info.build.pixel_tolerance : 0;
+    frame.budget_limited = info.build.budget_limited;
     info.elapsed_ms = elapsed();
     publish(frame, info);
     last = frame;
@@ -172,6 +210,28 @@ AsaOptions DisplayPipeline::asa_options() const {
 bool DisplayPipeline::asa_enabled() const {
   std::lock_guard lock(mutex_);
   return settings_.asa_enabled;
+}
+
+void DisplayPipeline::set_view_camera(const AsaCamera& camera) {
+  {
+    std::lock_guard lock(mutex_);
+    settings_.view.camera = camera;
+  }
+  decoded_.poke();
+}
+
+void DisplayPipeline::set_pixel_tolerance(float pixels) {
+  if (!(pixels > 0)) return;
+  {
+    std::lock_guard lock(mutex_);
+    settings_.view.pixel_tolerance = pixels;
+  }
+  decoded_.poke();
+}
+
+float DisplayPipeline::pixel_tolerance() const {
+  std::lock_guard lock(mutex_);
+  return settings_.view.dependent ? settings_.view.pixel_tolerance : 0;
 }
 
 void DisplayPipeline::pause() {

@@ -30,10 +30,20 @@ struct FrameInfo {
 
 using FrameObserver = std::function<void(const DisplayFrame&, const FrameInfo&)>;
 
+// Where view-dependent ASA's camera comes from, and its limits.
+struct ViewSettings {
+  bool dependent = true;            // false: --view-independent (the whole mesh)
+  std::optional<AsaCamera> camera;  // --camera or the viewer's; else the snapshot camera
+  int width = 1024, height = 768;   // the snapshot camera's image (--width, --height)
+  float pixel_tolerance = 2;
+  uint64_t max_display_faces = 4'000'000;
+};
+
 struct PipelineSettings {
   bool asa_enabled = true;
-  AsaOptions asa;
+  AsaOptions asa;  // asa.view is filled per update from `view`
   AsaPath path = AsaPath::kAuto;
+  ViewSettings view;
 };
 
 class DisplayPipeline : public StreamControls {
@@ -62,6 +72,9 @@ class DisplayPipeline : public StreamControls {
   void resume() override;
   bool paused() const override;
   double current_rate_bytes_per_s() const override;
+  void set_view_camera(const AsaCamera& camera) override;
+  void set_pixel_tolerance(float pixels) override;
+  float pixel_tolerance() const override;
 
  private:
   void loop();

@@ -10,6 +10,16 @@ namespace {
 
 double round3(double x) { return std::round(x * 1000.0) / 1000.0; }
 
+// pixel_tolerance: the one used (null when ASA refines the whole mesh or
+// is off); budget_limited: --max-display-faces raised it (or cut levels).
+void add_view_fields(nlohmann::json& j, const DisplayFrame& fr) {
+  if (fr.pixel_tolerance > 0)
+    j["pixel_tolerance"] = round3(fr.pixel_tolerance);
+  else
+    j["pixel_tolerance"] = nullptr;
+  j["budget_limited"] = fr.budget_limited;
+}
+
 }  // namespace
 
 std::string human_bytes(double b) {
@@ -86,6 +96,7 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
                      {"coalesced", fr.coalesced_updates},
                      {"asa_path", info.build.incremental ? "incremental" : "full"},
                      {"final", fr.final}};
+    add_view_fields(j, fr);
     line(j.dump());
     return;
   }
@@ -99,6 +110,20 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
                human_bytes(rate).c_str());
   std::fflush(stderr);
   progress_shown_ = true;
+}
+
+void EventLog::view_update(const DisplayFrame& fr, const FrameInfo& info, double elapsed_ms) {
+  std::lock_guard lock(mutex_);
+  if (!json_) return;
+  nlohmann::json j{{"event", "view"},
+                   {"display_vertices", fr.display->vertex_count()},
+                   {"display_faces", fr.display->face_count()},
+                   {"asa_ms", round3(fr.asa_ms)},
+                   {"region_faces", info.build.region_faces},
+                   {"asa_path", info.build.incremental ? "incremental" : "full"},
+                   {"elapsed_ms", round3(elapsed_ms)}};
+  add_view_fields(j, fr);
+  line(j.dump());
 }
 
 void EventLog::reconnecting(const Error& error, int attempt) {

@@ -41,6 +41,9 @@ class EventLog {
   void header(const StreamFacts& facts, double elapsed_ms);
   void record(const AppliedRecord& record, double elapsed_ms);
   void refinement(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms, double rate);
+  // A re-run of ASA without new records (camera or options changed): a
+  // "view" event with --json, nothing otherwise.
+  void view_update(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms);
   void reconnecting(const Error& error, int attempt);
   // --wait: the model is not ready yet. One line (or `waiting` event) each
   // time its state or whole percent changes.

@@ -1,7 +1,9 @@
 // `meshstream subdivide IN -o OUT [--levels L] [--flatness T] [--uniform]
-//  [--rule zorin|projection] [--crease DEG] [--tension W]`:
+//  [--rule zorin|projection] [--crease DEG] [--tension W]
+//  [--camera EX,EY,EZ,TX,TY,TZ[,FOV] [--pixel-tolerance PX] [--width W --height H]]`:
 // ASA (adaptive modified Butterfly, common/asa/subdivide.h) on a mesh file.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -19,12 +21,40 @@ struct SubdivideArgs {
   std::string input, output;
   AsaOptions options;
   std::string rule = "zorin";
+  std::string camera;  // view-dependent ASA when set
+  float pixel_tolerance = 2;
+  int width = 1024, height = 768;
 };
+
+// --camera and its companions into options.view; the exit code 2 after a
+// usage error (printed), else 0.
+int set_view(SubdivideArgs& args) {
+  auto usage = [](const std::string& why) {
+    std::fprintf(stderr, "meshstream subdivide: %s (see --help)\n", why.c_str());
+    return 2;
+  };
+  if (args.camera.empty()) return 0;
+  AsaView& view = args.options.view;
+  if (auto parsed = parse_camera(args.camera, view.camera); !parsed)
+    return usage(parsed.error().message);
+  if (!(args.pixel_tolerance > 0) || !std::isfinite(args.pixel_tolerance)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", args.pixel_tolerance);
+    return usage(std::string("--pixel-tolerance ") + text + ": must be above 0 pixels");
+  }
+  if (args.options.uniform) return usage("--camera needs ASA: it cannot go with --uniform");
+  view.enabled = true;
+  view.camera.width = args.width;
+  view.camera.height = args.height;
+  view.pixel_tolerance = args.pixel_tolerance;
+  return 0;
+}
 
 int run_subdivide(SubdivideArgs& args) {
   auto imported = import_mesh(args.input);
   if (!imported) return report_failure(imported.error());
   const Mesh& mesh = imported->mesh;
+  if (args.options.view.enabled) args.options.view.facing_sign = facing_sign_of(mesh);
   args.options.rule =
       args.rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
 
@@ -46,6 +76,10 @@ int run_subdivide(SubdivideArgs& args) {
       result->mesh.vertex_count(), result->mesh.face_count(),
       args.options.uniform ? "uniform" : ("ASA t=" + std::to_string(args.options.flatness)).c_str(),
       args.options.levels, args.options.levels == 1 ? "" : "s", ms);
+  if (args.options.view.enabled)
+    std::printf("  camera %s at %dx%d, pixel tolerance %g\n",
+                format_camera(args.options.view.camera).c_str(), args.width, args.height,
+                args.options.view.pixel_tolerance);
   if (!args.options.uniform) {
     const AsaStats& stats = workspace.last_stats();
     for (size_t level = 0; level < stats.targets.size(); ++level) {
@@ -92,7 +126,24 @@ void add_subdivide_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--tension", args->options.tension, "omega of the ten-point stencil")
       ->check(CLI::Range(-0.25f, 0.25f))
       ->capture_default_str();
-  cmd->callback([args, &exit_code] { exit_code = run_subdivide(*args); });
+  cmd->add_option("--camera", args->camera,
+                  "EX,EY,EZ,TX,TY,TZ[,FOV_DEG]: view-dependent ASA for this camera (eye, target, "
+                  "vertical field of view, default 45): a bent edge is split only where it is in "
+                  "view, not back-facing and projects above --pixel-tolerance (default: the whole "
+                  "mesh)");
+  cmd->add_option("--pixel-tolerance", args->pixel_tolerance,
+                  "with --camera: edges projecting to PX pixels or less stay")
+      ->capture_default_str();
+  cmd->add_option("--width", args->width, "with --camera: image width in pixels")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
+  cmd->add_option("--height", args->height, "with --camera: image height in pixels")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
+  cmd->callback([args, &exit_code] {
+    exit_code = set_view(*args);
+    if (exit_code == 0) exit_code = run_subdivide(*args);
+  });
 }
 
 }  // namespace meshstream::tools

@@ -71,6 +71,32 @@ Mat4 OrbitCamera::projection(float aspect) const {
   return mat4_perspective(fovy, aspect, z_near, z_far);
 }
 
+void OrbitCamera::look_from(const AsaCamera& c, const Mesh& mesh) {
+  target = c.target;
+  const Vec3f offset = c.eye - c.target;
+  distance = std::max(length(offset), 1e-12f);
+  const Vec3f dir = offset / distance;
+  pitch = std::clamp(std::asin(std::clamp(dir.y, -1.0f, 1.0f)), -1.55f, 1.55f);
+  yaw = std::atan2(dir.x, dir.z);
+  fovy = c.fov_degrees * 3.14159265358979f / 180.0f;
+  scene_radius = 1e-6f;
+  if (!mesh.positions.empty()) {
+    const BoundingBox box = bounding_box(mesh);
+    scene_radius =
+        std::max(box.diagonal() / 2 + length((box.min + box.max) * 0.5f - target), 1e-6f);
+  }
+}
+
+AsaCamera OrbitCamera::asa_camera(int width, int height) const {
+  AsaCamera c;
+  c.eye = eye();
+  c.target = target;
+  c.fov_degrees = fovy * 180.0f / 3.14159265358979f;
+  c.width = std::max(width, 1);
+  c.height = std::max(height, 1);
+  return c;
+}
+
 void OrbitCamera::orbit(float dx, float dy) {
   yaw -= dx * 0.008f;
   pitch = std::clamp(pitch + dy * 0.008f, -1.55f, 1.55f);

@@ -5,6 +5,7 @@
 #include <array>
 #include <vector>
 
+#include "common/asa/view.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream::client {
@@ -23,6 +24,13 @@ class OrbitCamera {
   // centred. An empty mesh resets to the unit sphere. O(V) per refinement
   // round (three rounds).
   void frame(const Mesh& mesh, float aspect, float fill = 0.85f);
+
+  // Looks from camera.eye at camera.target with its field of view (pitch
+  // clamped as orbit() does; the image size is the caller's); the near and
+  // far planes enclose `mesh`.
+  void look_from(const AsaCamera& camera, const Mesh& mesh);
+  // This camera for view-dependent ASA on a width x height image.
+  AsaCamera asa_camera(int width, int height) const;
 
   // Mouse gestures in pixels of a viewport `height` pixels tall.
   void orbit(float dx_pixels, float dy_pixels);

@@ -3,6 +3,7 @@
 // window, so snapshots look exactly like what the viewer shows.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "client/viewer/mesh_renderer.h"
@@ -27,9 +28,13 @@ struct OffscreenRequest {
   // Viewing direction (radians); the distance and target frame the model.
   float yaw = 0.6f;
   float pitch = 0.35f;
+  // When set, this camera instead of the framing (the one view-dependent
+  // ASA refined for, so the picture matches the refinement).
+  std::optional<AsaCamera> camera;
 };
 
-// Renders `mesh` framed as a whole (OrbitCamera::frame) into an image.
+// Renders `mesh` framed as a whole (OrbitCamera::frame), or seen by
+// request.camera, into an image.
 // kInvalidMesh when the mesh breaks validate_arrays; kInvalidArgument for a
 // size outside 1..8192 or the GL limit; kUnsupported when OSMesa cannot make
 // a 3.3 core context. Calls are serialized (one context at a time). Cost:

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct ViewerOptions {
   int initial_coloring = 0;
   bool initial_wireframe = false;
   std::string screenshot_dir = ".";  // where the screenshot button writes
+  // Scripted orbit: the camera turns this many degrees per frame once the
+  // model is framed (0: off); for captures and benchmarks under Xvfb.
+  float orbit_degrees_per_frame = 0;
 };
 
 // Opens the window and runs the render loop on the calling thread until the
@@ -39,7 +43,8 @@ struct ViewerOptions {
 // For scripted captures (docs/images/make_snapshot_strip.sh) the environment
 // may fill options the caller left at their defaults:
 // MESHSTREAM_VIEWER_CAPTURE=FILE.png (exit screenshot with the panel),
-// MESHSTREAM_VIEWER_COLORING=shaded|kinds|distance, MESHSTREAM_VIEWER_WIREFRAME=1.
+// MESHSTREAM_VIEWER_COLORING=shaded|kinds|distance, MESHSTREAM_VIEWER_WIREFRAME=1,
+// MESHSTREAM_VIEWER_ORBIT=DEGREES (turned per frame).
 Status run_viewer(const ViewerOptions& options, LatestFrameMailbox& frames,
                   StreamControls& controls);
 
@@ -51,10 +56,13 @@ struct SnapshotOptions {
   // Shading keeps edges bending more than this sharp (the user's --crease;
   // 0: kDefaultShadingCreaseDegrees, 60).
   float crease_degrees = 0.0f;
+  // The camera to render with (the one the display was refined for); unset:
+  // the whole model framed.
+  std::optional<AsaCamera> camera;
 };
 
 // Renders `mesh` off-screen (OSMesa) with the viewer's renderer, framing the
-// whole model, and writes a PNG. `face_kind` may be null.
+// whole model (or from options.camera), and writes a PNG. `face_kind` may be null.
 Status render_snapshot(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
                        const SnapshotOptions& options, const std::string& png_path);
 

@@ -76,6 +76,17 @@ PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const Dis
     ImGui::SliderFloat("crease angle", &state.asa.crease_degrees, 0.0f, 120.0f, "%.0f deg");
     actions.asa_changed |= ImGui::IsItemDeactivatedAfterEdit();
     if (ImGui::Checkbox("uniform (split all)", &state.asa.uniform)) actions.asa_changed = true;
+    if (state.pixel_tolerance > 0) {
+      // Refines only edges larger than this on screen, for the window's camera.
+      ImGui::SliderFloat("pixel tolerance", &state.pixel_tolerance, 0.25f, 32.0f, "%.2f px",
+                         ImGuiSliderFlags_Logarithmic);
+      actions.tolerance_changed |= ImGui::IsItemDeactivatedAfterEdit();
+      if (latest.pixel_tolerance > 0)
+        ImGui::Text("used %.2f px%s", latest.pixel_tolerance,
+                    latest.budget_limited ? "  (raised: face budget)" : "");
+    } else {
+      ImGui::TextUnformatted("view-independent (whole mesh)");
+    }
   }
 
   // Display.

@@ -28,6 +28,9 @@ struct PanelState {
   // ASA (mirrors StreamControls until the user edits)
   bool asa_enabled = true;
   AsaOptions asa;
+  // View-dependent ASA's pixel tolerance (0: ASA refines the whole mesh,
+  // --view-independent, and the control is hidden).
+  float pixel_tolerance = 0;
   // stream and renderer facts
   bool has_frame = false;
   bool paused = false;
@@ -41,6 +44,7 @@ struct PanelState {
 
 struct PanelActions {
   bool asa_changed = false;
+  bool tolerance_changed = false;  // pixel_tolerance edited (StreamControls::set_pixel_tolerance)
   bool toggle_pause = false;
   bool frame_model = false;
   bool history_changed = false;

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -195,6 +196,7 @@ class ViewerLoop {
     panel_.wireframe = options.initial_wireframe;
     panel_.asa_enabled = controls.asa_enabled();
     panel_.asa = controls.asa_options();
+    panel_.pixel_tolerance = controls.pixel_tolerance();
     glfwGetCursorPos(window, &last_x_, &last_y_);
   }
 
@@ -214,6 +216,8 @@ class ViewerLoop {
       for (const ScriptedCommand& c : commands) apply(c);
       input_.keys.clear();
       frame_model_if_asked(g);
+      activity |= orbit_if_scripted();
+      send_camera(g);
       const bool last_frame = draw_model(g);
       const PanelActions actions = draw_panel_and_swap(g, last_frame);
       apply_panel_actions(actions);
@@ -370,6 +374,30 @@ class ViewerLoop {
     }
   }
 
+  // 2d. View-dependent ASA refines for the window's camera: hand it to the
+  // pipeline when it moved (once the model is framed). The pipeline re-runs
+  // ASA on its own thread; this frame draws the display mesh it has.
+  void send_camera(const FrameGeometry& g) {
+    if (panel_.pixel_tolerance <= 0 || !framed_once_ || want_frame_ || g.fb_w <= 0 || g.fb_h <= 0)
+      return;
+    const AsaCamera camera = camera_.asa_camera(g.fb_w, g.fb_h);
+    if (sent_camera_ && camera.eye == sent_camera_->eye && camera.target == sent_camera_->target &&
+        camera.fov_degrees == sent_camera_->fov_degrees && camera.width == sent_camera_->width &&
+        camera.height == sent_camera_->height)
+      return;
+    controls_.set_view_camera(camera);
+    sent_camera_ = camera;
+    ++report_.cameras_sent;
+  }
+
+  // MESHSTREAM_VIEWER_ORBIT=DEG: a scripted orbit of DEG degrees per frame
+  // (for captures and the view-dependent benchmark under Xvfb).
+  bool orbit_if_scripted() {
+    if (options_.orbit_degrees_per_frame == 0 || !framed_once_ || want_frame_) return false;
+    camera_.yaw -= options_.orbit_degrees_per_frame * 3.14159265f / 180.0f;
+    return true;
+  }
+
   // 2c. Frame into the part of the window right of the panel: fit the
   // model to that width, then slide it over by half the panel.
   void frame_model_if_asked(const FrameGeometry& g) {
@@ -446,6 +474,7 @@ class ViewerLoop {
   // 4. What the panel asked for.
   void apply_panel_actions(const PanelActions& actions) {
     if (actions.asa_changed) controls_.set_asa(panel_.asa_enabled, panel_.asa);
+    if (actions.tolerance_changed) controls_.set_pixel_tolerance(panel_.pixel_tolerance);
     if (actions.toggle_pause) controls_.paused() ? controls_.resume() : controls_.pause();
     if (actions.frame_model) want_frame_ = true;
     if (actions.history_changed && !history_.empty()) {
@@ -511,6 +540,7 @@ class ViewerLoop {
   double last_x_ = 0, last_y_ = 0;
   Clock::time_point last_activity_;
   int last_window_w_ = 0, last_window_h_ = 0;
+  std::optional<AsaCamera> sent_camera_;  // the last camera handed to the pipeline
 };
 
 }  // namespace
@@ -556,6 +586,8 @@ Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,
   }
   if (!options.initial_wireframe)
     options.initial_wireframe = env("MESHSTREAM_VIEWER_WIREFRAME") == "1";
+  if (options.orbit_degrees_per_frame == 0 && !env("MESHSTREAM_VIEWER_ORBIT").empty())
+    options.orbit_degrees_per_frame = std::strtof(env("MESHSTREAM_VIEWER_ORBIT").c_str(), nullptr);
   auto report = run_viewer_with_report(options, frames, controls);
   if (!report) return tl::unexpected(report.error());
   return {};

@@ -39,6 +39,7 @@ struct ViewerReport {
   double mean_frame_ms = 0;              // wall time per frame, including waits
   uint64_t distance_uploads = 0;         // per-vertex distances to the final mesh shown
   uint64_t rejected_meshes = 0;          // frames whose mesh failed validate_arrays
+  uint64_t cameras_sent = 0;             // camera moves handed to view-dependent ASA
   std::vector<std::string> screenshots;  // PNGs written by kScreenshot
   int final_coloring = 0;                // ColorMode at exit
   bool final_wireframe = false;

@@ -72,10 +72,40 @@ uint32_t count_vertex_faces(const LevelView& m, std::vector<uint32_t>& faces) {
   return largest;
 }
 
+namespace {
+
+// The camera's veto, kept apart from the flatness rule so either can change
+// alone: the edge faced by corner c (between faces c / 3 and o / 3) is worth
+// splitting on screen.
+bool view_wants(const LevelView& m, const std::vector<Vec3f>& normals, const ViewTest* view,
+                uint32_t c, uint32_t o) {
+  if (view == nullptr) return true;
+  const Vec3f a = m.positions[m.corner_vertex[next_corner(c)]];
+  const Vec3f b = m.positions[m.corner_vertex[prev_corner(c)]];
+  return view->matters(a, b, normals[c / 3], normals[o / 3]);
+}
+
+}  // namespace
+
 uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, float t,
-                      std::vector<uint8_t>& target) {
+                      std::vector<uint8_t>& target, const ViewTest* view) {
   target.resize(m.face_count);
   uint32_t count = 0;
+  if (view != nullptr) {
+    // With a camera: the (rare) bent edges also ask the view.
+    for (uint32_t f = 0; f < m.face_count; ++f) {
+      const Vec3f n = normals[f];
+      uint8_t bent = 0;
+      for (uint32_t c = 3 * f; c < 3 * f + 3 && !bent; ++c) {
+        const uint32_t o = m.opposite[c];
+        if (o == kNone || m.feature_edge[c]) continue;
+        bent = dot(n, normals[o / 3]) <= t && view_wants(m, normals, view, c, o);
+      }
+      target[f] = bent;
+      count += bent;
+    }
+    return count;
+  }
   // Each face tests its own three edges (every edge is tested from both
   // sides: the dot product is symmetric bit for bit), so the loop writes only
   // its own flag and has no data-dependent skip.
@@ -95,7 +125,7 @@ uint32_t mark_targets(const LevelView& m, const std::vector<Vec3f>& normals, flo
 
 uint32_t mark_targets_near_fresh(const LevelView& m, const std::vector<Vec3f>& normals,
                                  const std::vector<uint8_t>& fresh, float t,
-                                 std::vector<uint8_t>& target) {
+                                 std::vector<uint8_t>& target, const ViewTest* view) {
   target.assign(m.face_count, 0);
   uint32_t count = 0;
   for (uint32_t f = 0; f < m.face_count; ++f) {
@@ -104,7 +134,7 @@ uint32_t mark_targets_near_fresh(const LevelView& m, const std::vector<Vec3f>& n
     for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
       const uint32_t o = m.opposite[c];
       if (o == kNone || m.feature_edge[c]) continue;
-      if (dot(n, normals[o / 3]) <= t) {
+      if (dot(n, normals[o / 3]) <= t && view_wants(m, normals, view, c, o)) {
         const uint32_t g = o / 3;
         count += !target[f] + !target[g];
         target[f] = target[g] = 1;

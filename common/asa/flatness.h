@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/asa/level_mesh.h"
+#include "common/asa/view.h"
 
 namespace meshstream::asa {
 
@@ -30,17 +31,21 @@ uint32_t count_vertex_faces(const LevelView& mesh, std::vector<uint32_t>& faces)
 // ASA targets: both faces of every interior, non-feature edge whose unit
 // normals satisfy N1.N2 <= t become targets (the pair is flat when
 // t < N1.N2 <= 1). Feature edges are sharp on purpose and ask for nothing.
-// Returns the number of targets. O(F).
+// With `view` (view-dependent ASA, view.h), a bent edge marks its faces
+// only where the camera says it matters on screen; the flatness rule itself
+// is the same. Returns the number of targets. O(F).
 uint32_t mark_targets(const LevelView& mesh, const std::vector<Vec3f>& normals, float t,
-                      std::vector<uint8_t>& target);
+                      std::vector<uint8_t>& target, const ViewTest* view = nullptr);
 
 // mark_targets after an adaptive split, testing only the edges of fresh faces
 // (fresh[f] != 0): an edge between two unchanged faces was flat at the level
-// before (else both would have been refined) and still is. Same targets as
+// before (else both would have been refined) and still is; with a camera,
+// or the camera ruled it out and still does (same edge, same camera). Same
+// targets as
 // mark_targets (the dot product is symmetric bit for bit). Returns the number
 // of targets. O(F) for the flags plus O(fresh faces).
 uint32_t mark_targets_near_fresh(const LevelView& mesh, const std::vector<Vec3f>& normals,
                                  const std::vector<uint8_t>& fresh, float t,
-                                 std::vector<uint8_t>& target);
+                                 std::vector<uint8_t>& target, const ViewTest* view = nullptr);
 
 }  // namespace meshstream::asa

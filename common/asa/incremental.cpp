@@ -2,8 +2,11 @@
 // with the neighbouring patches, splice. See incremental.h.
 #include "common/asa/incremental.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
+#include "common/asa/view.h"
 #include "common/mesh/adjacency.h"
 
 namespace meshstream {
@@ -44,7 +47,67 @@ void IncrementalSubdivider::remember(const Mesh& input) {
   has_previous_ = true;
 }
 
+// With a camera, a "full" update need not subdivide the whole mesh: faces
+// none of whose edges can matter on screen are not targets by themselves.
+// Taking the input itself (every face its own untouched patch) as the
+// previous result, the faces that may matter are the change, and the region
+// path below subdivides them with their rings and proves the seam. False
+// when the region would be most of the mesh or cannot be proven (the caller
+// subdivides everything).
+bool IncrementalSubdivider::view_region_update(const Mesh& input) {
+  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  if (!validate_arrays(input)) return false;
+  const asa::ViewTest test(options_.view);
+  changed_vertex_.assign(Vn, 0);
+  uint32_t candidates = 0;
+  for (const Triangle& t : input.triangles) {
+    const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
+    const Vec3f n = normalized(cross(b - a, c - a));
+    if (!test.matters(a, b, n, n) && !test.matters(b, c, n, n) && !test.matters(c, a, n, n))
+      continue;
+    ++candidates;
+    for (uint32_t v : t) changed_vertex_[v] = 1;
+  }
+  // The region is the candidates grown by several rings: give up early
+  // where that is bound to be most of the mesh.
+  if (4.0 * candidates > incremental_.max_dirty_fraction * Fn) return false;
+  result_.mesh.positions.assign(input.positions.begin(), input.positions.end());
+  result_.mesh.triangles.assign(input.triangles.begin(), input.triangles.end());
+  result_.mesh.colors.assign(input.colors.begin(), input.colors.end());
+  result_.mesh.texcoords.assign(input.texcoords.begin(), input.texcoords.end());
+  result_.mesh.normals.clear();
+  result_.face_kind.assign(Fn, FaceKind::kUntouched);
+  result_.source_face.resize(Fn);
+  for (uint32_t f = 0; f < Fn; ++f) result_.source_face[f] = f;
+  remember(input);
+  if (candidates == 0) {
+    if (!input.normals.empty()) result_.mesh.normals = compute_vertex_normals(result_.mesh);
+    return true;
+  }
+  index_vertex_faces(input);
+  for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
+    stats_.attempts = attempt + 1;
+    stats_.dirty_faces = grow_region(input, attempt);
+    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn) return false;
+    extract_region(input);
+    stats_.region_faces = region_.face_count();
+    if (!subdivide_into(region_, options_, workspace_, region_result_)) return false;
+    compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
+    if (!seam_matches()) continue;
+    splice(input);
+    std::swap(result_, next_);
+    remember(input);
+    return true;
+  }
+  return false;
+}
+
 Status IncrementalSubdivider::full_update(const Mesh& input) {
+  if (options_.view.enabled && !options_.uniform && options_.levels > 0) {
+    stats_.full = false;
+    if (view_region_update(input)) return {};
+    stats_ = {};
+  }
   stats_.full = true;
   stats_.dirty_faces = input.face_count();
   stats_.region_faces = input.face_count();
@@ -268,8 +331,99 @@ void IncrementalSubdivider::splice(const Mesh& input) {
   }
 }
 
+namespace {
+bool same_view(const AsaView& a, const AsaView& b) {
+  return a.enabled == b.enabled && a.camera.eye == b.camera.eye &&
+         a.camera.target == b.camera.target && a.camera.fov_degrees == b.camera.fov_degrees &&
+         a.camera.width == b.camera.width && a.camera.height == b.camera.height &&
+         a.pixel_tolerance == b.pixel_tolerance && a.frustum_margin == b.frustum_margin &&
+         a.backface_margin == b.backface_margin && a.cull_back_faces == b.cull_back_faces &&
+         a.facing_sign == b.facing_sign;
+}
+}  // namespace
+
+void IncrementalSubdivider::set_view(const AsaView& view) {
+  if (same_view(view, options_.view)) return;
+  if (!view_changed_) previous_view_ = options_.view;
+  options_.view = view;
+  view_changed_ = true;
+}
+
+namespace {
+
+// True when no edge inside face f's neighbourhood sphere can matter for
+// `view`: the sphere (centroid, 1.5 x the farthest corner, plus half the
+// longest edge for an edge's own sphere) is wholly outside the widened
+// frustum or behind the eye, or even the longest edge at its nearest point
+// projects to no more than the tolerance. Subdivision only shortens edges
+// and moves new points a fraction of an edge off the face, so what holds
+// for the sphere holds for every descendant edge.
+class QuietFaces {
+ public:
+  explicit QuietFaces(const AsaView& view) : view_(view) {
+    const AsaCamera& c = view.camera;
+    eye_ = c.eye;
+    forward_ = normalized(c.target - c.eye);
+    Vec3f world_up{0, 1, 0};
+    if (std::fabs(forward_.y) > 0.999f) world_up = {0, 0, 1};
+    right_ = normalized(cross(forward_, world_up));
+    up_ = cross(right_, forward_);
+    const float aspect = static_cast<float>(c.width) / static_cast<float>(std::max(c.height, 1));
+    const float tan_half = std::tan(c.fov_degrees * 3.14159265f / 360.0f);
+    tan_y_ = tan_half * (1 + view.frustum_margin);
+    tan_x_ = tan_half * aspect * (1 + view.frustum_margin);
+    inv_x_ = 1.0f / std::sqrt(1 + tan_x_ * tan_x_);
+    inv_y_ = 1.0f / std::sqrt(1 + tan_y_ * tan_y_);
+    focal_px_ = static_cast<float>(c.height) / (2 * tan_half);
+  }
+
+  bool quiet(Vec3f a, Vec3f b, Vec3f c) const {
+    if (!view_.enabled) return false;
+    const Vec3f centre = (a + b + c) / 3.0f;
+    const float corner = std::sqrt(std::max(
+        {squared_length(a - centre), squared_length(b - centre), squared_length(c - centre)}));
+    const float longest =
+        std::sqrt(std::max({squared_length(b - a), squared_length(c - b), squared_length(a - c)}));
+    const float r = 1.5f * corner + 0.5f * longest;
+    const Vec3f rel = centre - eye_;
+    const float dist = length(rel);
+    if (dist <= r) return false;
+    if (longest * focal_px_ <= view_.pixel_tolerance * (dist - r)) return true;
+    const float z = dot(rel, forward_), x = dot(rel, right_), y = dot(rel, up_);
+    if (z < -r) return true;
+    if ((std::fabs(x) - z * tan_x_) * inv_x_ > r) return true;
+    if ((std::fabs(y) - z * tan_y_) * inv_y_ > r) return true;
+    return false;
+  }
+
+ private:
+  const AsaView& view_;
+  Vec3f eye_, forward_, right_, up_;
+  float tan_x_ = 1, tan_y_ = 1, inv_x_ = 1, inv_y_ = 1, focal_px_ = 1;
+};
+
+}  // namespace
+
+// 1b. After set_view: every vertex of an input face that either view may
+// refine counts as changed. Returns the number of such faces.
+uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
+  const QuietFaces before(previous_view_), after(options_.view);
+  uint32_t faces = 0;
+  for (const Triangle& t : input.triangles) {
+    const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
+    if (before.quiet(a, b, c) && after.quiet(a, b, c)) continue;
+    ++faces;
+    for (uint32_t v : t) changed_vertex_[v] = 1;
+  }
+  return faces;
+}
+
 Status IncrementalSubdivider::update(const Mesh& input) {
   stats_ = {};
+  const bool view_changed = view_changed_;
+  view_changed_ = false;
+  if (view_changed && has_previous_ && previous_view_.enabled != options_.view.enabled)
+    return full_update(input);  // every decision may change
   if (!has_previous_ || options_.levels == 0 || !same_attribute_layout(input, previous_) ||
       input.vertex_count() < previous_.vertex_count()) {
     return full_update(input);
@@ -279,6 +433,11 @@ Status IncrementalSubdivider::update(const Mesh& input) {
     return ok;
   }
   stats_.changed_vertices = mark_changed_vertices(input);
+  if (view_changed) {
+    stats_.view_faces = mark_view_changes(input);
+    stats_.changed_vertices = 0;
+    for (uint8_t c : changed_vertex_) stats_.changed_vertices += c;
+  }
   if (stats_.changed_vertices == 0 && input.face_count() == previous_.face_count()) {
     if (!input.normals.empty()) previous_.normals = input.normals;
     return {};

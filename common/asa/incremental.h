@@ -34,6 +34,7 @@ struct IncrementalStats {
   uint32_t dirty_faces = 0;       // input faces whose patches were recomputed
   uint32_t region_faces = 0;      // faces of the submesh that was subdivided
   uint32_t attempts = 0;          // subdivisions of a region this update
+  uint32_t view_faces = 0;        // input faces redone because the view changed
 };
 
 class IncrementalSubdivider {
@@ -49,7 +50,10 @@ class IncrementalSubdivider {
   // bit-identical corner positions; vertex numbering may differ beyond the
   // input vertices, which keep their indices). Errors as subdivide(); after an
   // error the next update is a full one.
-  // Cost: O(changed region) subdivision + O(output) copying.
+  // Cost: O(changed region) subdivision + O(output) copying. With a camera
+  // (options.view), even a first or full update subdivides only the region
+  // of faces whose edges may matter on screen (one pass over the faces finds
+  // them), when that region is small.
   Status update(const Mesh& input);
 
   const AsaResult& result() const { return result_; }
@@ -57,11 +61,23 @@ class IncrementalSubdivider {
   // Forgets the previous input: the next update subdivides everything.
   void reset() { has_previous_ = false; }
 
+  // A new camera (or tolerance) for view-dependent ASA, used from the next
+  // update on. That update redoes, besides what the input changed, the input
+  // faces whose refinement the new view or the old one may ask for: a face
+  // whose every possible edge (its own and its descendants', which stay
+  // inside a sphere around it) is below the tolerance or outside the frustum
+  // for both views keeps its patch, unless the closure around it changed,
+  // which the seam check finds. Cost: O(F) sphere tests.
+  void set_view(const AsaView& view);
+  const AsaOptions& options() const { return options_; }
+
  private:
   Status full_update(const Mesh& input);
+  bool view_region_update(const Mesh& input);
   void remember(const Mesh& input);
   // The phases of update(), in order (see incremental.cpp).
   uint32_t mark_changed_vertices(const Mesh& input);
+  uint32_t mark_view_changes(const Mesh& input);
   void index_vertex_faces(const Mesh& input);
   uint32_t grow_region(const Mesh& input, uint32_t attempt);
   void extract_region(const Mesh& input);
@@ -72,6 +88,8 @@ class IncrementalSubdivider {
   IncrementalOptions incremental_;
   AsaWorkspace workspace_;
   bool has_previous_ = false;
+  bool view_changed_ = false;          // set_view since the last update
+  AsaView previous_view_;              // the view the result was made for
   Mesh previous_;                      // the previous input
   std::vector<uint32_t> patch_start_;  // per previous input face, into result_ faces (+1 sentinel)
   AsaResult result_;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -53,7 +54,7 @@ Status check_options(const AsaOptions& o) {
   if (!std::isfinite(o.crease_degrees) || o.crease_degrees < 0 || o.crease_degrees > 180) {
     return make_error(ErrorCode::kInvalidArgument, "crease angle must be in [0, 180] degrees");
   }
-  return {};
+  return check_view(o.view);
 }
 
 // Levels multiply faces by up to 4 each; refuse what cannot be indexed.
@@ -134,16 +135,17 @@ void copy_level_unchanged(const asa::SplitInput& in, bool normals, AsaResult& re
 // Level 0 tests every edge; later levels only the edges of faces the last
 // split made (their normals came with the split), unless most faces are new
 // anyway. Returns false, leaving `out` alone, when no face is a target.
-bool split_adaptive_level(int level, const AsaOptions& options, asa::SplitInput& in,
-                          AsaWorkspace::Buffers& ws, asa::LevelMesh& out,
+bool split_adaptive_level(int level, const AsaOptions& options, const asa::ViewTest* camera,
+                          asa::SplitInput& in, AsaWorkspace::Buffers& ws, asa::LevelMesh& out,
                           std::vector<FaceKind>* kinds) {
   const asa::LevelView& view = in.mesh;
   const bool mostly_fresh =
       level > 0 && 2 * static_cast<uint64_t>(ws.scratch.fresh_count) > view.face_count;
   const uint32_t targets =
       level == 0 || mostly_fresh
-          ? asa::mark_targets(view, ws.normals, options.flatness, ws.target)
-          : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target);
+          ? asa::mark_targets(view, ws.normals, options.flatness, ws.target, camera)
+          : asa::mark_targets_near_fresh(view, ws.normals, ws.fresh, options.flatness, ws.target,
+                                         camera);
   if (targets == 0) return false;
   const uint32_t split = asa::close_targets(view, ws.target.data(), ws.closure);
   in.normals = ws.normals.data();
@@ -189,6 +191,22 @@ void take_last_level(asa::LevelMesh& out, bool source, bool normals, AsaResult& 
   }
 }
 
+// With a camera: can any edge of the mesh matter on screen? Each face asks
+// for its three edges with its own normal on both sides: an interior edge
+// is asked from both its faces, so it passes here exactly when the real
+// test (both normals) would let it through from either side. One pass over
+// the faces, no adjacency: when nothing may matter, ASA is a copy.
+bool any_edge_may_matter(const Mesh& mesh, const asa::ViewTest& view) {
+  const Vec3f* p = mesh.positions.data();
+  for (const Triangle& t : mesh.triangles) {
+    const Vec3f a = p[t[0]], b = p[t[1]], c = p[t[2]];
+    const Vec3f n = normalized(cross(b - a, c - a));
+    if (view.matters(a, b, n, n) || view.matters(b, c, n, n) || view.matters(c, a, n, n))
+      return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace& workspace,
@@ -202,6 +220,25 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   ws.stats.targets.clear();
   ws.stats.split_edges.clear();
   const uint32_t F = mesh.face_count();
+
+  std::optional<asa::ViewTest> camera;
+  if (options.view.enabled && !options.uniform) camera.emplace(options.view);
+  if (camera && options.levels > 0 && F > 0 && !any_edge_may_matter(mesh, *camera)) {
+    // The mesh is finer than the tolerance (or out of view) everywhere:
+    // what the levels would give, without building adjacency.
+    result.mesh.positions = mesh.positions;
+    result.mesh.triangles = mesh.triangles;
+    result.mesh.colors = mesh.colors;
+    result.mesh.texcoords = mesh.texcoords;
+    result.mesh.normals.clear();
+    if (!mesh.normals.empty()) result.mesh.normals = compute_vertex_normals(result.mesh);
+    result.face_kind.assign(F, FaceKind::kUntouched);
+    result.source_face.resize(options.track_source_faces ? F : 0);
+    for (uint32_t f = 0; f < result.source_face.size(); ++f) result.source_face[f] = f;
+    ws.stats.targets.assign(options.levels, 0);
+    ws.stats.split_edges.assign(options.levels, 0);
+    return {};
+  }
 
   asa::SplitInput in;
   if (auto built = build_base_level(mesh, options, ws, in.mesh); !built) return built;
@@ -237,7 +274,8 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
       ws.stats.targets.push_back(in.mesh.face_count);
       ws.stats.split_edges.push_back(static_cast<uint32_t>(out.positions.size()) -
                                      in.mesh.vertex_count);
-    } else if (!split_adaptive_level(level, options, in, ws, out, kinds)) {
+    } else if (!split_adaptive_level(level, options, camera ? &*camera : nullptr, in, ws, out,
+                                     kinds)) {
       // Nothing bends: this and every later level would copy the mesh
       // unchanged (same normals, same verdicts). Stop here.
       copy_level_unchanged(in, normals, result);

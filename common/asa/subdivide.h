@@ -43,6 +43,7 @@
 #include <memory>
 #include <vector>
 
+#include "common/asa/view.h"
 #include "common/base/result.h"
 #include "common/mesh/mesh.h"
 
@@ -54,13 +55,16 @@ enum class ButterflyRule {
 };
 
 struct AsaOptions {
-  int levels = 1;
+  int levels = 1;          // with a camera (view.enabled): the most levels the screen may ask for
   float flatness = 0.85f;  // t: an interior edge is flat when t < N1.N2 <= 1
   bool uniform = false;    // split every triangle (classic modified Butterfly)
   ButterflyRule rule = ButterflyRule::kZorin;
   float tension = 0.0f;             // omega of the ten-point stencil
   float crease_degrees = 0;         // > 0: edges bending more than this stay sharp
   bool track_source_faces = false;  // fill AsaResult::source_face
+  // View-dependent ASA (view.h): a bent edge is refined only where it
+  // matters on screen for this camera. Off: the whole mesh, as the thesis.
+  AsaView view;
 };
 
 // Per-face label of the last level, for viewers: what ASA did to it.

@@ -8,28 +8,6 @@
 namespace meshstream {
 namespace {
 
-// Same faces in the same order with bit-identical corner positions, same
-// vertex count, same face kinds.
-::testing::AssertionResult same_output(const AsaResult& a, const AsaResult& b) {
-  if (a.mesh.face_count() != b.mesh.face_count())
-    return ::testing::AssertionFailure()
-           << "faces " << a.mesh.face_count() << " vs " << b.mesh.face_count();
-  if (a.mesh.vertex_count() != b.mesh.vertex_count())
-    return ::testing::AssertionFailure()
-           << "vertices " << a.mesh.vertex_count() << " vs " << b.mesh.vertex_count();
-  for (uint32_t f = 0; f < a.mesh.face_count(); ++f) {
-    for (int i = 0; i < 3; ++i) {
-      const Vec3f p = a.mesh.positions[a.mesh.triangles[f][i]],
-                  q = b.mesh.positions[b.mesh.triangles[f][i]];
-      if (std::memcmp(&p, &q, sizeof p) != 0)
-        return ::testing::AssertionFailure() << "face " << f << " corner " << i;
-    }
-    if (a.face_kind[f] != b.face_kind[f])
-      return ::testing::AssertionFailure() << "face kind of " << f;
-  }
-  return ::testing::AssertionSuccess();
-}
-
 // A decoder-like refinement: a new vertex inside face f, lifted off the
 // plane; f is replaced in place and two faces are appended.
 void insert_vertex(Mesh& m, uint32_t f, float lift) {
@@ -44,6 +22,8 @@ void insert_vertex(Mesh& m, uint32_t f, float lift) {
   m.triangles.push_back({t[1], t[2], v});
   m.triangles.push_back({t[2], t[0], v});
 }
+
+using asa_test::same_output;
 
 void run_records(const Mesh& start, const AsaOptions& options, int records, const char* what,
                  bool expect_partial = true) {

@@ -128,6 +128,28 @@ inline std::vector<std::array<uint32_t, 2>> parents(const std::vector<Triangle>&
   return p;
 }
 
+// Same faces in the same order with bit-identical corner positions, same
+// vertex count, same face kinds.
+inline ::testing::AssertionResult same_output(const AsaResult& a, const AsaResult& b) {
+  if (a.mesh.face_count() != b.mesh.face_count())
+    return ::testing::AssertionFailure()
+           << "faces " << a.mesh.face_count() << " vs " << b.mesh.face_count();
+  if (a.mesh.vertex_count() != b.mesh.vertex_count())
+    return ::testing::AssertionFailure()
+           << "vertices " << a.mesh.vertex_count() << " vs " << b.mesh.vertex_count();
+  for (uint32_t f = 0; f < a.mesh.face_count(); ++f) {
+    for (int i = 0; i < 3; ++i) {
+      const Vec3f p = a.mesh.positions[a.mesh.triangles[f][i]],
+                  q = b.mesh.positions[b.mesh.triangles[f][i]];
+      if (std::memcmp(&p, &q, sizeof p) != 0)
+        return ::testing::AssertionFailure() << "face " << f << " corner " << i;
+    }
+    if (a.face_kind[f] != b.face_kind[f])
+      return ::testing::AssertionFailure() << "face kind of " << f;
+  }
+  return ::testing::AssertionSuccess();
+}
+
 inline uint32_t edge_count(const Mesh& m) {
   auto adj = Adjacency::build(m);
   return adj ? adj->edge_count() : 0;

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <set>
 
+#include "common/asa/view.h"
 #include "tests/client/client_harness.h"
 
 namespace meshstream::clienttest {
@@ -298,10 +299,13 @@ TEST_F(ClientCliTest, OutWritesTheChosenRecordsWhateverTheTiming) {
   }
   EXPECT_TRUE(read_text(out / "fast/final.decoded.ply") ==
               read_text(out / "slow/final.decoded.ply"));
-  // NNNN.ply is the display mesh after record NNNN: ASA of that prefix.
+  // NNNN.ply is the display mesh after record NNNN: ASA of that prefix,
+  // view-dependent for the snapshot camera of that prefix at 1024 x 768.
   const std::string prefix =
       tool_decode(of_kind(fast.events, "record")[17]["bytes"].get<uint64_t>(), "prefix17.ply");
-  ASSERT_EQ(run({tool_bin(), "subdivide", prefix, "-o", *dir_ / "sub17.ply", "--levels", "1"},
+  const std::string camera = format_camera(fit_camera(load_ply(prefix), 1024, 768));
+  ASSERT_EQ(run({tool_bin(), "subdivide", prefix, "-o", *dir_ / "sub17.ply", "--levels", "1",
+                 "--camera", camera, "--width", "1024", "--height", "768"},
                 *dir_ / "sub.out", *dir_ / "sub.err"),
             0)
       << read_text(*dir_ / "sub.err");

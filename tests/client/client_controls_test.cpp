@@ -100,7 +100,8 @@ TEST_F(ClientControlsTest, SetAsaReRunsOnTheCurrentMesh) {
   Server server;
   ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache"}, dir_.path()))
       << server.log();
-  PipelineSettings settings;  // ASA on, 1 level
+  PipelineSettings settings;  // ASA on, 1 level, on the whole mesh (as subdivide())
+  settings.view.dependent = false;
   Session s(server, settings);
   ASSERT_TRUE(s.pipeline->wait_finished());
   auto final_frame = s.mailbox.take_newer(0);

@@ -137,7 +137,9 @@ TEST_F(ClientStreamTest, EachDisplayMeshEqualsOfflineSubdivideAtItsRecord) {
   TempDir out;
   const std::vector<std::string> asa{"--asa-levels", "2",          "--flatness", "0.8",
                                      "--rule",       "projection", "--crease",   "60"};
-  std::vector<std::string> args{"demo", "--json", "--out", out.path(), "--out-every", "25"};
+  // Whole-mesh ASA: what `meshstream subdivide` does without a camera.
+  std::vector<std::string> args{
+      "demo", "--json", "--out", out.path(), "--out-every", "25", "--view-independent"};
   args.insert(args.end(), asa.begin(), asa.end());
   const ClientRun r = client(server_->address(), args);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -184,9 +186,10 @@ TEST_F(ClientStreamTest, IncrementalAsaEqualsOfflineSubdivideAtEachRecord) {
                           out.path()))
       << paced.log();
   const std::vector<std::string> asa{"--levels", "1", "--flatness", "0.8", "--crease", "50"};
-  const ClientRun r = client(
-      paced.address(), {"demo", "--json", "--out", out / "o", "--out-every", "1", "--asa-levels",
-                        "1", "--flatness", "0.8", "--crease", "50", "--asa-path", "incremental"});
+  const ClientRun r =
+      client(paced.address(), {"demo", "--json", "--out", out / "o", "--out-every", "1",
+                               "--asa-levels", "1", "--flatness", "0.8", "--crease", "50",
+                               "--asa-path", "incremental", "--view-independent"});
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
   std::vector<nlohmann::json> incremental;
@@ -381,7 +384,8 @@ TEST_F(ClientStreamTest, RealMeshFinalMeshesEqualOfflineDecodeAndSubdivide) {
   Server server;
   ASSERT_TRUE(server.start({"--models", models.path(), "--cache", out / "cache"}, out.path()))
       << server.log();
-  const ClientRun r = client(server.address(), {"bunny", "--json", "--out", out / "snaps"});
+  const ClientRun r =
+      client(server.address(), {"bunny", "--json", "--out", out / "snaps", "--view-independent"});
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
   ASSERT_EQ(
