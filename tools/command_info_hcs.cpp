@@ -23,6 +23,8 @@ const char* base_coder_name(uint8_t id) {
       return "own";
     case kBaseCoderDraco:
       return "draco-edgebreaker";
+    case kBaseCoderTraversal:
+      return "traversal";
   }
   return "unknown";
 }

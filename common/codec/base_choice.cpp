@@ -34,6 +34,34 @@ ChosenBase code_base_own(const DecimationResult& dec, const std::vector<Vec3i>& 
   return out;
 }
 
+std::optional<ChosenBase> code_base_traversal(const DecimationResult& dec,
+                                              const std::vector<Vec3i>& q, int bits) {
+  BaseMesh base;
+  std::unordered_map<uint32_t, uint32_t> id;
+  for (uint32_t v : dec.base_vertices) {
+    id.emplace(v, static_cast<uint32_t>(base.positions.size()));
+    base.positions.push_back(q[v]);
+  }
+  for (const Triangle& t : dec.base_faces) base.faces.push_back({id[t[0]], id[t[1]], id[t[2]]});
+  auto coded = encode_base_traversal(base, bits);
+  if (!coded) return std::nullopt;
+  // The decoder's picture must be the encoder's: checked here (the base is
+  // small) rather than trusted.
+  auto decoded = decode_base_traversal(coded->bytes, static_cast<uint32_t>(base.positions.size()),
+                                       static_cast<uint32_t>(base.faces.size()), bits);
+  if (!decoded || decoded->positions != coded->decoded.positions ||
+      decoded->faces != coded->decoded.faces) {
+    return std::nullopt;
+  }
+  ChosenBase out;
+  out.coder = kBaseCoderTraversal;
+  out.bytes = std::move(coded->bytes);
+  out.decoded = std::move(coded->decoded);
+  out.to_input.reserve(coded->to_base.size());
+  for (uint32_t b : coded->to_base) out.to_input.push_back(dec.base_vertices[b]);
+  return out;
+}
+
 std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std::vector<Vec3i>& q,
                                           int bits) {
   BaseMesh base;
@@ -112,7 +140,8 @@ std::optional<ChosenBase> code_base_draco(const DecimationResult& dec, const std
 
 ChosenBase choose_base(const DecimationResult& dec, const std::vector<Vec3i>& positions, int bits,
                        bool allow_draco) {
-  ChosenBase base = code_base_own(dec, positions);
+  auto traversal = code_base_traversal(dec, positions, bits);
+  ChosenBase base = traversal ? std::move(*traversal) : code_base_own(dec, positions);
   if (allow_draco) {
     if (auto draco = code_base_draco(dec, positions, bits);
         draco && draco->bytes.size() < base.bytes.size()) {

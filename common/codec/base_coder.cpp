@@ -231,4 +231,21 @@ Result<BaseMesh> decode_base_draco(std::span<const uint8_t> bytes, uint32_t vert
   return base;
 }
 
+bool known_base_coder(uint8_t coder) {
+  return coder == kBaseCoderOwn || coder == kBaseCoderDraco || coder == kBaseCoderTraversal;
+}
+
+Result<BaseMesh> decode_base(uint8_t coder, std::span<const uint8_t> bytes, uint32_t vertex_count,
+                             uint32_t face_count, int quant_bits) {
+  switch (coder) {
+    case kBaseCoderOwn:
+      return decode_base_own(bytes, vertex_count, face_count, quant_bits);
+    case kBaseCoderDraco:
+      return decode_base_draco(bytes, vertex_count, face_count, quant_bits);
+    case kBaseCoderTraversal:
+      return decode_base_traversal(bytes, vertex_count, face_count, quant_bits);
+  }
+  return make_error(ErrorCode::kUnsupported, "unknown base mesh coder " + std::to_string(coder));
+}
+
 }  // namespace meshstream

@@ -15,8 +15,12 @@
 //   boundary edge) already exists (no non-manifold edge; Euler characteristic
 //   and boundary loops kept, so genus is kept), and for an interior valence-3
 //   vertex the new triangle is not already a face;
-// - no fan triangle is degenerate on the grid (zero area, exact integers) or
-//   turns against the star's normal (cosine <= kMinFanCosine).
+// - no fan triangle with area turns against the star's normal (cosine <=
+//   kMinFanCosine); a fan triangle folded flat on the grid (zero area, exact
+//   integers) is allowed where a triangle of v's star is folded flat
+//   already: it covers nothing and cannot turn over, and refusing it
+//   stalled decimation on dense scans, where 12-bit positions fold many
+//   triangles flat. A star with no area takes only fans without area.
 // A fan from apex a is exactly the half-edge collapse of v into a, so the
 // error is Garland & Heckbert's quadric (1997): every vertex carries the
 // area-weighted planes of the original faces around it (and, weighted by

@@ -70,7 +70,7 @@ struct IncrementalDecoder::State {
       return make_error(ErrorCode::kCorrupt, "stream header has quantization bits " +
                                                  std::to_string(h.quant_bits) + " (8..20 allowed)");
     }
-    if (h.base_coder != kBaseCoderOwn && h.base_coder != kBaseCoderDraco) {
+    if (!known_base_coder(h.base_coder)) {
       return make_error(ErrorCode::kUnsupported,
                         "unknown base mesh coder " + std::to_string(h.base_coder));
     }
@@ -122,9 +122,7 @@ struct IncrementalDecoder::State {
     delta.record = i;
     if (i == 0) {
       const int coarse_bits = h.quant_bits - base_shift;
-      auto base = h.base_coder == kBaseCoderDraco
-                      ? decode_base_draco(payload, rec.vertices, rec.faces, coarse_bits)
-                      : decode_base_own(payload, rec.vertices, rec.faces, coarse_bits);
+      auto base = decode_base(h.base_coder, payload, rec.vertices, rec.faces, coarse_bits);
       if (!base) return where(base.error());
       auto state =
           RefinementState::from_coarse_base(base->positions, base->faces, h.quant_bits, base_shift);

@@ -17,12 +17,15 @@ inline constexpr uint16_t kContainerVersion = 3;
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct. What each
 // bump changed: docs/hcs-format.md ("Encoder versions").
-inline constexpr uint32_t kEncoderVersion = 8;
+inline constexpr uint32_t kEncoderVersion = 9;
 
 // Which coder made record 0, the base mesh (header `base_coder`,
 // base_coder.h).
 inline constexpr uint8_t kBaseCoderOwn = 1;    // own range-coded deltas
 inline constexpr uint8_t kBaseCoderDraco = 2;  // Draco's edgebreaker on grid integers
+// Breadth-first face traversal, parallelogram-predicted positions (encoder
+// version 9 on; what replaced kBaseCoderOwn, which is still read).
+inline constexpr uint8_t kBaseCoderTraversal = 3;
 
 // Ids written in the stream header (`structure_coder`, `geometry_coder`).
 inline constexpr uint8_t kStructureCoderRange = 1;  // adaptive binary range coder
