@@ -318,11 +318,15 @@ Status check_manifold(const Mesh& mesh) {
 }
 
 Result<RepairCounts> make_manifold(Mesh& mesh) {
+  return make_manifold(mesh, build_edge_groups(mesh));
+}
+
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups) {
   RepairCounts counts;
   constexpr int kMaxRounds = 32;
   std::string last_problem;
   for (int round = 0; round < kMaxRounds; ++round) {
-    EdgeGroups groups = build_edge_groups(mesh);
+    if (round > 0) groups = build_edge_groups(mesh);
     std::vector<Join> joins = choose_joins(mesh, groups);
     auto flipped = orient(mesh, groups, joins);
     if (!flipped) return tl::unexpected(flipped.error());
