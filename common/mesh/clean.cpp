@@ -133,6 +133,11 @@ uint32_t weld(Mesh& mesh, std::vector<std::string>& notes) {
 
 bool repeats_a_vertex(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; }
 
+uint32_t count_degenerate(const Mesh& mesh) {
+  return static_cast<uint32_t>(
+      std::count_if(mesh.triangles.begin(), mesh.triangles.end(), repeats_a_vertex));
+}
+
 uint32_t drop_degenerate(Mesh& mesh) {
   const size_t before = mesh.triangles.size();
   std::erase_if(mesh.triangles, repeats_a_vertex);
@@ -242,7 +247,11 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
   }
 
   if (options.weld) report.welded_vertices = weld(mesh, report.notes);
-  report.degenerate_faces = drop_degenerate(mesh);
+  if (options.keep_degenerate_faces && options.keep_nonmanifold) {
+    report.degenerate_faces = count_degenerate(mesh);
+  } else {
+    report.degenerate_faces = drop_degenerate(mesh);
+  }
   std::vector<uint8_t> had_twin;
   if (options.drop_duplicate_faces) report.duplicate_faces = drop_duplicates(mesh, had_twin);
   report.unreferenced_vertices = drop_unreferenced(mesh);
