@@ -13,21 +13,6 @@ namespace asio = net::asio;
 using asio::awaitable;
 using asio::use_awaitable;
 
-std::shared_ptr<const std::vector<uint8_t>> model_list_frame(const Catalog& catalog) {
-  v1::ServerMessage out;
-  v1::ModelList* list = out.mutable_model_list();
-  for (const CatalogModel* model : catalog.models()) {
-    v1::ModelInfo* info = list->add_models();
-    info->set_name(model->name);
-    info->set_vertices(model->index.header.vertex_count);
-    info->set_faces(model->index.header.face_count);
-    info->set_stream_bytes(model->index.total_bytes());
-    info->set_records(static_cast<uint32_t>(model->index.records.size()));
-    info->set_source(model->source);
-  }
-  return std::make_shared<const std::vector<uint8_t>>(proto::encode_frame(out));
-}
-
 std::shared_ptr<const std::vector<uint8_t>> hello_frame(const ServerOptions& options) {
   v1::ServerMessage out;
   v1::ServerHello* hello = out.mutable_hello();
@@ -98,9 +83,8 @@ Status Server::listen() {
   return {};
 }
 
-void Server::start_serving(const Catalog& catalog) {
-  shared_.catalog = &catalog;
-  shared_.model_list_frame = model_list_frame(catalog);
+void Server::start_serving(const ModelRegistry& models) {
+  shared_.models = &models;
   // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
   // queues a signal that arrives before run() and delivers it then.
   signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);

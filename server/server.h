@@ -12,7 +12,7 @@
 
 #include "common/base/result.h"
 #include "common/net/asio.h"
-#include "server/catalog.h"
+#include "server/model_registry.h"
 #include "server/server_options.h"
 #include "server/session.h"
 
@@ -25,20 +25,19 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and listens on options.listen_host:listen_port: done before the
-  // catalog is loaded, so an unusable address fails at once instead of
-  // after every model is encoded. Clients that connect before run() wait in
-  // the backlog. kIo when the address is unusable (in use, not local, not an
+  // Binds and listens on options.listen_host:listen_port, first of all, so
+  // an unusable address fails at once. Clients that connect before run()
+  // wait in the backlog. kIo when the address is unusable (in use, not local, not an
   // address); the message names it and the cause.
   Status listen();
   // The bound address (after listen()); port is the real one for port 0.
   net::tcp::endpoint local_endpoint() const;
 
-  // What the server serves (must outlive it), and from now on SIGINT/SIGTERM
-  // mean stop(). Call after listen(), before announcing the port and run().
-  // (Until then the signals keep their default effect, so Ctrl-C while the
-  // models are encoding ends the program at once.)
-  void start_serving(const Catalog& catalog);
+  // What the server serves (must outlive it; it may change while the
+  // server runs: models are encoded in the background), and from now on
+  // SIGINT/SIGTERM mean stop(). Call after listen(), before announcing the
+  // port and run().
+  void start_serving(const ModelRegistry& models);
 
   // Serves until stop() or SIGINT/SIGTERM, then shuts down cleanly (sessions
   // get up to `grace` to close) and returns. Blocks the calling thread.
