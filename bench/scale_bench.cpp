@@ -66,6 +66,7 @@ struct Measured {
   double wall_s = 0, cpu_s = 0;
   double peak_mb = 0;
   std::string err;  // its stderr when it failed
+  std::string out;  // its stdout
 };
 
 Measured run_measured(const std::vector<std::string>& argv, const std::string& dir,
@@ -106,6 +107,7 @@ Measured run_measured(const std::vector<std::string>& argv, const std::string& d
   m.peak_mb = usage.ru_maxrss / 1024.0;
   m.status = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
   if (m.status != 0) m.err = read_text(err);
+  m.out = read_text(out);
   return m;
 }
 
@@ -285,12 +287,14 @@ void write_report(const std::vector<Row>& rows, const std::vector<std::string>& 
   const std::string data = report_dir + "/scale.dat";
   {
     std::ofstream out(data);
-    out << "# vertices encode_us decode_us draco_decoder_us draco_library_us client_us\n";
+    out << "# vertices encode_us decode_us draco_decoder_us draco_library_us client_us "
+           "encode_cpu_us decode_cpu_us draco_decoder_cpu_us (wall, then CPU time per vertex)\n";
     for (const Row& r : rows) {
       const double v = r.size.vertices;
       out << r.size.vertices << " " << 1e6 * r.encode.wall_s / v << " " << 1e6 * r.decode.wall_s / v
           << " " << 1e6 * r.draco_decode.wall_s / v << " " << 1e6 * r.draco_library_s / v << " "
-          << 1e6 * r.client.wall_s / v << "\n";
+          << 1e6 * r.client.wall_s / v << " " << 1e6 * r.encode.cpu_s / v << " "
+          << 1e6 * r.decode.cpu_s / v << " " << 1e6 * r.draco_decode.cpu_s / v << "\n";
     }
   }
   const std::string svg = report_dir + "/scale.svg";
@@ -301,13 +305,16 @@ void write_report(const std::vector<Row>& rows, const std::vector<std::string>& 
     gp << "set terminal svg size 720,440 dynamic font 'sans,11'\n"
        << "set output '" << svg << "'\n"
        << "set logscale xy\nset grid\nset key outside right\n"
-       << "set xlabel 'vertices'\nset ylabel 'wall time per vertex (microseconds)'\n"
+       << "set xlabel 'vertices'\nset ylabel 'time per vertex (microseconds)'\n"
        << "set title 'scale_bench: time per vertex against size (flat = linear)'\n"
        << "plot '" << data << "' using 1:2 with linespoints title 'meshstream encode', "
        << "'' using 1:3 with linespoints title 'meshstream decode', "
        << "'' using 1:4 with linespoints title 'draco\\_decoder', "
        << "'' using 1:5 with linespoints title 'Draco library decode', "
-       << "'' using 1:6 with linespoints title 'meshstream-client --no-asa'\n";
+       << "'' using 1:6 with linespoints title 'meshstream-client --no-asa', "
+       << "'' using 1:7 with linespoints dashtype 2 lc 1 title 'encode, CPU time', "
+       << "'' using 1:8 with linespoints dashtype 2 lc 2 title 'decode, CPU time', "
+       << "'' using 1:9 with linespoints dashtype 2 lc 3 title 'draco\\_decoder, CPU time'\n";
     gp.close();
     plotted = run_measured({"gnuplot", script}, work).status == 0;
   }
@@ -637,7 +644,7 @@ int main(int argc, char** argv) {
         if (r.client.status != 0) {
           r.client_error = r.client.err;
         } else {
-          const auto events = parse_events(read_text(work + "/run.out"));
+          const auto events = parse_events(r.client.out);  // the median run's
           if (!events.empty() && events.back().value("event", "") == "done")
             r.client_done_s = events.back().value("elapsed_ms", 0.0) / 1000;
         }
