@@ -20,11 +20,16 @@ struct CompareArgs {
   uint64_t seed = DistanceOptions{}.seed;
 };
 
-// Analysis-mode import: weld and drop what has no surface, but repair and
-// reorder nothing, so the distance is between the files as drawn.
+// Analysis-mode import: weld and drop unreferenced vertices, but repair and
+// reorder nothing, so the distance is between the files as drawn. Faces
+// folded flat (12-bit quantization folds many on dense scans; a one-face
+// component can fold to a point) stay: welding makes them repeat a vertex,
+// and dropping them would make a correct decode look as if whole components
+// were missing. The metrics measure such a face as its segment or point.
 Result<Mesh> load(const std::string& path) {
   ImportOptions options;
   options.keep_nonmanifold = true;
+  options.keep_degenerate_faces = true;
   options.drop_duplicate_faces = false;
   auto imported = import_mesh(path, options);
   if (!imported) return tl::unexpected(imported.error());

@@ -196,9 +196,13 @@ int run_info_mesh(const std::string& path, bool json) {
   ImportOptions analysis;
   analysis.keep_nonmanifold = true;
   analysis.drop_duplicate_faces = false;
-  auto as_drawn = import_mesh(path, analysis);
-  if (!as_drawn) return report_failure(as_drawn.error());
-  const MeshStats file_stats = compute_stats(as_drawn->mesh);
+  MeshStats file_stats;
+  {
+    // Released before the second import: never two big meshes at once.
+    auto as_drawn = import_mesh(path, analysis);
+    if (!as_drawn) return report_failure(as_drawn.error());
+    file_stats = compute_stats(as_drawn->mesh);
+  }
   auto imported = import_mesh(path);
   if (!imported) return report_failure(imported.error());
   const MeshStats stats = compute_stats(imported->mesh);

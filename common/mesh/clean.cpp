@@ -9,13 +9,13 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <numeric>
 #include <sstream>
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/edge_groups.h"
 #include "common/mesh/import.h"
 #include "common/mesh/manifold_repair.h"
+#include "common/mesh/same_faces.h"
 #include "common/mesh/topology.h"
 
 namespace meshstream {
@@ -77,27 +77,37 @@ bool consistent_after_merge(const std::vector<T>& values,
 }
 
 // Merges vertices whose positions are bit-identical (so -0 and +0 stay
-// apart, as the manifest counts them). Sort of the 96-bit keys: O(V log V).
+// apart, as the manifest counts them); each keeps the lowest index of its
+// group. An open-addressing table of the 96-bit keys: O(V), 8-16 bytes per
+// vertex besides the result.
 uint32_t weld(Mesh& mesh, std::vector<std::string>& notes) {
   const uint32_t n = mesh.vertex_count();
-  std::vector<uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::vector<std::array<uint32_t, 3>> keys(n);
-  for (uint32_t v = 0; v < n; ++v) keys[v] = bits(mesh.positions[v]);
-  std::sort(order.begin(), order.end(), [&keys](uint32_t a, uint32_t b) {
-    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
-  });
+  size_t table_size = 16;
+  while (table_size < 2 * static_cast<size_t>(n)) table_size *= 2;
+  const size_t mask = table_size - 1;
+  std::vector<uint32_t> table(table_size, kNone);
   std::vector<uint32_t> representative(n);
   uint32_t merged = 0;
-  for (uint32_t k = 0; k < n; ++k) {
-    const uint32_t v = order[k];
-    if (k > 0 && keys[v] == keys[order[k - 1]]) {
-      representative[v] = representative[order[k - 1]];
-      ++merged;
-    } else {
-      representative[v] = v;
+  for (uint32_t v = 0; v < n; ++v) {
+    const std::array<uint32_t, 3> key = bits(mesh.positions[v]);
+    uint64_t h = (key[0] * 0x9E3779B97F4A7C15ull) ^ (key[1] * 0xC2B2AE3D27D4EB4Full) ^
+                 (key[2] * 0x165667B19E3779F9ull);
+    h ^= h >> 29;
+    for (size_t slot = h & mask;; slot = (slot + 1) & mask) {
+      const uint32_t other = table[slot];
+      if (other == kNone) {
+        table[slot] = v;
+        representative[v] = v;
+        break;
+      }
+      if (bits(mesh.positions[other]) == key) {
+        representative[v] = other;
+        ++merged;
+        break;
+      }
     }
   }
+  table = {};
   if (merged == 0) return 0;
 
   auto check = [&](auto& values, const char* name) {
@@ -121,48 +131,45 @@ uint32_t weld(Mesh& mesh, std::vector<std::string>& notes) {
   return merged;
 }
 
+bool repeats_a_vertex(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; }
+
+uint32_t count_degenerate(const Mesh& mesh) {
+  return static_cast<uint32_t>(
+      std::count_if(mesh.triangles.begin(), mesh.triangles.end(), repeats_a_vertex));
+}
+
 uint32_t drop_degenerate(Mesh& mesh) {
   const size_t before = mesh.triangles.size();
-  std::erase_if(mesh.triangles,
-                [](const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t[2] == t[0]; });
+  std::erase_if(mesh.triangles, repeats_a_vertex);
   return static_cast<uint32_t>(before - mesh.triangles.size());
 }
 
 // Drops every face whose vertex set equals an earlier face's (either
 // orientation); the first one stays and is flagged in `had_twin` (aligned
-// with the remaining faces).
+// with the remaining faces). Linear (same_faces.h).
 uint32_t drop_duplicates(Mesh& mesh, std::vector<uint8_t>& had_twin) {
   const uint32_t f_count = mesh.face_count();
-  std::vector<std::array<uint32_t, 3>> keys(f_count);
-  for (uint32_t f = 0; f < f_count; ++f) {
-    keys[f] = mesh.triangles[f];
-    std::sort(keys[f].begin(), keys[f].end());
-  }
-  std::vector<uint32_t> order(f_count);
-  std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&keys](uint32_t a, uint32_t b) {
-    return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
-  });
-  std::vector<uint8_t> duplicate(f_count, 0), twin(f_count, 0);
+  std::vector<uint32_t> first = first_face_with_same_vertices(mesh);
   uint32_t dups = 0;
-  uint32_t first_of_group = 0;
-  for (uint32_t k = 1; k < f_count; ++k) {
-    if (keys[order[k]] == keys[order[k - 1]]) {
-      duplicate[order[k]] = 1;
-      twin[order[first_of_group]] = 1;
-      ++dups;
-    } else {
-      first_of_group = k;
-    }
+  for (uint32_t f = 0; f < f_count; ++f) {
+    if (first[f] != f) ++dups;
   }
   had_twin.clear();
   if (dups == 0) return 0;
+  std::vector<uint8_t> state(f_count, 0);  // 2: duplicate, 1: kept and had a twin
+  for (uint32_t f = 0; f < f_count; ++f) {
+    if (first[f] == f) continue;
+    state[f] = 2;
+    state[first[f]] = 1;
+  }
+  first = {};
   std::vector<Triangle> kept;
   kept.reserve(f_count - dups);
+  had_twin.reserve(f_count - dups);
   for (uint32_t f = 0; f < f_count; ++f) {
-    if (duplicate[f]) continue;
+    if (state[f] == 2) continue;
     kept.push_back(mesh.triangles[f]);
-    had_twin.push_back(twin[f]);
+    had_twin.push_back(state[f]);
   }
   mesh.triangles.swap(kept);
   return dups;
@@ -240,7 +247,11 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
   }
 
   if (options.weld) report.welded_vertices = weld(mesh, report.notes);
-  report.degenerate_faces = drop_degenerate(mesh);
+  if (options.keep_degenerate_faces && options.keep_nonmanifold) {
+    report.degenerate_faces = count_degenerate(mesh);
+  } else {
+    report.degenerate_faces = drop_degenerate(mesh);
+  }
   std::vector<uint8_t> had_twin;
   if (options.drop_duplicate_faces) report.duplicate_faces = drop_duplicates(mesh, had_twin);
   report.unreferenced_vertices = drop_unreferenced(mesh);
@@ -254,19 +265,21 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
                           (options.weld ? ", after welding equal positions)" : ")"));
   }
 
-  const MeshStats found = compute_stats(mesh);
+  EdgeGroups groups = build_edge_groups(mesh);
+  const ManifoldCounts found = count_nonmanifold(mesh, groups);
   report.nonmanifold_edges = found.nonmanifold_edges;
   report.nonmanifold_vertices = found.nonmanifold_vertices;
   if (options.keep_nonmanifold) return report;
   // Already what the corner table needs (no edge with more than two faces,
   // so "fans" mean the same to both): nothing to refuse or repair.
-  if (found.manifold && found.orientation_conflicts == 0) return report;
+  if (found.manifold() && found.orientation_conflicts == 0) return report;
   if (!options.repair_nonmanifold) {
+    groups = {};
     if (auto status = check_manifold(mesh); !status) return tl::unexpected(status.error());
     return report;
   }
   const uint32_t vertices_before_repair = mesh.vertex_count();
-  auto repaired = make_manifold(mesh);
+  auto repaired = make_manifold(mesh, std::move(groups));
   if (!repaired) return tl::unexpected(repaired.error());
   report.split_vertices = repaired->split_vertices;
   report.detached_faces = repaired->detached_faces;

@@ -28,35 +28,33 @@ uint32_t corner_at(const Mesh& mesh, uint32_t f, uint32_t v) {
 }
 
 // Two faces kept connected across edge `edge`: uses[a] and uses[b] (indices
-// into EdgeGroups::uses). Joins of two-face edges are `required`; pairings
-// at non-manifold edges are a choice that orientation may overrule.
+// into EdgeGroups::uses). Both faces of a two-face edge are always joined
+// (required); those joins are read from the groups in edge order, never
+// stored (that would be 16 bytes per edge of the mesh). The Join list holds
+// only the pairings at non-manifold edges: a choice that orientation may
+// overrule (cut).
 struct Join {
   uint32_t edge;
   uint32_t a, b;
-  bool required;
   bool cut = false;
 };
 
-// Corner sets joined across the given joins at each shared endpoint; each
-// set is one fan of faces around one vertex.
+// Corner sets joined across every two-face edge and the given joins (not
+// cut) at each shared endpoint; each set is one fan of faces around one vertex.
 UnionFind fans_through(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
   UnionFind sets(3 * mesh.face_count());
+  auto join = [&](uint32_t edge, uint32_t a, uint32_t b) {
+    const uint32_t fa = groups.uses[a].face, fb = groups.uses[b].face;
+    sets.unite(corner_at(mesh, fa, groups.lo[edge]), corner_at(mesh, fb, groups.lo[edge]));
+    sets.unite(corner_at(mesh, fa, groups.hi[edge]), corner_at(mesh, fb, groups.hi[edge]));
+  };
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) == 2) join(e, groups.begin[e], groups.begin[e] + 1);
+  }
   for (const Join& j : joins) {
-    if (j.cut) continue;
-    const uint32_t fa = groups.uses[j.a].face, fb = groups.uses[j.b].face;
-    sets.unite(corner_at(mesh, fa, groups.lo[j.edge]), corner_at(mesh, fb, groups.lo[j.edge]));
-    sets.unite(corner_at(mesh, fa, groups.hi[j.edge]), corner_at(mesh, fb, groups.hi[j.edge]));
+    if (!j.cut) join(j.edge, j.a, j.b);
   }
   return sets;
-}
-
-std::vector<Join> two_face_joins(const EdgeGroups& groups) {
-  std::vector<Join> joins;
-  joins.reserve(groups.edge_count());
-  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) == 2) joins.push_back({e, groups.begin[e], groups.begin[e] + 1, true});
-  }
-  return joins;
 }
 
 // Step 1 for one non-manifold edge: a greedy matching of consistently
@@ -95,12 +93,13 @@ void match_nonmanifold_edge(const Mesh& mesh, const EdgeGroups& groups, uint32_t
     }
     taken.push_back(c.a);
     taken.push_back(c.b);
-    joins.push_back({e, c.a, c.b, false});
+    joins.push_back({e, c.a, c.b});
   }
 }
 
+// The pairings at non-manifold edges (the two-face edges are joined anyway).
 std::vector<Join> choose_joins(const Mesh& mesh, const EdgeGroups& groups) {
-  std::vector<Join> joins = two_face_joins(groups);
+  std::vector<Join> joins;
   UnionFind fans = fans_through(mesh, groups, joins);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     if (groups.use_count(e) > 2) match_nonmanifold_edge(mesh, groups, e, fans, joins);
@@ -171,10 +170,10 @@ class ParityUnionFind {
 Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups, std::vector<Join>& joins) {
   const uint32_t f_count = mesh.face_count();
   ParityUnionFind faces(f_count);
-  for (const Join& j : joins) {
-    if (!j.required) continue;
-    const EdgeUse& a = groups.uses[j.a];
-    const EdgeUse& b = groups.uses[j.b];
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) != 2) continue;
+    const EdgeUse& a = groups.uses[groups.begin[e]];
+    const EdgeUse& b = groups.uses[groups.begin[e] + 1];
     if (!faces.unite(a.face, b.face, a.forward == b.forward ? 1 : 0)) {
       const Triangle& t = mesh.triangles[a.face];
       return make_error(ErrorCode::kNonManifold,
@@ -185,7 +184,6 @@ Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups, std::vector<Join>&
     }
   }
   for (Join& j : joins) {
-    if (j.required) continue;
     const EdgeUse& a = groups.uses[j.a];
     const EdgeUse& b = groups.uses[j.b];
     if (!faces.unite(a.face, b.face, a.forward == b.forward ? 1 : 0)) j.cut = true;
@@ -302,7 +300,7 @@ Status check_manifold(const Mesh& mesh) {
                             edge_name(mesh, groups.lo[e], groups.hi[e]) + " in the same direction");
     }
   }
-  UnionFind sets = fans_through(mesh, groups, two_face_joins(groups));
+  UnionFind sets = fans_through(mesh, groups, {});
   std::vector<uint32_t> first_root(mesh.vertex_count(), kNone);
   for (uint32_t c = 0; c < 3 * mesh.face_count(); ++c) {
     const uint32_t v = mesh.triangles[c / 3][c % 3];
@@ -318,11 +316,19 @@ Status check_manifold(const Mesh& mesh) {
 }
 
 Result<RepairCounts> make_manifold(Mesh& mesh) {
+  return make_manifold(mesh, build_edge_groups(mesh));
+}
+
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups) {
   RepairCounts counts;
   constexpr int kMaxRounds = 32;
   std::string last_problem;
   for (int round = 0; round < kMaxRounds; ++round) {
-    EdgeGroups groups = build_edge_groups(mesh);
+    // Old groups are released before new ones are built, never two at once.
+    if (round > 0) {
+      groups = {};
+      groups = build_edge_groups(mesh);
+    }
     std::vector<Join> joins = choose_joins(mesh, groups);
     auto flipped = orient(mesh, groups, joins);
     if (!flipped) return tl::unexpected(flipped.error());
@@ -331,7 +337,10 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
     // for the fan split (only the directions recorded in them are stale).
     const uint32_t split = split_fans(mesh, groups, joins);
     counts.split_vertices += split;
-    if (split > 0) groups = build_edge_groups(mesh);
+    if (split > 0) {
+      groups = {};
+      groups = build_edge_groups(mesh);
+    }
     const auto [detached, copies] = detach_extra_faces(mesh, groups);
     counts.detached_faces += detached;
     counts.split_vertices += copies;
@@ -339,6 +348,10 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
     // straight to another round. Otherwise the corner table is the judge
     // (and the cheapest full check).
     if (detached > 0) continue;
+    // The groups are rebuilt by the next round anyway: never hold them and a
+    // corner table at once (about 42 and 40 bytes per face).
+    groups = {};
+    joins = {};
     auto adjacency = Adjacency::build(mesh);
     if (adjacency) return counts;
     last_problem = adjacency.error().message;

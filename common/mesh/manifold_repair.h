@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "common/base/result.h"
+#include "common/mesh/edge_groups.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
@@ -41,5 +42,8 @@ Status check_manifold(const Mesh& mesh);
 // two-face edges alone (Möbius-like). The result always passes
 // Adjacency::build. O((V + F) * rounds); rounds is small (2-3 on real data).
 Result<RepairCounts> make_manifold(Mesh& mesh);
+// The same, starting from build_edge_groups(mesh) already built by the
+// caller (import builds them to decide whether to repair at all).
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups);
 
 }  // namespace meshstream

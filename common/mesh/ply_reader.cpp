@@ -159,6 +159,23 @@ class BodyReader {
     return true;
   }
 
+  // Binary, native byte order: `count` float32 values, true; false (nothing
+  // read) when the data ends first.
+  bool take_native(float* out, size_t count) {
+    const size_t size = 4 * count;
+    if (data_.size() - pos_ < size) return false;
+    std::memcpy(out, data_.data() + pos_, size);
+    pos_ += size;
+    return true;
+  }
+  // The next `size` bytes without consuming them; false when fewer remain.
+  bool peek(unsigned char* out, size_t size) const {
+    if (data_.size() - pos_ < size) return false;
+    std::memcpy(out, data_.data() + pos_, size);
+    return true;
+  }
+  void skip(size_t size) { pos_ += size; }
+
   // ASCII bodies are read as a stream of tokens (one element per line is the
   // rule, but only the order matters, as in most readers).
   const std::string& error() const { return error_; }
@@ -426,12 +443,23 @@ class BodyParser {
     }
     values_.resize(element.properties.size());
     floats_.resize(element.properties.size());
+    const bool fast_vertices = is_vertex && all_native_floats(element);
+    const bool fast_faces = is_face && is_native_triangle_list(element);
     for (uint64_t k = 0; k < element.count; ++k) {
-      const std::string where = element.name + " " + std::to_string(k);
+      // The common binary layouts, without a call per value: float32
+      // vertices, faces with only a uchar-counted int32 list of 3. Anything
+      // else (another count, the end of the data) takes the general path,
+      // which gives the errors.
+      if (fast_vertices && reader_.take_native(floats_.data(), element.properties.size())) {
+        store_vertex(element, k);
+        continue;
+      }
+      if (fast_faces && take_triangle()) continue;
+      const Where where{element.name, k};
       for (size_t p = 0; p < element.properties.size(); ++p) {
         const Property& property = element.properties[p];
         if (!property.is_list) {
-          if (!reader_.read(property.type, values_[p], floats_[p])) return body_error(where);
+          if (!reader_.read(property.type, values_[p], floats_[p])) return body_error(where.str());
           continue;
         }
         const bool keep = is_face && static_cast<int>(p) == indices_;
@@ -442,31 +470,73 @@ class BodyParser {
     return {};
   }
 
+  // An element and its index, named only when an error needs it (building
+  // the string per element cost more than reading it).
+  struct Where {
+    const std::string& element;
+    uint64_t k;
+    std::string str() const { return element + " " + std::to_string(k); }
+  };
+
+  bool native_order() const {
+    return (header_.encoding == Encoding::kBinaryLittle) ==
+           (std::endian::native == std::endian::little);
+  }
+  bool all_native_floats(const Element& element) const {
+    if (header_.encoding == Encoding::kAscii || !native_order()) return false;
+    for (const Property& p : element.properties) {
+      if (p.is_list || p.type != Scalar::kFloat32) return false;
+    }
+    return true;
+  }
+  bool is_native_triangle_list(const Element& element) const {
+    if (header_.encoding == Encoding::kAscii || !native_order()) return false;
+    if (element.properties.size() != 1 || indices_ != 0) return false;
+    const Property& p = element.properties[0];
+    return p.is_list && p.count_type == Scalar::kUint8 &&
+           (p.type == Scalar::kInt32 || p.type == Scalar::kUint32);
+  }
+  // One face "3 a b c" with every index in range: appended, true. Otherwise
+  // nothing read, false.
+  bool take_triangle() {
+    unsigned char record[13];
+    if (!reader_.peek(record, sizeof record) || record[0] != 3) return false;
+    int32_t index[3];
+    std::memcpy(index, record + 1, sizeof index);
+    for (int32_t i : index) {
+      if (i < 0 || static_cast<uint64_t>(i) >= vertex_count_) return false;
+    }
+    mesh_.triangles.push_back({static_cast<uint32_t>(index[0]), static_cast<uint32_t>(index[1]),
+                               static_cast<uint32_t>(index[2])});
+    reader_.skip(sizeof record);
+    return true;
+  }
+
   // One list: its length, then its items; the face index list (`keep`)
   // becomes fan triangles.
-  Status read_list(const Property& property, bool keep, const std::string& where) {
+  Status read_list(const Property& property, bool keep, const Where& at) {
     double count_value = 0;
     float unused = 0;
-    if (!reader_.read(property.count_type, count_value, unused)) return body_error(where);
+    if (!reader_.read(property.count_type, count_value, unused)) return body_error(at.str());
     if (count_value < 0 || count_value > 1e6) {
-      return make_error(ErrorCode::kParse, where + ": list length " + std::to_string(count_value) +
-                                               " is out of range");
+      return make_error(ErrorCode::kParse, at.str() + ": list length " +
+                                               std::to_string(count_value) + " is out of range");
     }
     polygon_.clear();
     for (uint32_t i = 0; i < static_cast<uint32_t>(count_value); ++i) {
       double item = 0;
-      if (!reader_.read(property.type, item, unused)) return body_error(where);
+      if (!reader_.read(property.type, item, unused)) return body_error(at.str());
       if (!keep) continue;
       if (item < 0 || item >= static_cast<double>(vertex_count_) || item != std::floor(item)) {
         return make_error(ErrorCode::kInvalidMesh,
-                          where + " refers to vertex " + std::to_string(item) +
+                          at.str() + " refers to vertex " + std::to_string(item) +
                               " but there are only " + std::to_string(vertex_count_));
       }
       polygon_.push_back(static_cast<uint32_t>(item));
     }
     if (!keep) return {};
     if (polygon_.size() < 3) {
-      return make_error(ErrorCode::kParse, where + " has " + std::to_string(polygon_.size()) +
+      return make_error(ErrorCode::kParse, at.str() + " has " + std::to_string(polygon_.size()) +
                                                " vertices; a polygon needs at least 3");
     }
     for (size_t i = 2; i < polygon_.size(); ++i)

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "common/mesh/edge_groups.h"
+#include "common/mesh/same_faces.h"
 #include "common/mesh/union_find.h"
 
 namespace meshstream {
@@ -15,17 +16,11 @@ bool usable(const Triangle& t, uint32_t n) {
 }
 
 uint32_t count_duplicates(const Mesh& mesh) {
-  std::vector<std::array<uint32_t, 3>> keys;
-  keys.reserve(mesh.triangles.size());
-  for (const Triangle& t : mesh.triangles) {
-    if (!usable(t, mesh.vertex_count())) continue;
-    std::array<uint32_t, 3> k = t;
-    std::sort(k.begin(), k.end());
-    keys.push_back(k);
-  }
-  std::sort(keys.begin(), keys.end());
+  const std::vector<uint32_t> first = first_face_with_same_vertices(mesh);
   uint32_t dups = 0;
-  for (size_t i = 1; i < keys.size(); ++i) dups += keys[i] == keys[i - 1];
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    dups += usable(mesh.triangles[f], mesh.vertex_count()) && first[f] != f;
+  }
   return dups;
 }
 
@@ -59,13 +54,39 @@ MeshStats compute_stats(const Mesh& mesh) {
   s.isolated_vertices = n - s.referenced_vertices;
   s.duplicate_faces = count_duplicates(mesh);
 
-  // Edges, boundary, non-manifold edges; fans by joining, at each endpoint,
-  // the corners of all faces that share an edge.
+  // Edges, boundary loops; the rest from count_nonmanifold.
   const EdgeGroups groups = build_edge_groups(mesh);
   s.edges = groups.edge_count();
-  UnionFind corner_sets(3 * s.faces);
   UnionFind boundary_sets(n);
   std::vector<uint8_t> on_boundary(n, 0);
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) != 1) continue;
+    ++s.boundary_edges;
+    boundary_sets.unite(groups.lo[e], groups.hi[e]);
+    on_boundary[groups.lo[e]] = on_boundary[groups.hi[e]] = 1;
+  }
+  for (uint32_t v = 0; v < n; ++v) {
+    if (on_boundary[v] && boundary_sets.find(v) == v) ++s.boundary_loops;
+  }
+  const ManifoldCounts counts = count_nonmanifold(mesh, groups);
+  s.nonmanifold_edges = counts.nonmanifold_edges;
+  s.nonmanifold_vertices = counts.nonmanifold_vertices;
+  s.orientation_conflicts = counts.orientation_conflicts;
+
+  s.euler = static_cast<int64_t>(s.referenced_vertices) - s.edges + valid_faces;
+  s.manifold = counts.manifold();
+  s.genus_valid = s.manifold && s.orientation_conflicts == 0;
+  s.genus = (2 * static_cast<int64_t>(s.components) - s.euler - s.boundary_loops) / 2;
+  return s;
+}
+
+ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups) {
+  ManifoldCounts s;
+  const uint32_t n = mesh.vertex_count();
+  const uint32_t faces = mesh.face_count();
+  // Fans by joining, at each endpoint, the corners of all faces that share
+  // an edge.
+  UnionFind corner_sets(3 * faces);
   auto corner_at = [&mesh](uint32_t f, uint32_t v) {
     const Triangle& t = mesh.triangles[f];
     return 3 * f + (t[0] == v ? 0 : (t[1] == v ? 1 : 2));
@@ -73,13 +94,9 @@ MeshStats compute_stats(const Mesh& mesh) {
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     const uint32_t count = groups.use_count(e);
     const EdgeUse* uses = &groups.uses[groups.begin[e]];
-    if (count == 1) {
-      ++s.boundary_edges;
-      boundary_sets.unite(groups.lo[e], groups.hi[e]);
-      on_boundary[groups.lo[e]] = on_boundary[groups.hi[e]] = 1;
-    } else if (count > 2) {
+    if (count > 2) {
       ++s.nonmanifold_edges;
-    } else if (uses[0].forward == uses[1].forward) {
+    } else if (count == 2 && uses[0].forward == uses[1].forward) {
       ++s.orientation_conflicts;
     }
     for (uint32_t k = 1; k < count; ++k) {
@@ -89,14 +106,11 @@ MeshStats compute_stats(const Mesh& mesh) {
                         corner_at(uses[k].face, groups.hi[e]));
     }
   }
-  for (uint32_t v = 0; v < n; ++v) {
-    if (on_boundary[v] && boundary_sets.find(v) == v) ++s.boundary_loops;
-  }
 
   // A vertex is non-manifold when its corners fall into more than one set.
   std::vector<uint32_t> first_fan(n, 0xFFFFFFFFu);
   std::vector<uint8_t> counted(n, 0);
-  for (uint32_t f = 0; f < s.faces; ++f) {
+  for (uint32_t f = 0; f < faces; ++f) {
     const Triangle& t = mesh.triangles[f];
     if (!usable(t, n)) continue;
     for (uint32_t i = 0; i < 3; ++i) {
@@ -110,11 +124,6 @@ MeshStats compute_stats(const Mesh& mesh) {
       }
     }
   }
-
-  s.euler = static_cast<int64_t>(s.referenced_vertices) - s.edges + valid_faces;
-  s.manifold = s.nonmanifold_edges == 0 && s.nonmanifold_vertices == 0;
-  s.genus_valid = s.manifold && s.orientation_conflicts == 0;
-  s.genus = (2 * static_cast<int64_t>(s.components) - s.euler - s.boundary_loops) / 2;
   return s;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "common/mesh/edge_groups.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
@@ -39,5 +40,16 @@ struct MeshStats {
 // repeated index are counted in invalid_faces and otherwise ignored.
 // O(V + F) time (plus small per-vertex sorts), O(V + F) memory.
 MeshStats compute_stats(const Mesh& mesh);
+
+// The part of the statistics that decides whether a mesh needs repair, from
+// edge groups already built (build_edge_groups(mesh)): import needs only
+// this, and hands the same groups on to the repair.
+struct ManifoldCounts {
+  uint32_t nonmanifold_edges = 0;
+  uint32_t nonmanifold_vertices = 0;
+  uint32_t orientation_conflicts = 0;
+  bool manifold() const { return nonmanifold_edges == 0 && nonmanifold_vertices == 0; }
+};
+ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups);
 
 }  // namespace meshstream

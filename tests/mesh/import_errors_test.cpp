@@ -51,6 +51,29 @@ TEST(ImportErrors, DegenerateFaceIsDroppedAndReported) {
   EXPECT_EQ(imported->mesh.vertex_count(), 5u);
 }
 
+// For distances (`meshstream compare`): a face that repeats a vertex is kept
+// as the segment or point it is, and counted; without analysis mode the
+// option does nothing (repair needs real triangles).
+TEST(ImportErrors, DegenerateFaceIsKeptForDistancesWhenAsked) {
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  ImportOptions distances;
+  distances.keep_nonmanifold = true;
+  distances.keep_degenerate_faces = true;
+  distances.drop_duplicate_faces = false;
+  auto kept = import_mesh(testing::test_mesh("deg_faces.obj"), distances);
+  ASSERT_TRUE(kept) << kept.error().message;
+  EXPECT_EQ(kept->report.degenerate_faces, 1u);
+  EXPECT_EQ(kept->report.unreferenced_vertices, 1u);  // vertex 5 is in no face at all
+  EXPECT_EQ(kept->mesh.face_count(), 4u);
+  EXPECT_EQ(kept->mesh.vertex_count(), 5u);
+
+  ImportOptions repairing;
+  repairing.keep_degenerate_faces = true;
+  auto dropped = import_mesh(testing::test_mesh("deg_faces.obj"), repairing);
+  ASSERT_TRUE(dropped) << dropped.error().message;
+  EXPECT_EQ(dropped->mesh.face_count(), 3u);
+}
+
 TEST(ImportErrors, NonManifoldEdgeIsRefusedWhenRepairIsOff) {
   MESHSTREAM_REQUIRE_TEST_MESHES();
   ImportOptions strict;

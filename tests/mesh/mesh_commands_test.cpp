@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -177,6 +178,34 @@ TEST(MeshCommands, InfoOfTheSharedFilesNamesTheirAttributes) {
   const auto json = nlohmann::json::parse(run("info --json " + usb).out);
   EXPECT_EQ(json["contents"]["texcoords"]["count"], 601);
   EXPECT_EQ(json["contents"]["material_libraries"][0]["textures"][0], "usb.jpg");
+}
+
+// `compare` against a decode whose quantization folded two one-face
+// components flat: one to a segment, one to a point (vertices at one
+// position, as a decoder writes them). They are still surface: the distance
+// is to the segment and the point, not to the square 9 and 19 units away.
+TEST(MeshCommands, CompareMeasuresFoldedFacesAsTheirSegmentOrPoint) {
+  REQUIRE_BINARY();
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+  const std::string original_path = temp_path("original.obj");
+  const std::string folded_path = temp_path("folded.obj");
+  {
+    std::ofstream original(original_path);
+    original << square << "v 10 0 0\nv 10.5 0 0\nv 10 0.5 0\nf 5 6 7\n"
+             << "v 20 0 0\nv 20.5 0 0\nv 20 0.5 0\nf 8 9 10\n";
+    std::ofstream folded(folded_path);
+    folded << square << "v 10 0 0\nv 10.5 0 0\nv 10.25 0 0\nf 5 6 7\n"
+           << "v 20.25 0 0\nv 20.25 0 0\nv 20.25 0 0\nf 8 9 10\n";
+  }
+  const CommandResult compared = run("compare --json " + original_path + " " + folded_path);
+  ASSERT_EQ(compared.exit_code, 0) << compared.out;
+  const auto json = nlohmann::json::parse(compared.out);
+  EXPECT_EQ(json["b"]["faces"], 4);  // the folded faces are kept
+  // (10, 0.5) is 0.5 from the segment; (20, 0.5) is hypot(0.25, 0.5) from the point.
+  EXPECT_NEAR(json["a_to_b"]["max"].get<double>(), std::hypot(0.25, 0.5), 1e-6);
+  EXPECT_LE(json["b_to_a"]["max"].get<double>(), 1e-6);
+  std::filesystem::remove(original_path);
+  std::filesystem::remove(folded_path);
 }
 
 TEST(MeshCommands, BadDataExitsOneAndBadUsageTwo) {

@@ -45,6 +45,75 @@ TEST(SurfaceDistance, ShiftedSquareIsAtTheShiftEverywhere) {
   EXPECT_NEAR(d->relative_hausdorff(), shift / std::sqrt(2.0), 1e-7);
 }
 
+// A unit square, plus two small separate triangles far from it: the original.
+// The "decoded" copy keeps the square and folds the first small triangle to
+// a segment and the second to a point, as 12-bit quantization does on dense
+// scans. `same_index` writes the folds as repeated indices (what welding
+// makes of them), otherwise as distinct vertices at one position (what a
+// decoder writes).
+struct FoldedPair {
+  Mesh original, folded;
+};
+
+FoldedPair folded_components(bool same_index) {
+  FoldedPair p;
+  p.original = grid_square(2, 0);
+  p.folded = p.original;
+  auto add = [](Mesh& m, std::initializer_list<Vec3f> corners) {
+    const uint32_t first = m.vertex_count();
+    for (const Vec3f& c : corners) m.positions.push_back(c);
+    m.triangles.push_back({first, first + 1, first + 2});
+  };
+  // Far to the side (x = 10 and x = 20), 0.1 across.
+  add(p.original, {{10, 0, 0}, {10.1f, 0, 0}, {10, 0.1f, 0}});
+  add(p.original, {{20, 0, 0}, {20.1f, 0, 0}, {20, 0.1f, 0}});
+  const Vec3f on_segment{10.05f, 0, 0};
+  const Vec3f point{20.03f, 0.03f, 0};
+  if (same_index) {
+    const uint32_t s = p.folded.vertex_count();
+    p.folded.positions.push_back({10, 0, 0});
+    p.folded.positions.push_back({10.1f, 0, 0});
+    p.folded.triangles.push_back({s, s + 1, s + 1});  // the segment
+    p.folded.positions.push_back(point);
+    p.folded.triangles.push_back({s + 2, s + 2, s + 2});  // the point
+  } else {
+    add(p.folded, {{10, 0, 0}, {10.1f, 0, 0}, on_segment});
+    add(p.folded, {point, point, point});
+  }
+  return p;
+}
+
+// The farthest point of a small original triangle from its folded copy is a
+// corner (distance to a convex set is convex): (10, 0.1) to the segment on
+// the x axis, and the corners (20.1, 0) and (20, 0.1) to the point.
+double expected_folded_distance() {
+  auto d = [](double x, double y, double px, double py) { return std::hypot(x - px, y - py); };
+  const float f01 = 0.1f, f201 = 20.1f, f2003 = 20.03f, f003 = 0.03f;
+  const double to_segment = f01;
+  const double to_point = std::max(d(f201, 0, f2003, f003), d(20, f01, f2003, f003));
+  return std::max(to_segment, to_point);
+}
+
+TEST(SurfaceDistance, AFoldedTriangleCountsAsItsSegmentOrPoint) {
+  for (bool same_index : {false, true}) {
+    const FoldedPair p = folded_components(same_index);
+    auto d = surface_distance(p.original, p.folded, few_samples());
+    ASSERT_TRUE(d) << d.error().message;
+    // Were the folded faces dropped, the small triangles would be measured
+    // against the square, about 9 and 19 away.
+    EXPECT_NEAR(d->a_to_b.max, expected_folded_distance(), 1e-6) << same_index;
+    // The folded copy lies on the original: its segment and point are inside
+    // the original triangles.
+    EXPECT_LE(d->b_to_a.max, 1e-6) << same_index;
+    // The point and the segment are targets of their own, not only samples.
+    const TriangleBvh bvh = TriangleBvh::build(p.folded);
+    const ClosestHit near_point = bvh.closest({20.03, 0.03, 1});
+    EXPECT_NEAR(near_point.squared_distance, 1.0, 1e-9) << same_index;
+    const ClosestHit near_segment = bvh.closest({10.02, -0.5, 0});
+    EXPECT_NEAR(near_segment.squared_distance, 0.25, 1e-9) << same_index;
+  }
+}
+
 TEST(SurfaceDistance, SphereAgainstItsScaledCopyIsTheRadialGap) {
   // Vertices lie on the spheres of radius 1 and 1.1; the flat facets sit at
   // most 1 - cos(0.04) < 1e-3 inside them, which bounds the deviation.
