@@ -50,6 +50,7 @@ Server::Server(const ServerOptions& options)
   shared_.active_sessions = &active_sessions_;
   shared_.rejecting_sessions = &rejecting_;
   shared_.first_chunks = &first_chunks_;
+  shared_.metrics = &metrics_;
   unsigned threads = options_.threads ? options_.threads : std::thread::hardware_concurrency();
   threads = std::max(1u, threads);
   for (unsigned i = 0; i < threads; ++i) {
@@ -59,7 +60,38 @@ Server::Server(const ServerOptions& options)
   }
 }
 
-Server::~Server() = default;
+Server::~Server() {
+  // Before the counters and the catalog it reads go.
+  if (metrics_endpoint_) metrics_endpoint_->stop();
+}
+
+std::optional<net::tcp::endpoint> Server::metrics_endpoint() const {
+  if (!metrics_endpoint_) return std::nullopt;
+  return metrics_endpoint_->local_endpoint();
+}
+
+Status Server::listen_metrics() {
+  metrics_endpoint_ = std::make_unique<MetricsEndpoint>(
+      [this] {
+        ModelCounts models;
+        // Every model in the catalog is ready: it is loaded (encoded or
+        // mapped) before it is added.
+        if (const Catalog* catalog = serving_catalog_.load()) models.ready = catalog->size();
+        return render_prometheus(metrics_, active_sessions_.load(), models);
+      },
+      [this] {
+        if (stopping_) return MetricsEndpoint::Health{false, "shutting down"};
+        if (!serving_catalog_.load()) return MetricsEndpoint::Health{false, "loading"};
+        return MetricsEndpoint::Health{true, ""};
+      });
+  if (auto status = metrics_endpoint_->listen(options_.metrics_host, options_.metrics_port);
+      !status) {
+    metrics_endpoint_.reset();
+    return status;
+  }
+  metrics_endpoint_->start();
+  return {};
+}
 
 Status Server::listen() {
   boost::system::error_code ec;
@@ -95,12 +127,14 @@ Status Server::listen() {
                                           ec.message());
   }
   acceptor_ = std::move(acceptor);
+  if (!options_.metrics_host.empty()) return listen_metrics();
   return {};
 }
 
 void Server::start_serving(const Catalog& catalog) {
   shared_.catalog = &catalog;
   shared_.model_list_frame = model_list_frame(catalog);
+  serving_catalog_ = &catalog;
   // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
   // queues a signal that arrives before run() and delivers it then.
   signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);
@@ -215,6 +249,8 @@ void Server::run(std::chrono::milliseconds grace) {
   }
   for (auto& t : threads) t.join();
   first_chunks_.stop_waking();
+  // HAProxy's check sees 503 from stop() on; the endpoint closes with us.
+  if (metrics_endpoint_) metrics_endpoint_->stop();
   spdlog::info("server stopped");
 }
 

@@ -8,11 +8,13 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "common/base/result.h"
 #include "common/net/asio.h"
 #include "server/catalog.h"
+#include "server/metrics_http.h"
 #include "server/server_options.h"
 #include "server/session.h"
 
@@ -25,7 +27,8 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and listens on options.listen_host:listen_port: done before the
+  // Binds and listens on options.listen_host:listen_port (and starts the
+  // --metrics endpoint, whose /healthz says 503 until start_serving): done before the
   // catalog is loaded, so an unusable address fails at once instead of
   // after every model is encoded. Clients that connect before run() wait in
   // the backlog. kIo when the address is unusable (in use, not local, not an
@@ -33,6 +36,8 @@ class Server {
   Status listen();
   // The bound address (after listen()); port is the real one for port 0.
   net::tcp::endpoint local_endpoint() const;
+  // The --metrics address (after listen()); nullopt without --metrics.
+  std::optional<net::tcp::endpoint> metrics_endpoint() const;
 
   // What the server serves (must outlive it), and from now on SIGINT/SIGTERM
   // mean stop(). Call after listen(), before announcing the port and run().
@@ -55,9 +60,13 @@ class Server {
 
   net::asio::awaitable<void> accept_loop();
   void begin_shutdown();  // on worker 0
+  Status listen_metrics();
 
   const ServerOptions& options_;
   FirstChunkGate first_chunks_;
+  ServerMetrics metrics_;
+  std::atomic<const Catalog*> serving_catalog_{nullptr};  // for /metrics, set by start_serving
+  std::unique_ptr<MetricsEndpoint> metrics_endpoint_;
   ServerShared shared_;
   std::atomic<int64_t> active_sessions_{0};
   std::atomic<int64_t> rejecting_{0};

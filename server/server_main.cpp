@@ -125,6 +125,10 @@ int main(int argc, char** argv) {
   server.start_serving(catalog);
   std::printf("listening on %s:%u\n", endpoint.address().to_string().c_str(),
               unsigned(endpoint.port()));
+  if (const auto metrics = server.metrics_endpoint()) {
+    std::printf("metrics on %s:%u\n", metrics->address().to_string().c_str(),
+                unsigned(metrics->port()));
+  }
   std::fflush(stdout);
   server.run();
   return 0;
