@@ -29,25 +29,4 @@ Result<CatalogModel> make_model(std::string name, std::string source, std::strin
   return model;
 }
 
-Status Catalog::add(CatalogModel model) {
-  if (contains(model.name)) {
-    return make_error(ErrorCode::kInvalidArgument, "model name '" + model.name + "' is taken");
-  }
-  std::string name = model.name;
-  models_.emplace(std::move(name), std::move(model));
-  return {};
-}
-
-const CatalogModel* Catalog::find(std::string_view name) const {
-  auto it = models_.find(name);
-  return it == models_.end() ? nullptr : &it->second;
-}
-
-std::vector<const CatalogModel*> Catalog::models() const {
-  std::vector<const CatalogModel*> out;
-  out.reserve(models_.size());
-  for (const auto& [name, model] : models_) out.push_back(&model);
-  return out;
-}
-
 }  // namespace meshstream::server

@@ -2,15 +2,10 @@
 
 #include <unistd.h>
 
-#include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
 #include <optional>
-#include <thread>
 
 #include "server/cache_lock.h"
 
@@ -24,7 +19,8 @@ namespace fs = std::filesystem;
 
 bool encoder_built() { return MESHSTREAM_HAVE_MESH_ENCODER != 0; }
 
-EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir) {
+EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir,
+                            const EncodeProgressCallback& progress) {
   EncodeOutcome out;
   const auto start = std::chrono::steady_clock::now();
   auto finish = [&](Result<CatalogModel> model) {
@@ -33,7 +29,8 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir) 
     return out;
   };
 #if MESHSTREAM_HAVE_MESH_ENCODER
-  const EncodeOptions options;
+  EncodeOptions options;
+  options.progress = progress;
   const fs::path cached =
       cache_dir.empty()
           ? fs::path()
@@ -82,6 +79,7 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir) 
   return finish(make_model(job.name, job.source, job.origin, own_bytes(std::move(*encoded))));
 #else
   (void)cache_dir;
+  (void)progress;
   return finish(make_error(ErrorCode::kUnsupported,
                            job.origin + ": this build cannot encode meshes (no encoder)"));
 #endif
@@ -109,52 +107,6 @@ Result<bool> prepare_cache_folder(const std::string& dir, bool create_parents) {
   }
   if (ec) return make_error(ErrorCode::kIo, dir + ": cannot create it: " + ec.message());
   return true;
-}
-
-void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsigned threads,
-                Catalog& catalog, const CatalogLog& log) {
-  if (jobs.empty()) return;
-  if (!cache_dir.empty()) {
-    std::error_code ec;
-    if (!fs::is_directory(cache_dir, ec)) {
-      log(CatalogLogLevel::kWarn,
-          "cache " + cache_dir + " unusable (not a folder); encoding in memory");
-      cache_dir.clear();
-    }
-  }
-  if (threads == 0) threads = std::thread::hardware_concurrency();
-  threads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(jobs.size())));
-  std::vector<EncodeOutcome> outcomes(jobs.size());
-  std::atomic<size_t> next{0};
-  size_t done = 0;
-  std::mutex log_mutex;
-  auto work = [&] {
-    for (size_t i = next++; i < jobs.size(); i = next++) {
-      outcomes[i] = encode_cached(jobs[i], cache_dir);
-      std::lock_guard lock(log_mutex);
-      std::string line = "[" + std::to_string(++done) + "/" + std::to_string(jobs.size()) + "] ";
-      const EncodeOutcome& o = outcomes[i];
-      CatalogLogLevel level = CatalogLogLevel::kInfo;
-      if (o.model) {
-        char facts[256];
-        std::snprintf(facts, sizeof facts, "%s %s: %u vertices, %zu bytes in %.2f s",
-                      o.from_cache ? "from cache" : "encoded", jobs[i].origin.c_str(),
-                      o.model->index.header.vertex_count, o.model->stream().size(), o.seconds);
-        line += facts;
-      } else {
-        line += "skipped: " + o.model.error().message;  // errors name the input
-        level = CatalogLogLevel::kWarn;
-      }
-      log(level, line);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  for (EncodeOutcome& o : outcomes) {
-    if (o.model) (void)catalog.add(std::move(*o.model));
-  }
 }
 
 }  // namespace meshstream::server

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/base/result.h"
+#include "common/codec/encode_progress.h"
 #include "common/mesh/mesh.h"
 #include "server/catalog.h"
 
@@ -34,7 +35,10 @@ struct EncodeOutcome {
 // and a miss is encoded under the entry's lock (server/cache_lock.h), so
 // threads and processes sharing `cache_dir` encode each entry once and never
 // see it half-written. Cost: an encode on a miss, O(1) on a hit.
-EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir);
+// `progress`, if set, gets the encoder's progress (encode_progress.h) on
+// this thread; a cache hit reports nothing.
+EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir,
+                            const EncodeProgressCallback& progress = {});
 
 // Makes `dir` ready to hold cached streams: nothing to do when it is a
 // folder; else creates it, only its last level unless `create_parents` (a
@@ -43,14 +47,6 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir);
 // `create_parents`) its parent is missing, kIo when creating fails; the
 // message names `dir`.
 Result<bool> prepare_cache_folder(const std::string& dir, bool create_parents);
-
-// Runs `jobs` on `threads` threads (0 = one per core), calling `log` with a
-// progress line as each finishes ("[3/12] encoded bunny.ply: ...", a
-// warning for a failure), and adds the successes to `catalog` in job order.
-// A `cache_dir` that is not a folder is one warning; the jobs then encode
-// in memory.
-void encode_all(const std::vector<EncodeJob>& jobs, std::string cache_dir, unsigned threads,
-                Catalog& catalog, const CatalogLog& log);
 
 // Whether this build has the mesh importer, encoder and demo meshes.
 bool encoder_built();

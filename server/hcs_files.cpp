@@ -1,27 +1,22 @@
 // `.hcs` files served exactly as they are on disk.
-#include "server/folder_loaders.h"
+#include <fstream>
+
+#include "server/model_sources.h"
 
 namespace meshstream::server {
 
-void add_hcs_files(const std::vector<ModelFile>& files, Catalog& catalog, const CatalogLog& log) {
-  for (const ModelFile& file : files) {
-    if (catalog.contains(file.name)) {
-      log(CatalogLogLevel::kWarn,
-          "skipped " + file.path + ": model name '" + file.name + "' is taken");
-      continue;
-    }
-    auto bytes = map_file(file.path);
-    if (!bytes) {
-      log(CatalogLogLevel::kWarn, "skipped " + bytes.error().message);
-      continue;
-    }
-    auto model = make_model(file.name, "hcs", file.path, std::move(*bytes));
-    if (!model) {
-      log(CatalogLogLevel::kWarn, "skipped " + model.error().message);
-      continue;
-    }
-    (void)catalog.add(std::move(*model));
-  }
+Result<CatalogModel> load_hcs_file(const ModelFile& file) {
+  std::ifstream in(file.path, std::ios::binary | std::ios::ate);
+  if (!in) return make_error(ErrorCode::kIo, file.path + ": cannot open it");
+  const std::streamoff size = in.tellg();
+  if (size <= 0) return make_error(ErrorCode::kInvalidArgument, file.path + ": empty file");
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(bytes.data()), size);
+  // A file cut short while we read is caught by make_model's checks.
+  bytes.resize(static_cast<size_t>(in.gcount()));
+  if (bytes.empty()) return make_error(ErrorCode::kIo, file.path + ": cannot read it");
+  return make_model(file.name, "hcs", file.path, own_bytes(std::move(bytes)));
 }
 
 }  // namespace meshstream::server

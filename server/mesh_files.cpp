@@ -1,6 +1,6 @@
-// Mesh files imported and encoded at start-up on all cores, cached by
-// content hash and encoder version (encode_cache.h) so a second start maps
-// the cache instead of encoding again.
+// Mesh files imported and encoded by the encoder pool, cached by content
+// hash and encoder version (encode_cache.h) so a second start maps the
+// cache instead of encoding again.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -8,7 +8,7 @@
 
 #include "common/mesh/import.h"
 #include "server/encode_cache.h"
-#include "server/folder_loaders.h"
+#include "server/model_sources.h"
 
 namespace meshstream::server {
 namespace {
@@ -40,33 +40,28 @@ Result<std::string> content_key(const fs::path& path) {
 
 }  // namespace
 
-void encode_mesh_files(const std::vector<ModelFile>& files, const std::string& cache_dir,
-                       unsigned threads, Catalog& catalog, const CatalogLog& log) {
-  std::vector<EncodeJob> jobs;
-  for (const ModelFile& file : files) {
-    if (catalog.contains(file.name)) {
-      log(CatalogLogLevel::kWarn,
-          "skipped " + file.path + ": model name '" + file.name + "' is taken");
-      continue;
-    }
+EncodeTask mesh_file_task(const ModelFile& file, const std::string& cache_dir) {
+  EncodeTask task{file.name, "mesh", file.path, nullptr};
+  task.run = [file, cache_dir](const EncodeProgressCallback& progress,
+                               bool& from_cache) -> Result<CatalogModel> {
     if (!encoder_built()) {
-      log(CatalogLogLevel::kWarn,
-          "skipped " + file.path + ": this build cannot encode meshes (serve an .hcs)");
-      continue;
+      return make_error(ErrorCode::kUnsupported,
+                        file.path + ": this build cannot encode meshes (serve an .hcs)");
     }
+    // Hashed here, on the encoder thread: a big file costs a read.
     auto key = content_key(file.path);
-    if (!key) {
-      log(CatalogLogLevel::kWarn, "skipped " + key.error().message);
-      continue;
-    }
+    if (!key) return tl::unexpected(key.error());
     const std::string origin = file.path;
-    jobs.push_back(EncodeJob{file.name, "mesh", origin, *key, [origin]() -> Result<Mesh> {
-                               auto imported = import_mesh(origin);
-                               if (!imported) return tl::unexpected(imported.error());
-                               return std::move(imported->mesh);
-                             }});
-  }
-  encode_all(jobs, cache_dir, threads, catalog, log);
+    const EncodeJob job{file.name, "mesh", origin, *key, [origin]() -> Result<Mesh> {
+                          auto imported = import_mesh(origin);
+                          if (!imported) return tl::unexpected(imported.error());
+                          return std::move(imported->mesh);
+                        }};
+    EncodeOutcome outcome = encode_cached(job, cache_dir, progress);
+    from_cache = outcome.from_cache;
+    return std::move(outcome.model);
+  };
+  return task;
 }
 
 bool mesh_encoding_available() { return encoder_built(); }

@@ -13,21 +13,6 @@ namespace asio = net::asio;
 using asio::awaitable;
 using asio::use_awaitable;
 
-std::shared_ptr<const std::vector<uint8_t>> model_list_frame(const Catalog& catalog) {
-  v1::ServerMessage out;
-  v1::ModelList* list = out.mutable_model_list();
-  for (const CatalogModel* model : catalog.models()) {
-    v1::ModelInfo* info = list->add_models();
-    info->set_name(model->name);
-    info->set_vertices(model->index.header.vertex_count);
-    info->set_faces(model->index.header.face_count);
-    info->set_stream_bytes(model->index.total_bytes());
-    info->set_records(static_cast<uint32_t>(model->index.records.size()));
-    info->set_source(model->source);
-  }
-  return std::make_shared<const std::vector<uint8_t>>(proto::encode_frame(out));
-}
-
 std::shared_ptr<const std::vector<uint8_t>> hello_frame(const ServerOptions& options) {
   v1::ServerMessage out;
   v1::ServerHello* hello = out.mutable_hello();
@@ -74,14 +59,20 @@ Status Server::listen_metrics() {
   metrics_endpoint_ = std::make_unique<MetricsEndpoint>(
       [this] {
         ModelCounts models;
-        // Every model in the catalog is ready: it is loaded (encoded or
-        // mapped) before it is added.
-        if (const Catalog* catalog = serving_catalog_.load()) models.ready = catalog->size();
+        if (const ModelRegistry* registry = serving_models_.load()) {
+          const StateCounts counts = registry->counts();
+          models.queued = counts.queued;
+          models.encoding = counts.encoding;
+          models.ready = counts.ready;
+          models.failed = counts.failed;
+        }
         return render_prometheus(metrics_, active_sessions_.load(), models);
       },
       [this] {
         if (stopping_) return MetricsEndpoint::Health{false, "shutting down"};
-        if (!serving_catalog_.load()) return MetricsEndpoint::Health{false, "loading"};
+        if (!serving_models_.load() || !initial_models_done_) {
+          return MetricsEndpoint::Health{false, "loading models"};
+        }
         return MetricsEndpoint::Health{true, ""};
       });
   if (auto status = metrics_endpoint_->listen(options_.metrics_host, options_.metrics_port);
@@ -131,10 +122,9 @@ Status Server::listen() {
   return {};
 }
 
-void Server::start_serving(const Catalog& catalog) {
-  shared_.catalog = &catalog;
-  shared_.model_list_frame = model_list_frame(catalog);
-  serving_catalog_ = &catalog;
+void Server::start_serving(const ModelRegistry& models) {
+  shared_.models = &models;
+  serving_models_ = &models;
   // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
   // queues a signal that arrives before run() and delivers it then.
   signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);

@@ -13,8 +13,8 @@
 
 #include "common/base/result.h"
 #include "common/net/asio.h"
-#include "server/catalog.h"
 #include "server/metrics_http.h"
+#include "server/model_registry.h"
 #include "server/server_options.h"
 #include "server/session.h"
 
@@ -27,11 +27,11 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and listens on options.listen_host:listen_port (and starts the
-  // --metrics endpoint, whose /healthz says 503 until start_serving): done before the
-  // catalog is loaded, so an unusable address fails at once instead of
-  // after every model is encoded. Clients that connect before run() wait in
-  // the backlog. kIo when the address is unusable (in use, not local, not an
+  // Binds and listens on options.listen_host:listen_port, first of all, so
+  // an unusable address fails at once (and starts the --metrics endpoint,
+  // whose /healthz says 503 until start_serving). Clients that connect
+  // before run() wait in the backlog. kIo when the address is unusable (in
+  // use, not local, not an
   // address); the message names it and the cause.
   Status listen();
   // The bound address (after listen()); port is the real one for port 0.
@@ -39,17 +39,20 @@ class Server {
   // The --metrics address (after listen()); nullopt without --metrics.
   std::optional<net::tcp::endpoint> metrics_endpoint() const;
 
-  // What the server serves (must outlive it), and from now on SIGINT/SIGTERM
-  // mean stop(). Call after listen(), before announcing the port and run().
-  // (Until then the signals keep their default effect, so Ctrl-C while the
-  // models are encoding ends the program at once.)
-  void start_serving(const Catalog& catalog);
+  // What the server serves (must outlive it; it may change while the
+  // server runs: models are encoded in the background), and from now on
+  // SIGINT/SIGTERM mean stop(). Call after listen(), before announcing the
+  // port and run().
+  void start_serving(const ModelRegistry& models);
 
   // Serves until stop() or SIGINT/SIGTERM, then shuts down cleanly (sessions
   // get up to `grace` to close) and returns. Blocks the calling thread.
   void run(std::chrono::milliseconds grace = std::chrono::milliseconds(3000));
   // Thread-safe, idempotent: begins the clean shutdown.
   void stop();
+  // Thread-safe: every model found at start is ready or failed; from now on
+  // /healthz answers 200 (a load balancer sends clients only then).
+  void initial_models_done() { initial_models_done_ = true; }
 
  private:
   struct Worker {
@@ -65,7 +68,7 @@ class Server {
   const ServerOptions& options_;
   FirstChunkGate first_chunks_;
   ServerMetrics metrics_;
-  std::atomic<const Catalog*> serving_catalog_{nullptr};  // for /metrics, set by start_serving
+  std::atomic<const ModelRegistry*> serving_models_{nullptr};  // for /metrics, set by start_serving
   std::unique_ptr<MetricsEndpoint> metrics_endpoint_;
   ServerShared shared_;
   std::atomic<int64_t> active_sessions_{0};
@@ -74,6 +77,7 @@ class Server {
   std::unique_ptr<net::tcp::acceptor> acceptor_;
   std::unique_ptr<net::asio::signal_set> signals_;
   std::atomic<bool> stopping_{false};
+  std::atomic<bool> initial_models_done_{false};
   std::mutex mutex_;
   std::condition_variable stopped_;
   size_t next_worker_ = 0;

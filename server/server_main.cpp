@@ -1,16 +1,24 @@
 // meshstream-server: parse options -> check the folders -> bind the address
-// -> load the catalog (encoding what is not cached) -> announce the port ->
-// serve until SIGINT/SIGTERM -> exit 0. Bad input (a folder that is not
-// there, an address in use, nothing to serve) exits 1 with one line.
+// -> announce the port -> serve until SIGINT/SIGTERM while the folder
+// watcher and the encoder pool fill the model registry in the background ->
+// exit 0. Bad input (a folder that is not there, an address in use, nothing
+// that could ever be served) exits 1 with one line.
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
 #include "server/catalog.h"
 #include "server/encode_cache.h"
+#include "server/encoder_pool.h"
+#include "server/folder_watcher.h"
+#include "server/model_registry.h"
+#include "server/model_sources.h"
 #include "server/models_folder.h"
 #include "server/server.h"
 #include "server/server_options.h"
@@ -51,37 +59,30 @@ meshstream::Result<std::string> prepare_cache(const ServerOptions& options) {
   return options.cache_dir;
 }
 
-Catalog load_catalog(const ServerOptions& options, const std::string& cache_dir) {
-  std::vector<std::unique_ptr<CatalogSource>> sources;
-  if (!options.models_dir.empty()) {
-    sources.push_back(models_folder_source({options.models_dir, cache_dir, 0}));
+void log_catalog_line(CatalogLogLevel level, const std::string& line) {
+  if (level == CatalogLogLevel::kWarn) {
+    spdlog::warn("catalog: {}", line);
+  } else {
+    spdlog::info("catalog: {}", line);
   }
-  if (options.demo) sources.push_back(demo_source(cache_dir));
-  Catalog catalog;
-  for (auto& source : sources) {
-    source->load(catalog, [](CatalogLogLevel level, const std::string& line) {
-      if (level == CatalogLogLevel::kWarn) {
-        spdlog::warn("catalog: {}", line);
-      } else {
-        spdlog::info("catalog: {}", line);
-      }
-    });
-  }
-  return catalog;
 }
 
-void log_catalog(const Catalog& catalog) {
-  for (const CatalogModel* model : catalog.models()) {
-    spdlog::info("serving {} ({}, {} vertices, {} bytes, {} records)", model->name, model->source,
-                 model->index.header.vertex_count, model->index.total_bytes(),
-                 model->index.records.size());
-    if (model->compact.coded.empty()) {
-      spdlog::warn(
-          "{}: its record index cannot be coded compactly ({}); its headers carry the "
-          "arrays",
-          model->name, model->compact.refused);
-    }
-  }
+// With --watch off, a folder that holds nothing the server reads will never
+// serve anything: the one-line reason, else "".
+std::string nothing_to_serve(const ServerOptions& options) {
+  const bool demo = options.demo && demo_models_available();
+  if (demo) return {};
+  if (options.models_dir.empty())
+    return "no model to serve (this build cannot make the demo models)";
+  if (options.watch != "off") return {};
+  auto scan = scan_models_folder(options.models_dir);
+  if (scan && (!scan->hcs.empty() || !scan->meshes.empty())) return {};
+  return "no model to serve in " + options.models_dir + " (the server reads files ending in " +
+         served_extensions() + "; add some, or --demo)";
+}
+
+WatchMode watch_mode(const std::string& text) {
+  return text == "poll" ? WatchMode::kPoll : text == "off" ? WatchMode::kOff : WatchMode::kAuto;
 }
 
 }  // namespace
@@ -101,28 +102,56 @@ int main(int argc, char** argv) {
       return fail(problem);
     }
   }
-  // Bind before loading: encoding a folder can take minutes, and a port in
-  // use must not be found out only after that.
+  // Bind first, and listen at once: the models are encoded in the
+  // background while the server serves.
   Server server(options);
   if (auto status = server.listen(); !status) return fail(status.error().message);
   const auto endpoint = server.local_endpoint();
-  spdlog::info("bound {}:{}; loading the models before serving", endpoint.address().to_string(),
-               endpoint.port());
-
   const auto cache_dir = prepare_cache(options);
   if (!cache_dir) return fail(cache_dir.error().message);
-  const Catalog catalog = load_catalog(options, *cache_dir);
-  // (Once the server serves while it encodes, an empty folder will be a
-  // folder to watch; until then a server with nothing to serve is a mistake.)
-  if (catalog.size() == 0) {
-    return fail(options.models_dir.empty()
-                    ? std::string("no model to serve (this build cannot make the demo models)")
-                    : "no model to serve in " + options.models_dir + " (the server reads files " +
-                          "ending in " + served_extensions() + "; add some, or --demo)");
-  }
-  log_catalog(catalog);
+  if (const std::string problem = nothing_to_serve(options); !problem.empty()) return fail(problem);
 
-  server.start_serving(catalog);
+  const auto started = std::chrono::steady_clock::now();
+  ModelRegistry registry;
+  EncoderPool pool(registry, options.encoders, log_catalog_line);
+  // One line once everything found at start is ready or failed (scripts and
+  // tests wait for it: "initial models done").
+  // With --watch off, nothing new will come: a server none of whose models
+  // could be made is a mistake (exit 1), as it was before it watched.
+  std::atomic<bool> nothing_ready{false};
+  auto report_initial = [&] {
+    const StateCounts counts = registry.counts();
+    spdlog::info("catalog: initial models done: {} ready, {} failed in {:.2f} s", counts.ready,
+                 counts.failed,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    server.initial_models_done();
+    if (counts.ready == 0 && options.watch == "off") {
+      nothing_ready = true;
+      server.stop();
+    }
+  };
+  // The demo models, after the folder's first scan (a file of the same name
+  // wins, as it always has).
+  std::unique_ptr<FolderWatcher> watcher;
+  auto add_demo_models = [&] {
+    if (options.demo) {
+      if (!demo_models_available()) {
+        spdlog::warn("catalog: --demo: this build has no procedural demo meshes or no encoder");
+      }
+      const auto taken = registry.snapshot();
+      for (EncodeTask& task : demo_tasks(*cache_dir)) {
+        if (taken->count(task.name)) {
+          spdlog::warn("catalog: skipped demo model '{}': name is taken", task.name);
+          continue;
+        }
+        if (watcher) watcher->reserve(task.name);
+        pool.submit(std::move(task));
+      }
+    }
+    pool.when_idle(report_initial);
+  };
+
+  server.start_serving(registry);
   std::printf("listening on %s:%u\n", endpoint.address().to_string().c_str(),
               unsigned(endpoint.port()));
   if (const auto metrics = server.metrics_endpoint()) {
@@ -130,6 +159,40 @@ int main(int argc, char** argv) {
                 unsigned(metrics->port()));
   }
   std::fflush(stdout);
+  spdlog::info("serving while {} background encoder{} encode what is not cached", pool.encoders(),
+               pool.encoders() == 1 ? "" : "s");
+  if (!options.models_dir.empty()) {
+    watcher = std::make_unique<FolderWatcher>(
+        FolderWatchOptions{options.models_dir, *cache_dir, watch_mode(options.watch)}, registry,
+        pool, log_catalog_line, [&] {
+          if (registry.counts().total() == 0) {
+            spdlog::warn(
+                "catalog: no model in {} yet (the server reads files ending in {}); "
+                "serving them as they arrive",
+                options.models_dir, served_extensions());
+          }
+          add_demo_models();
+        });
+    watcher->start();
+  } else {
+    add_demo_models();
+  }
   server.run();
+  if (watcher) watcher->stop();
+  const std::vector<std::string> running = pool.stop(std::chrono::milliseconds(0));
+  if (!running.empty()) {
+    // An encode cannot be interrupted and may take minutes: do not wait for
+    // it (the cache only ever holds whole streams: temp file, then rename).
+    std::string names;
+    for (const std::string& name : running) names += (names.empty() ? "" : ", ") + name;
+    spdlog::info("abandoning the encodes still running: {}", names);
+    spdlog::shutdown();
+    std::fflush(stdout);
+    std::_Exit(0);
+  }
+  if (nothing_ready) {
+    return fail("no model to serve in " + options.models_dir + " (the server reads files " +
+                "ending in " + served_extensions() + "; add some, or --demo)");
+  }
   return 0;
 }

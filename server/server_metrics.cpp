@@ -56,11 +56,13 @@ std::string render_prometheus(const ServerMetrics& m, int64_t open_sessions,
                load(m.errors[static_cast<size_t>(code)]));
   }
   out.family("meshstream_models", "gauge", "Models in the catalog, by state.");
-  out.sample("state", "ready", models.ready);
+  out.sample("state", "queued", models.queued);
   out.sample("state", "encoding", models.encoding);
+  out.sample("state", "ready", models.ready);
   out.sample("state", "failed", models.failed);
-  out.family("meshstream_encode_queue_length", "gauge", "Models waiting for the encoder.");
-  out.sample(models.encode_queue);
+  out.family("meshstream_encode_queue_length", "gauge",
+             "Models waiting for the encoder (queued, not yet encoding).");
+  out.sample(models.queued);
   return out.take();
 }
 

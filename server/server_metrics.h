@@ -33,13 +33,13 @@ struct ServerMetrics {
   }
 };
 
-// What the catalog holds, by state (ready / encoding / failed), and the
-// models waiting for the encoder.
+// What the catalog holds, by state (ModelState: queued for the encoder,
+// encoding, ready, failed).
 struct ModelCounts {
-  uint64_t ready = 0;
+  uint64_t queued = 0;
   uint64_t encoding = 0;
+  uint64_t ready = 0;
   uint64_t failed = 0;
-  uint64_t encode_queue = 0;
 };
 
 // The Prometheus text exposition (format 0.0.4) of `metrics`, the open

@@ -47,12 +47,23 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   uint64_t hold_ms = o.first_chunk_hold.count();
   cli::add_version_flag(app, "meshstream-server");
   app.add_option("--models", o.models_dir,
-                 "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded at start-up; "
-                 "other files are skipped with a warning");
+                 "folder of models: .hcs served as-is, PLY/OBJ/STL/DRC/OFF encoded in the "
+                 "background; other files are skipped with a warning. Watched while the server "
+                 "runs: files added, changed or removed are picked up within seconds");
   app.add_option("--listen", listen,
-                 "address to listen on, HOST:PORT (port 0 = any free port); bound before the "
-                 "models load, so a busy port fails at once")
+                 "address to listen on, HOST:PORT (port 0 = any free port); the server listens "
+                 "at once and encodes while it serves")
       ->capture_default_str();
+  app.add_option("--encoders", o.encoders,
+                 "models encoded at once in the background (0 = one per core less one, at "
+                 "least one)")
+      ->capture_default_str()
+      ->check(CLI::Range(0u, 256u));
+  app.add_option("--watch", o.watch,
+                 "how --models is watched: auto (inotify, polling every second where it is "
+                 "missing), poll (every second; for network file systems), off (read once)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "poll", "off"}));
   app.add_flag("--demo", o.demo, "also serve the procedural demo models");
   app.add_option("--cache", cache,
                  "cache folder for encoded meshes (default $XDG_CACHE_HOME/meshstream or "

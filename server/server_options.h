@@ -21,6 +21,8 @@ struct ServerOptions {
   uint32_t max_connections = 1024;   // extra clients get Error{BUSY}
   uint64_t rate_bytes_per_s = 0;     // per connection; 0 = unlimited
   unsigned threads = 0;              // io threads; 0 = one per core
+  unsigned encoders = 0;             // background encoders; 0 = one per core less one, >= 1
+  std::string watch = "auto";        // --models folder: auto (inotify, else polling), poll, off
   std::chrono::milliseconds handshake_timeout{5000};
   std::chrono::milliseconds idle_timeout{60000};
   std::chrono::milliseconds stall_timeout{30000};

@@ -234,9 +234,14 @@ void Session::handle(const v1::ClientMessage& message) {
     case v1::ClientMessage::kHello:
       fail(v1::Error::PROTOCOL_VIOLATION, "Hello was already sent", "second hello");
       return;
-    case v1::ClientMessage::kListModels:
-      push(Frame{shared_.model_list_frame}, shared_.model_list_frame->size());
+    case v1::ClientMessage::kListModels: {
+      // Encoded per request: states change while the server runs.
+      auto frame = std::make_shared<const std::vector<uint8_t>>(
+          model_list_frame(*shared_.models->snapshot()));
+      const size_t size = frame->size();
+      push(Frame{std::move(frame)}, size);
       return;
+    }
     case v1::ClientMessage::kStream:
       handle_stream(message.stream());
       return;
@@ -250,14 +255,23 @@ void Session::handle(const v1::ClientMessage& message) {
 }
 
 void Session::handle_stream(const v1::StreamRequest& request) {
-  const CatalogModel* model = shared_.catalog->find(request.model());
-  if (!model) {
+  const auto snapshot = shared_.models->snapshot();
+  const auto found = snapshot->find(request.model());
+  if (found == snapshot->end()) {
     std::vector<std::string> names;
-    for (const CatalogModel* m : shared_.catalog->models()) names.push_back(m->name);
+    for (const auto& [name, status] : *snapshot) names.push_back(name);
     const std::string message =
         unknown_model_message(request.model(), closest_names(request.model(), names));
     spdlog::info("session {}: {}", peer_, message);
     send_error(v1::Error::UNKNOWN_MODEL, message, false);
+    return;
+  }
+  const ModelStatus& status = found->second;
+  // A changed file's model keeps its previous stream served while it is
+  // re-encoded; only a model with no stream yet is not ready.
+  std::shared_ptr<const CatalogModel> model = status.model;
+  if (!model) {
+    send_not_servable(status);
     return;
   }
   const Budget budget = request.has_budget() ? budget_from_wire(request.budget()) : Budget{};
@@ -276,12 +290,37 @@ void Session::handle_stream(const v1::StreamRequest& request) {
   }
   ++starting_;
   shared_.first_chunks->stream_starting(Clock::now());
-  push(StartStream{.model = model,
+  push(StartStream{.model = std::move(model),
                    .plan = *plan,
                    .chunk_bytes = chunk,
                    .requested = Clock::now(),
                    .compact_index = request.compact_index()},
        0);
+}
+
+void Session::send_not_servable(const ModelStatus& status) {
+  v1::ServerMessage out;
+  v1::Error* error = out.mutable_error();
+  *error->mutable_model() = model_info(status);
+  char progress[96];
+  if (status.state == ModelState::kFailed) {
+    error->set_code(v1::Error::MODEL_FAILED);
+    error->set_message("model '" + status.name + "' cannot be served: " + status.reason);
+  } else if (status.state == ModelState::kQueued) {
+    error->set_code(v1::Error::NOT_READY);
+    error->set_message("model '" + status.name +
+                       "' is not ready: queued for encoding; ask again later");
+  } else {
+    std::snprintf(progress, sizeof progress, "%.0f %%", status.percent);
+    error->set_code(v1::Error::NOT_READY);
+    error->set_message("model '" + status.name + "' is not ready: encoding, " + progress +
+                       (status.stage.empty() ? "" : " (" + status.stage + ")") +
+                       "; ask again later");
+  }
+  error->set_closing(false);
+  shared_.metrics->count_error(error->code());
+  spdlog::info("session {}: {}", peer_, error->message());
+  send(out, false);
 }
 
 // ------------------------------------------------------------------ writer
@@ -434,8 +473,7 @@ awaitable<bool> Session::begin_stream(const StartStream& start) {
   }
   const CatalogModel& model = *start.model;
   stream_.emplace(ActiveStream{
-      .model = &model,
-      .keep_alive = model.bytes,
+      .model = start.model,
       .plan = start.plan,
       .chunk_bytes = start.chunk_bytes,
       .requested = start.requested,

@@ -20,6 +20,7 @@
 #include "proto/framing.h"
 #include "server/catalog.h"
 #include "server/first_chunk_gate.h"
+#include "server/model_registry.h"
 #include "server/server_metrics.h"
 #include "server/server_options.h"
 #include "server/stream_plan.h"
@@ -32,11 +33,11 @@ class Session;
 // Shared, immutable for the server's lifetime (read from every thread).
 struct ServerShared {
   const ServerOptions* options = nullptr;
-  const Catalog* catalog = nullptr;
-  std::shared_ptr<const std::vector<uint8_t>> model_list_frame;  // ModelList, pre-encoded
-  std::shared_ptr<const std::vector<uint8_t>> hello_frame;       // ServerHello, pre-encoded
-  std::atomic<int64_t>* active_sessions = nullptr;               // counted toward --max-connections
-  std::atomic<int64_t>* rejecting_sessions = nullptr;            // busy sessions still closing
+  // The models and their states; thread-safe, changes while serving.
+  const ModelRegistry* models = nullptr;
+  std::shared_ptr<const std::vector<uint8_t>> hello_frame;  // ServerHello, pre-encoded
+  std::atomic<int64_t>* active_sessions = nullptr;          // counted toward --max-connections
+  std::atomic<int64_t>* rejecting_sessions = nullptr;       // busy sessions still closing
   FirstChunkGate* first_chunks = nullptr;  // bulk waits for new streams' first chunks
   ServerMetrics* metrics = nullptr;        // counters for --metrics (atomics)
 };
@@ -78,7 +79,9 @@ class Session : public std::enable_shared_from_this<Session> {
     bool closing = false;  // close gracefully after writing it
   };
   struct StartStream {
-    const CatalogModel* model = nullptr;
+    // Held from the request on: the registry may withdraw or replace the
+    // model meanwhile, this stream still finishes with these bytes.
+    std::shared_ptr<const CatalogModel> model;
     StreamPlan plan;
     size_t chunk_bytes = 0;
     Clock::time_point requested;  // when its request was read
@@ -88,8 +91,7 @@ class Session : public std::enable_shared_from_this<Session> {
   using Item = std::variant<Frame, StartStream, CancelStream>;
 
   struct ActiveStream {
-    const CatalogModel* model = nullptr;
-    std::shared_ptr<const StreamBytes> keep_alive;
+    std::shared_ptr<const CatalogModel> model;
     StreamPlan plan;
     size_t chunk_bytes = 0;
     Clock::time_point requested;
@@ -131,6 +133,8 @@ class Session : public std::enable_shared_from_this<Session> {
   void push(Item item, size_t bytes);
   void send(const google::protobuf::MessageLite& message, bool closing = false);
   void send_error(v1::Error::Code code, const std::string& message, bool closing);
+  // NOT_READY (queued, encoding) or MODEL_FAILED for a model with no stream.
+  void send_not_servable(const ModelStatus& status);
   // Fatal for the connection: error frame, then graceful close.
   void fail(v1::Error::Code code, const std::string& message, const std::string& log_reason);
   void close_now(const std::string& reason);

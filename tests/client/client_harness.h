@@ -185,6 +185,11 @@ class Server {
         const auto colon = line.rfind(':');
         if (line.rfind("listening on ", 0) != 0 || colon == std::string::npos) return false;
         port_ = static_cast<uint16_t>(std::stoi(line.substr(colon + 1)));
+        // The server encodes in the background while it serves: wait until
+        // the models it found at start are ready (or failed).
+        while (read_text(err_).find("initial models done") == std::string::npos) {
+          if (Clock::now() >= deadline + 100s || child_.wait(10ms)) return false;
+        }
         return true;
       }
       if (child_.wait(10ms)) return false;  // exited

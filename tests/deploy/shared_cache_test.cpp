@@ -58,10 +58,10 @@ TEST_F(SharedCacheTest, ServersStartedTogetherEncodeEachModelOnceAndServeTheSame
   std::string logs;
   for (const auto& s : fleet) logs += s->process.log();
   for (const std::string model : {"knot", "big"}) {
-    EXPECT_EQ(count_lines(logs, std::regex("\\] encoded .*" + model + "\\.ply")), 1)
+    EXPECT_EQ(count_lines(logs, std::regex(": encoded .*" + model + "\\.ply")), 1)
         << model << " must be encoded by exactly one of the 3 servers:\n"
         << logs;
-    EXPECT_EQ(count_lines(logs, std::regex("\\] from cache .*" + model + "\\.ply")), 2) << logs;
+    EXPECT_EQ(count_lines(logs, std::regex(": from cache .*" + model + "\\.ply")), 2) << logs;
   }
   // Two entries and their locks; no temporary file left.
   const std::vector<std::string> files = cache_files(cache);
@@ -73,7 +73,7 @@ TEST_F(SharedCacheTest, ServersStartedTogetherEncodeEachModelOnceAndServeTheSame
   nettest::ServerProcess alone;
   ASSERT_TRUE(alone.start(server_args(tmp_ / "cache-alone"), tmp_ / "alone.log", 60s))
       << alone.log();
-  EXPECT_EQ(count_lines(alone.log(), std::regex("\\] encoded ")), 2) << alone.log();
+  EXPECT_EQ(count_lines(alone.log(), std::regex(": encoded ")), 2) << alone.log();
   for (const std::string model : {"knot", "big"}) {
     const std::vector<uint8_t> first = stream_of(fleet[0]->process.port(), model);
     ASSERT_GT(first.size(), 1000u);
@@ -117,13 +117,47 @@ TEST_F(SharedCacheTest, AServerKilledWhileEncodingLeavesNothingBroken) {
   std::string problem;
   ASSERT_TRUE(start_fleet(fleet, 2, server_args(cache), tmp_.path(), problem)) << problem;
   const std::string logs = fleet[0]->process.log() + fleet[1]->process.log();
-  EXPECT_EQ(count_lines(logs, std::regex("skipped")), 0) << logs;
+  EXPECT_EQ(count_lines(logs, std::regex("initial models done: 2 ready, 0 failed")), 2) << logs;
   for (const std::string model : {"knot", "big"}) {
-    EXPECT_LE(count_lines(logs, std::regex("\\] encoded .*" + model + "\\.ply")), 1) << logs;
+    EXPECT_LE(count_lines(logs, std::regex(": encoded .*" + model + "\\.ply")), 1) << logs;
     EXPECT_TRUE(stream_of(fleet[0]->process.port(), model) ==
                 stream_of(fleet[1]->process.port(), model))
         << model;
   }
+}
+
+// A server still encoding the models it found at start is not sent
+// clients: HAProxy's check (/healthz) says 503 until they are done, while
+// /metrics shows them queued or encoding.
+TEST_F(SharedCacheTest, HealthzSays503UntilTheModelsFoundAtStartAreDone) {
+  if (!nettest::have_curl()) GTEST_SKIP() << "curl is not installed (Debian package curl)";
+  nettest::ServerProcess server;
+  std::vector<std::string> args = server_args(tmp_ / "cache");
+  args.insert(args.end(), {"--metrics", "127.0.0.1:0", "--encoders", "1"});
+  ASSERT_TRUE(server.start(args, tmp_ / "health.log", 30s, nettest::ServerProcess::Wait::kPort))
+      << server.log();
+  const uint16_t metrics = server.read_metrics_port();
+  ASSERT_NE(metrics, 0);
+  const std::string base = "http://127.0.0.1:" + std::to_string(metrics);
+  const nettest::HttpAnswer early = nettest::curl(base + "/healthz");
+  const nettest::PrometheusText early_metrics =
+      nettest::parse_prometheus(nettest::curl(base + "/metrics").body);
+  ASSERT_TRUE(server.wait_log("initial models done", 60s)) << server.log();
+  // The 60k-triangle model takes more than a second to encode on a cold
+  // cache, so the first answers came while it was not ready.
+  EXPECT_EQ(early.status, 503) << early.body;
+  EXPECT_EQ(early.body, "loading models\n");
+  EXPECT_EQ(early_metrics.problem, "");
+  EXPECT_LT(early_metrics.value("meshstream_models{state=\"ready\"}"), 2);
+  EXPECT_GE(early_metrics.value("meshstream_models{state=\"queued\"}") +
+                early_metrics.value("meshstream_models{state=\"encoding\"}"),
+            1);
+  const nettest::HttpAnswer later = nettest::curl(base + "/healthz");
+  EXPECT_EQ(later.status, 200);
+  const nettest::PrometheusText done =
+      nettest::parse_prometheus(nettest::curl(base + "/metrics").body);
+  EXPECT_EQ(done.value("meshstream_models{state=\"ready\"}"), 2);
+  EXPECT_EQ(done.value("meshstream_encode_queue_length"), 0);
 }
 
 }  // namespace

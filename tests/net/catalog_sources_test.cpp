@@ -60,11 +60,20 @@ TEST(NetCatalog, MeshFilesAreEncodedCachedAndBadOnesSkipped) {
                              models + "/../log" + std::to_string(start) + ".txt"))
         << server.log();
     const v1::ModelList list = list_models(server.port());
-    ASSERT_EQ(list.models_size(), 2) << list.DebugString() << server.log();
+    ASSERT_EQ(list.models_size(), 3) << list.DebugString() << server.log();
     EXPECT_EQ(list.models(0).name(), "fandisk");
     EXPECT_EQ(list.models(0).source(), "mesh");
+    EXPECT_EQ(list.models(0).state(), v1::ModelInfo::READY);
     EXPECT_EQ(list.models(0).vertices(), 6475u);
-    EXPECT_EQ(list.models(1).name(), "sphere");
+    // The bad file is listed as failed, its reason naming it and the problem.
+    EXPECT_EQ(list.models(1).name(), "inf_nan");
+    EXPECT_EQ(list.models(1).state(), v1::ModelInfo::FAILED);
+    EXPECT_NE(list.models(1).reason().find(models + "/inf_nan.obj: "), std::string::npos)
+        << list.models(1).reason();
+    EXPECT_NE(list.models(1).reason().find("non-finite"), std::string::npos)
+        << list.models(1).reason();
+    EXPECT_EQ(list.models(2).name(), "sphere");
+    EXPECT_EQ(list.models(2).state(), v1::ModelInfo::READY);
     expect_stream_equals_a_cache_file(server.port(), "fandisk", cache);
     const std::string log = server.log();
     EXPECT_NE(log.find("inf_nan.obj"), std::string::npos) << log;  // reported
@@ -82,8 +91,9 @@ TEST(NetCatalog, DemoServesProceduralModelsWithoutAFolder) {
   if (!server::demo_models_available()) GTEST_SKIP() << "this build has no demo meshes";
   const std::string cache = fresh_dir("demo_cache");
   ServerProcess server;
-  // The server encodes its three demo models before it listens: a few
-  // seconds in a release build, up to a minute under the sanitizers.
+  // The server encodes its three demo models in the background (start()
+  // waits for them): a few seconds in a release build, up to a minute
+  // under the sanitizers.
   ASSERT_TRUE(
       server.start({"--demo", "--cache", cache, "--threads", "2"}, cache + "/../demo.txt", 120s))
       << server.log();

@@ -40,6 +40,8 @@ const MetricsModels& models() {
     out.big = server::make_synthetic_hcs(big);
     write_file(out.dir + "/small.hcs", out.small);
     write_file(out.dir + "/big.hcs", out.big);
+    // Not a stream: listed as failed.
+    write_file(out.dir + "/broken.hcs", std::vector<uint8_t>{'M', 'H', 'C', 'S', 1, 0});
     return out;
   }();
   return m;
@@ -105,14 +107,15 @@ TEST_F(MetricsEndpointTest, StartsAtZeroWithEveryFamilyAndModelsReady) {
   for (const char* outcome : {"complete", "budget", "cancelled", "interrupted"}) {
     EXPECT_EQ(t.value(std::string("meshstream_streams_total{outcome=\"") + outcome + "\"}"), 0);
   }
-  for (const char* code :
-       {"protocol_violation", "version_mismatch", "frame_too_large", "malformed_frame",
-        "unknown_model", "invalid_request", "busy", "timeout", "shutting_down", "internal"}) {
+  for (const char* code : {"protocol_violation", "version_mismatch", "frame_too_large",
+                           "malformed_frame", "unknown_model", "invalid_request", "busy", "timeout",
+                           "shutting_down", "internal", "not_ready", "model_failed"}) {
     EXPECT_EQ(t.value(std::string("meshstream_errors_total{code=\"") + code + "\"}"), 0) << code;
   }
   EXPECT_EQ(t.value("meshstream_models{state=\"ready\"}"), 2);
+  EXPECT_EQ(t.value("meshstream_models{state=\"queued\"}"), 0);
   EXPECT_EQ(t.value("meshstream_models{state=\"encoding\"}"), 0);
-  EXPECT_EQ(t.value("meshstream_models{state=\"failed\"}"), 0);
+  EXPECT_EQ(t.value("meshstream_models{state=\"failed\"}"), 1);
   EXPECT_EQ(t.value("meshstream_encode_queue_length"), 0);
 }
 
@@ -146,6 +149,10 @@ TEST_F(MetricsEndpointTest, CountersMoveByWhatTheClientsReceived) {
     v1::ServerMessage m;
     ASSERT_EQ(b.read(m), ReadEnd::kMessage);
     ASSERT_TRUE(m.has_error());
+    ASSERT_TRUE(b.stream("broken"));  // a failed model: MODEL_FAILED
+    ASSERT_EQ(b.read(m), ReadEnd::kMessage);
+    ASSERT_TRUE(m.has_error());
+    ASSERT_EQ(m.error().code(), v1::Error::MODEL_FAILED);
     ASSERT_TRUE(b.stream("big"));
     ASSERT_EQ(b.read(m), ReadEnd::kMessage);  // header (maybe with its first chunk)
     ASSERT_TRUE(b.cancel());
@@ -168,6 +175,7 @@ TEST_F(MetricsEndpointTest, CountersMoveByWhatTheClientsReceived) {
   EXPECT_EQ(t.value("meshstream_streams_total{outcome=\"interrupted\"}"), 0);
   EXPECT_EQ(t.value("meshstream_errors_total{code=\"unknown_model\"}"), 1);
   EXPECT_EQ(t.value("meshstream_errors_total{code=\"invalid_request\"}"), 0);
+  EXPECT_EQ(t.value("meshstream_errors_total{code=\"model_failed\"}"), 1);
 
   // A client that leaves mid-stream: interrupted, and the server counted at
   // least what that client read and at most the whole stream.

@@ -56,11 +56,17 @@ class ServerProcess {
   ServerProcess& operator=(const ServerProcess&) = delete;
   ~ServerProcess() { kill_now(); }
 
+  // What start() waits for after the port: the models found at start all
+  // ready or failed (the server's "initial models done" line), or only the
+  // port (the server encodes in the background while it serves).
+  enum class Wait { kInitialModels, kPort };
+
   // Starts the server with `args` (after the binary name, "--listen
-  // 127.0.0.1:0" is added unless `args` has a --listen) and waits up to `timeout` for its port.
-  // False when it did not come up (see log()).
+  // 127.0.0.1:0" is added unless `args` has a --listen) and waits up to
+  // `timeout` for its port and, by default, its initial models. False when
+  // it did not come up (see log()).
   bool start(const std::vector<std::string>& args, const std::string& log_path,
-             std::chrono::milliseconds timeout = 20s) {
+             std::chrono::milliseconds timeout = 20s, Wait wait = Wait::kInitialModels) {
     log_path_ = log_path;
     int out[2];
     if (::pipe(out) != 0) return false;
@@ -84,11 +90,14 @@ class ServerProcess {
     }
     ::close(out[1]);
     stdout_fd_ = out[0];
+    const auto deadline = Clock::now() + timeout;
     const std::string line = read_stdout_line(timeout);
     const auto colon = line.rfind(':');
     if (line.rfind("listening on ", 0) != 0 || colon == std::string::npos) return false;
     port_ = static_cast<uint16_t>(std::stoi(line.substr(colon + 1)));
-    return true;
+    if (wait == Wait::kPort) return true;
+    return wait_log("initial models done",
+                    std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()));
   }
 
   // The next line the server prints on stdout (after "listening on": with
@@ -112,6 +121,16 @@ class ServerProcess {
     const auto colon = line.rfind(':');
     if (line.rfind("metrics on ", 0) != 0 || colon == std::string::npos) return 0;
     return static_cast<uint16_t>(std::stoi(line.substr(colon + 1)));
+  }
+
+  // Polls the log until it holds `text` (true) or `timeout` passes.
+  bool wait_log(const std::string& text, std::chrono::milliseconds timeout) const {
+    const auto deadline = Clock::now() + timeout;
+    while (log().find(text) == std::string::npos) {
+      if (Clock::now() >= deadline) return false;
+      std::this_thread::sleep_for(20ms);
+    }
+    return true;
   }
 
   uint16_t port() const { return port_; }

@@ -119,15 +119,23 @@ TEST_F(NetTest, ListShowsEveryValidModelWithItsFacts) {
   ASSERT_EQ(c.read(m), ReadEnd::kMessage);
   ASSERT_TRUE(m.has_model_list()) << m.DebugString();
   const auto& list = m.model_list().models();
-  ASSERT_EQ(list.size(), 2) << m.DebugString();  // broken.hcs is skipped
+  // broken.hcs is listed as failed, with the reason naming it.
+  ASSERT_EQ(list.size(), 3) << m.DebugString();
   EXPECT_EQ(list[0].name(), "big");
-  EXPECT_EQ(list[1].name(), "small");
+  EXPECT_EQ(list[0].state(), v1::ModelInfo::READY);
+  EXPECT_EQ(list[1].name(), "broken");
+  EXPECT_EQ(list[1].state(), v1::ModelInfo::FAILED);
+  EXPECT_NE(list[1].reason().find(models().dir + "/broken.hcs"), std::string::npos)
+      << list[1].reason();
+  EXPECT_EQ(list[1].stream_bytes(), 0u);
+  EXPECT_EQ(list[2].name(), "small");
+  EXPECT_EQ(list[2].state(), v1::ModelInfo::READY);
   const StreamIndex small = index_of(models().small);
-  EXPECT_EQ(list[1].stream_bytes(), models().small.size());
-  EXPECT_EQ(list[1].records(), small.records.size());
-  EXPECT_EQ(list[1].vertices(), small.header.vertex_count);
-  EXPECT_EQ(list[1].faces(), small.header.face_count);
-  EXPECT_EQ(list[1].source(), "hcs");
+  EXPECT_EQ(list[2].stream_bytes(), models().small.size());
+  EXPECT_EQ(list[2].records(), small.records.size());
+  EXPECT_EQ(list[2].vertices(), small.header.vertex_count);
+  EXPECT_EQ(list[2].faces(), small.header.face_count);
+  EXPECT_EQ(list[2].source(), "hcs");
   EXPECT_NE(server_->log().find("broken.hcs"), std::string::npos);
 }
 
@@ -303,7 +311,7 @@ TEST_F(NetTest, CancelStopsTheStreamAndKeepsTheConnection) {
 
 TEST_F(NetTest, UnknownModelsAreErrorsNeverPaths) {
   TestClient c = connected();
-  for (const char* name : {"nope", "../../etc/passwd", "/etc/passwd", "small.hcs", "broken", ""}) {
+  for (const char* name : {"nope", "../../etc/passwd", "/etc/passwd", "small.hcs", ""}) {
     ASSERT_TRUE(c.stream(name));
     v1::ServerMessage m;
     ASSERT_EQ(c.read(m), ReadEnd::kMessage);
@@ -311,6 +319,18 @@ TEST_F(NetTest, UnknownModelsAreErrorsNeverPaths) {
     EXPECT_EQ(m.error().code(), v1::Error::UNKNOWN_MODEL);
     EXPECT_FALSE(m.error().closing());
   }
+  // A model whose file is broken is known, and says why it cannot be served.
+  ASSERT_TRUE(c.stream("broken"));
+  v1::ServerMessage m;
+  ASSERT_EQ(c.read(m), ReadEnd::kMessage);
+  ASSERT_TRUE(m.has_error()) << m.DebugString();
+  EXPECT_EQ(m.error().code(), v1::Error::MODEL_FAILED);
+  EXPECT_FALSE(m.error().closing());
+  EXPECT_EQ(m.error().model().state(), v1::ModelInfo::FAILED);
+  EXPECT_NE(
+      m.error().message().find("model 'broken' cannot be served: " + models().dir + "/broken.hcs"),
+      std::string::npos)
+      << m.error().message();
   ASSERT_TRUE(c.stream("small"));
   EXPECT_TRUE(read_stream(c).ok);
 }

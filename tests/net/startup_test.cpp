@@ -1,8 +1,10 @@
 // How the real meshstream-server binary starts, or refuses to (issue 21 rows
-// 3, 12 and 13): it binds before it encodes, so an unusable address fails at
-// once; it warns about every file in --models it cannot use and about two
-// files that want the same name; a missing or empty folder and a cache path
-// whose parent is missing are bad input (exit 1, one line naming them).
+// 3, 12 and 13; issue 15 point 5): it binds first, so an unusable address
+// fails at once; it warns about every file in --models it cannot use and
+// about two files that want the same name; a missing folder, a folder with
+// nothing to serve under --watch off and a cache path whose parent is
+// missing are bad input (exit 1, one line naming them); an empty folder is
+// served and watched.
 // Real sockets on loopback, real files in a temp folder.
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -277,9 +279,8 @@ TEST(ServerStartup, WarnsOnceAboutAClashAndOncePerSkippedFile) {
 
 // ------------------------------------------- row 13: folders that cannot serve
 
-TEST(ServerStartup, MissingOrEmptyModelsFolderExitsOneWithAHint) {
-  const std::string work = fresh_dir("empty");
-  const std::string empty = fresh_dir("empty/models");
+TEST(ServerStartup, MissingModelsFolderExitsOneWithAHint) {
+  const std::string work = fresh_dir("missing");
   const std::string missing = work + "/no-such-folder";
   Exit e = run_to_exit({"--models", missing, "--cache", "none", "--listen", "127.0.0.1:0"}, work);
   EXPECT_EQ(e.status, 1) << e.err;
@@ -288,7 +289,39 @@ TEST(ServerStartup, MissingOrEmptyModelsFolderExitsOneWithAHint) {
                                     ": no such folder (give the folder that holds your models, "
                                     "or --demo for the built-in ones)");
 
-  e = run_to_exit({"--models", empty, "--cache", "none", "--listen", "127.0.0.1:0"}, work);
+  // A file given as the folder.
+  write_text(work + "/README", "x");
+  e = run_to_exit({"--models", work + "/README", "--cache", "none"}, work);
+  EXPECT_EQ(e.status, 1) << e.err;
+  ASSERT_EQ(verdicts(e.err).size(), 1u) << e.err;
+  EXPECT_NE(verdicts(e.err)[0].find("README: is not a folder"), std::string::npos) << e.err;
+}
+
+// Issue 15 point 5: the server listens whatever the folder holds, an empty
+// one too (files will come: it watches it), with one warning.
+TEST(ServerStartup, AnEmptyFolderIsServedAndWatched) {
+  const std::string work = fresh_dir("empty_watched");
+  const std::string empty = fresh_dir("empty_watched/models");
+  ServerProcess server;
+  ASSERT_TRUE(server.start({"--models", empty, "--cache", "none"}, work + "/log.txt"))
+      << server.log();
+  TestClient c = greeted_client(server.port());
+  ASSERT_TRUE(c.list());
+  v1::ServerMessage m;
+  ASSERT_EQ(c.read(m), ReadEnd::kMessage);
+  EXPECT_EQ(m.model_list().models_size(), 0) << m.DebugString();
+  EXPECT_EQ(lines_with(server.log(), "warning catalog: no model in " + empty + " yet").size(), 1u)
+      << server.log();
+}
+
+// With --watch off nothing new will come: a folder with nothing the server
+// can serve is still bad input (exit 1, one line), after one warning per
+// file it could not use.
+TEST(ServerStartup, WatchOffAndNothingToServeExitsOneWithAHint) {
+  const std::string work = fresh_dir("empty");
+  const std::string empty = fresh_dir("empty/models");
+  Exit e = run_to_exit(
+      {"--models", empty, "--cache", "none", "--watch", "off", "--listen", "127.0.0.1:0"}, work);
   EXPECT_EQ(e.status, 1) << e.err;
   ASSERT_EQ(verdicts(e.err).size(), 1u) << e.err;
   EXPECT_EQ(verdicts(e.err)[0], "meshstream-server: no model to serve in " + empty +
@@ -298,19 +331,15 @@ TEST(ServerStartup, MissingOrEmptyModelsFolderExitsOneWithAHint) {
   // Only files it cannot use: the same verdict, after one warning each.
   write_text(empty + "/README", "x");
   write_file(empty + "/broken.hcs", std::vector<uint8_t>{'M', 'H', 'C', 'S', 1, 0});
-  e = run_to_exit({"--models", empty, "--cache", "none", "--listen", "127.0.0.1:0"}, work);
+  e = run_to_exit(
+      {"--models", empty, "--cache", "none", "--watch", "off", "--listen", "127.0.0.1:0"}, work);
   EXPECT_EQ(e.status, 1) << e.err;
   EXPECT_EQ(lines_with(e.err, "warning catalog: skipped " + empty + "/README").size(), 1u) << e.err;
-  EXPECT_EQ(lines_with(e.err, "warning catalog: skipped " + empty + "/broken.hcs").size(), 1u)
+  EXPECT_EQ(lines_with(e.err, "warning catalog: failed broken: " + empty + "/broken.hcs").size(),
+            1u)
       << e.err;
   ASSERT_EQ(verdicts(e.err).size(), 1u) << e.err;
   EXPECT_NE(verdicts(e.err)[0].find("no model to serve in " + empty), std::string::npos);
-
-  // A file given as the folder.
-  e = run_to_exit({"--models", empty + "/README", "--cache", "none"}, work);
-  EXPECT_EQ(e.status, 1) << e.err;
-  ASSERT_EQ(verdicts(e.err).size(), 1u) << e.err;
-  EXPECT_NE(verdicts(e.err)[0].find("README: is not a folder"), std::string::npos) << e.err;
 }
 
 TEST(ServerStartup, CacheCreatesOnlyItsLastLevelAndSaysSo) {

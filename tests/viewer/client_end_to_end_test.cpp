@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "client/viewer/rgba_image.h"
@@ -96,7 +97,17 @@ class ClientEndToEnd : public ::testing::Test {
     for (int i = 0; i < 20; ++i) {
       auto line = server.read_line(30s);
       if (!line) return {};
-      if (line->rfind("listening on ", 0) == 0) return line->substr(13);
+      if (line->rfind("listening on ", 0) != 0) continue;
+      // The server encodes in the background while it serves: wait until
+      // the models it found at start are ready (or failed).
+      const auto deadline = std::chrono::steady_clock::now() + 120s;
+      while (std::chrono::steady_clock::now() < deadline) {
+        std::ifstream in(*dir_ / "server.log");
+        const std::string log(std::istreambuf_iterator<char>(in), {});
+        if (log.find("initial models done") != std::string::npos) return line->substr(13);
+        std::this_thread::sleep_for(20ms);
+      }
+      return {};
     }
     return {};
   }
