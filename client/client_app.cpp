@@ -18,6 +18,7 @@
 #include "client/event_log.h"
 #include "client/interrupt_watch.h"
 #include "client/stream_client.h"
+#include "client/stream_source.h"
 #include "common/mesh/export.h"
 
 namespace meshstream::client {
@@ -36,21 +37,36 @@ int run_list(const ClientOptions& o) {
   if (o.json) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& m : *models) {
-      list.push_back({{"name", m.name()},
-                      {"vertices", m.vertices()},
-                      {"faces", m.faces()},
-                      {"stream_bytes", m.stream_bytes()},
-                      {"records", m.records()},
-                      {"source", m.source()}});
+      nlohmann::json entry{{"name", m.name()},
+                           {"vertices", m.vertices()},
+                           {"faces", m.faces()},
+                           {"stream_bytes", m.stream_bytes()},
+                           {"records", m.records()},
+                           {"source", m.source()},
+                           {"state", model_state_name(m.state())}};
+      if (m.state() == v1::ModelInfo::ENCODING) {
+        entry["percent"] = m.percent();
+        entry["stage"] = m.stage();
+      }
+      if (m.state() == v1::ModelInfo::FAILED) entry["reason"] = m.reason();
+      list.push_back(std::move(entry));
     }
     std::cout << nlohmann::json{{"event", "models"}, {"models", list}}.dump() << std::endl;
     return 0;
   }
-  std::printf("%-24s %10s %10s %12s %8s  %s\n", "model", "vertices", "faces", "bytes", "records",
-              "source");
+  std::printf("%-24s %10s %10s %12s %8s  %-6s  %s\n", "model", "vertices", "faces", "bytes",
+              "records", "source", "state");
   for (const auto& m : *models) {
-    std::printf("%-24s %10u %10u %12llu %8u  %s\n", m.name().c_str(), m.vertices(), m.faces(),
-                static_cast<unsigned long long>(m.stream_bytes()), m.records(), m.source().c_str());
+    std::string state = model_state_name(m.state());
+    if (m.state() == v1::ModelInfo::ENCODING) {
+      char percent[32];
+      std::snprintf(percent, sizeof percent, " %.0f %%", m.percent());
+      state += percent;
+    }
+    if (m.state() == v1::ModelInfo::FAILED) state += ": " + m.reason();
+    std::printf("%-24s %10u %10u %12llu %8u  %-6s  %s\n", m.name().c_str(), m.vertices(), m.faces(),
+                static_cast<unsigned long long>(m.stream_bytes()), m.records(), m.source().c_str(),
+                state.c_str());
   }
   return 0;
 }
@@ -153,9 +169,9 @@ class StreamingRun {
       : o_(o),
         hooks_(hooks),
         log_(o.json, !o.json && !o.quiet && ::isatty(2)),
-        client_(target_of(o)),
+        client_(make_stream_source(o)),
         pipeline_(
-            decoded_, &client_, mailbox_, settings_of(o),
+            decoded_, client_.get(), mailbox_, settings_of(o),
             [this](const DisplayFrame& frame, const FrameInfo& info) { on_frame(frame, info); }) {}
 
   // The phases: stream (until the end, an error, the window closing or
@@ -163,7 +179,7 @@ class StreamingRun {
   int run() {
     InterruptWatch interrupts([this](int) {
       interrupted_ = true;
-      client_.stop();
+      client_->stop();
       mailbox_.close();  // closes the window, if one is open
     });
     stream();
@@ -172,16 +188,6 @@ class StreamingRun {
   }
 
  private:
-  static StreamTarget target_of(const ClientOptions& o) {
-    StreamTarget target;
-    target.host = o.host;
-    target.port = o.port;
-    target.model = o.model;
-    target.budget = o.budget;
-    target.max_chunk_bytes = o.max_chunk_bytes;
-    target.reconnect = o.reconnect;
-    return target;
-  }
   static PipelineSettings settings_of(const ClientOptions& o) {
     PipelineSettings settings;
     settings.asa_enabled = o.asa_enabled;
@@ -230,7 +236,7 @@ class StreamingRun {
       last_frame_ = frame;
       ++display_updates_;
       coalesced_ += frame.coalesced_updates;
-      log_.refinement(frame, info, elapsed(), client_.rate_bytes_per_s());
+      log_.refinement(frame, info, elapsed(), client_->rate_bytes_per_s());
       const uint32_t record = frame.records_decoded - 1;
       if (!o_.out_dir.empty() && o_.saves_record(record))
         keep_error(write_mesh(*frame.display, record_file(o_.out_dir, record)));
@@ -255,22 +261,23 @@ class StreamingRun {
 
   void stream() {
     decoded_.on_record([this](const AppliedRecord& r) { log_.record(r, elapsed()); });
-    client_.on_retry([this](const Error& e, int attempt) { log_.reconnecting(e, attempt); });
-    client_.check_header([this](const StreamFacts& f) { return check_header(f); });
+    client_->on_retry([this](const Error& e, int attempt) { log_.reconnecting(e, attempt); });
+    client_->on_waiting([this](const v1::ModelInfo& m) { log_.waiting(m, elapsed()); });
+    client_->check_header([this](const StreamFacts& f) { return check_header(f); });
     std::thread network(
-        [this] { client_.run(decoded_, [this](const StreamFacts& f) { on_header(f); }); });
+        [this] { client_->run(decoded_, [this](const StreamFacts& f) { on_header(f); }); });
     pipeline_.start();
     if (o_.view && hooks_.run_view) {
       viewer_status_ = hooks_.run_view(o_, mailbox_, pipeline_);
       // The window closed: stop streaming if it still runs. After Ctrl-C the
       // pipeline still shows (and saves) what arrived.
-      client_.stop();
+      client_->stop();
       if (!interrupted_) decoded_.stop();
     }
     pipeline_status_ = pipeline_.wait_finished();
     // The last record may be shown before the server's StreamEnd arrives:
     // let the network thread finish the conversation (it stops by itself).
-    if (!pipeline_status_) client_.stop();
+    if (!pipeline_status_) client_->stop();
     network.join();
     pipeline_.stop();
     mailbox_.close();
@@ -284,7 +291,7 @@ class StreamingRun {
     s.records_total = facts_.records_total;
     s.bytes_total = facts_.total_bytes;
     s.elapsed_ms = elapsed();
-    s.reconnects = client_.reconnects();
+    s.reconnects = client_->reconnects();
     s.display_updates = display_updates_;
     s.coalesced = coalesced_;
     if (const auto& shown = final_frame_ ? final_frame_ : last_frame_) {
@@ -335,7 +342,7 @@ class StreamingRun {
   const Clock::time_point t0_ = Clock::now();
   EventLog log_;
   DecodedStream decoded_;
-  StreamClient client_;
+  std::unique_ptr<StreamSource> client_;  // a meshstream server or a web server
   LatestFrameMailbox mailbox_;
   DisplayPipeline pipeline_;
 

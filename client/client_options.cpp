@@ -36,7 +36,10 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   std::string address, rule = "zorin", path = "auto";
   int reconnect_attempts = o.reconnect.max_attempts;
   cli::add_version_flag(app, "meshstream-client");
-  app.add_option("address", address, "server address HOST:PORT")->required();
+  app.add_option("address", address,
+                 "server address HOST:PORT, or the URL http://HOST[:PORT]/PATH/MODEL.hcs of an "
+                 ".hcs file on a web server (HTTP/1.1 range requests; no MODEL then)")
+      ->required();
   app.add_option("model", o.model, "model name to stream (see --list)");
   app.add_flag("--list", o.list, "list the server's models and exit");
   app.add_option("--out", o.out_dir,
@@ -96,13 +99,24 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                  "close the window once a frame with N decoded records is drawn (0 = off)")
       ->capture_default_str();
   app.add_option("--max-chunk-bytes", o.max_chunk_bytes,
-                 "largest chunk to ask the server for (0 = the server's --max-chunk-bytes)")
+                 "largest chunk to ask the server for (0 = the server's --max-chunk-bytes); "
+                 "over http://, the bytes of one range request, rounded up to whole records "
+                 "(0 = 262144)")
+      ->capture_default_str();
+  uint64_t read_timeout_ms = static_cast<uint64_t>(o.reconnect.read_timeout.count());
+  app.add_option("--read-timeout", read_timeout_ms,
+                 "milliseconds of silence after which a connection counts as lost (and is "
+                 "resumed)")
+      ->check(CLI::Range(uint64_t{100}, uint64_t{3600000}))
       ->capture_default_str();
   app.add_option("--reconnect-attempts", reconnect_attempts,
                  "consecutive reconnects before giving up")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   app.add_flag("--quiet", o.quiet, "no progress line");
+  app.add_flag("--wait", o.wait,
+               "a model the server is still encoding (NOT_READY) is asked for again every half "
+               "second until it is ready, then streamed; without it the client exits 1");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -117,12 +131,26 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
     std::cerr << "meshstream-client: " << why << " (see --help)\n";
     return 2;
   };
-  auto hp = parse_host_port(address);
-  if (!hp) return usage(hp.error().message);
-  o.host = hp->host;
-  o.port = hp->port;
+  if (looks_like_http_url(address)) {
+    auto url = parse_http_url(address);
+    if (!url) return usage(url.error().message);
+    if (o.list) return usage("--list needs a meshstream server (HOST:PORT), not a URL");
+    if (o.wait) return usage("--wait needs a meshstream server (HOST:PORT), not a URL");
+    if (!o.model.empty())
+      return usage("the URL names the model already: no MODEL after " + address);
+    o.http = *url;
+    o.host = url->host;
+    o.port = url->port;
+    o.model = url->model;
+  } else {
+    auto hp = parse_host_port(address);
+    if (!hp) return usage(hp.error().message);
+    o.host = hp->host;
+    o.port = hp->port;
+  }
   if (!o.list && o.model.empty()) return usage("name a MODEL to stream, or use --list");
   if (o.list && !o.model.empty()) return usage("--list takes no MODEL");
+  if (o.list && o.wait) return usage("--wait is for streaming a MODEL, not --list");
   if (o.snapshot_at && o.snapshot_png.empty())
     return usage("--snapshot-at needs --snapshot FILE.png");
   if (!o.snapshot_png.empty() && extension_of(o.snapshot_png) != ".png") {
@@ -139,6 +167,7 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                : path == "incremental" ? AsaPath::kIncremental
                                        : AsaPath::kAuto;
   o.reconnect.max_attempts = reconnect_attempts;
+  o.reconnect.read_timeout = Millis(read_timeout_ms);
   return o;
 }
 

@@ -1,11 +1,12 @@
 // The `meshstream-client` command line (contract in docs/design.md;
 // every flag in docs/usage.md):
-//   meshstream-client HOST:PORT [MODEL] [--list] [--out DIR [--out-every N]
+//   meshstream-client HOST:PORT [MODEL] | http://HOST[:PORT]/PATH/MODEL.hcs [--list] [--out DIR
+//   [--out-every N]
 //     [--out-at LIST] [--overwrite]] [--asa-levels L]
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
 //     [--snapshot FILE.png] [--width W --height H] [--snapshot-at N]
-//     [--exit-after N] [--exit-after-records N]
+//     [--exit-after N] [--exit-after-records N] [--wait]
 #pragma once
 
 #include <cstdint>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "client/display_builder.h"
+#include "client/http_response.h"
 #include "client/stream_client.h"
 #include "common/asa/subdivide.h"
 
@@ -23,7 +25,8 @@ namespace meshstream::client {
 struct ClientOptions {
   std::string host;
   uint16_t port = 0;
-  std::string model;  // empty with --list
+  std::string model;            // empty with --list; the file name without .hcs for a URL
+  std::optional<HttpUrl> http;  // set: stream the .hcs file at this URL from a web server
   bool list = false;
   std::string out_dir;                // --out: final.ply, final.decoded.ply (+ NNNN.ply)
   uint32_t out_every = 0;             // --out-every: NNNN.ply at every N-th record (0 = none)
@@ -46,6 +49,7 @@ struct ClientOptions {
   uint32_t max_chunk_bytes = 0;
   ReconnectPolicy reconnect;
   bool quiet = false;  // no progress line
+  bool wait = false;   // --wait: a model still being encoded is waited for
 };
 
 // Options to run with, or the exit code to return now (0 after --help, 2

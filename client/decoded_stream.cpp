@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "client/frame_mesh_pool.h"
+
 namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
@@ -169,27 +171,47 @@ TakenUpdate DecodedStream::take(Mesh& mirror, MeshChanges& changes) {
       for (uint32_t v : pending_.moved) mirror.positions[v] = m.positions[v];
       for (uint32_t f : pending_.faces) mirror.triangles[f] = m.triangles[f];
     }
-    if (pending_.full) {
-      changes.clear();
-      changes.full = true;
-    } else if (!changes.full) {
-      changes.vertices.insert(changes.vertices.end(), pending_.vertices.begin(),
-                              pending_.vertices.end());
-      changes.faces.insert(changes.faces.end(), pending_.faces.begin(), pending_.faces.end());
-      changes.moved.insert(changes.moved.end(), pending_.moved.begin(), pending_.moved.end());
-    }
-    pending_.clear();
-    u.records_decoded = decoder_.records_decoded();
-    u.bytes_decoded = decoder_.resume_offset();
-    u.bytes_received = bytes_received_;
-    u.updates = pending_updates_;
-    u.decode_ms = pending_decode_ms_;
-    u.ended = outcome_.has_value();
-    pending_updates_ = 0;
-    pending_decode_ms_ = 0;
-    taken_records_ = u.records_decoded;
+    u = hand_over_pending(changes);
   }
   changed_.notify_all();  // releases a network thread waiting at the barrier
+  return u;
+}
+
+TakenUpdate DecodedStream::take(FrameMeshPool& pool, std::shared_ptr<const Mesh>& mesh,
+                                MeshChanges& changes) {
+  TakenUpdate u;
+  {
+    std::lock_guard lock(mutex_);
+    // pending_ is what changed in the decoder's mesh since the last take:
+    // the pool's meshes follow it by those changes alone.
+    mesh = pool.share(decoder_.mesh(), pending_);
+    u = hand_over_pending(changes);
+  }
+  changed_.notify_all();  // releases a network thread waiting at the barrier
+  return u;
+}
+
+TakenUpdate DecodedStream::hand_over_pending(MeshChanges& changes) {
+  TakenUpdate u;
+  if (pending_.full) {
+    changes.clear();
+    changes.full = true;
+  } else if (!changes.full) {
+    changes.vertices.insert(changes.vertices.end(), pending_.vertices.begin(),
+                            pending_.vertices.end());
+    changes.faces.insert(changes.faces.end(), pending_.faces.begin(), pending_.faces.end());
+    changes.moved.insert(changes.moved.end(), pending_.moved.begin(), pending_.moved.end());
+  }
+  pending_.clear();
+  u.records_decoded = decoder_.records_decoded();
+  u.bytes_decoded = decoder_.resume_offset();
+  u.bytes_received = bytes_received_;
+  u.updates = pending_updates_;
+  u.decode_ms = pending_decode_ms_;
+  u.ended = outcome_.has_value();
+  pending_updates_ = 0;
+  pending_decode_ms_ = 0;
+  taken_records_ = u.records_decoded;
   return u;
 }
 

@@ -3,13 +3,15 @@
 // (which takes the newest decoded mesh whenever it is ready for another
 // one). Latest wins: the network side never waits for the pipeline; the
 // changes of every record applied meanwhile accumulate and are handed over
-// together, so the pipeline copies only what changed into its own mirror.
+// together, so the pipeline copies only what changed into the mesh it gives
+// its next frame (a FrameMeshPool mesh, or a mirror of its own).
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -21,6 +23,8 @@
 #include "common/mesh/mesh.h"
 
 namespace meshstream::client {
+
+class FrameMeshPool;
 
 // What changed in the decoded mesh since the pipeline last took it.
 struct MeshChanges {
@@ -113,6 +117,11 @@ class DecodedStream {
   // Copies what changed into `mirror` (which must hold the previous take)
   // and appends the changes to `changes`.
   TakenUpdate take(Mesh& mirror, MeshChanges& changes);
+  // The same without a mirror: `mesh` becomes a mesh of `pool` equal to the
+  // decoded mesh, brought up to date with only what changed since it was
+  // last given out where the pool can (frame_mesh_pool.h). The pipeline's
+  // way: no private copy of the whole mesh besides the frames' own.
+  TakenUpdate take(FrameMeshPool& pool, std::shared_ptr<const Mesh>& mesh, MeshChanges& changes);
   std::optional<StreamOutcome> outcome() const;
 
   // ---- either side
@@ -125,6 +134,9 @@ class DecodedStream {
   // Calls record_observer_ for the `applied` records after the first
   // `before` (mutex_ held).
   void report_records(uint32_t before, uint32_t applied, double ms);
+  // The bookkeeping of a take (mutex_ held): appends pending_ to `changes`,
+  // clears it and says what was taken.
+  TakenUpdate hand_over_pending(MeshChanges& changes);
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;

@@ -59,7 +59,9 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   // its result would still have to be copied.
   bool plain_full = path_ == AsaPath::kFull;
   if (path_ == AsaPath::kAuto && !changes.full && !options_changed && F > 0) {
-    s.seen.assign(F, 0);
+    // `seen` stays all zero between updates (the marks are undone below),
+    // so counting costs the changes, not a clearing pass over every face.
+    if (s.seen.size() < F) s.seen.resize(F, 0);
     uint32_t unique = 0;
     for (uint32_t f : changes.faces) {
       if (f < F && !s.seen[f]) {
@@ -67,6 +69,8 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
         ++unique;
       }
     }
+    for (uint32_t f : changes.faces)
+      if (f < F) s.seen[f] = 0;
     if (!changes.moved.empty() && mesh.vertex_count() > 0) {
       // Moved vertices (plane records) change the shape of every face
       // around them: about 3F/V faces each (the mean valence), estimated

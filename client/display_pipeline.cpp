@@ -2,11 +2,13 @@
 
 #include <chrono>
 
+#include "client/frame_mesh_pool.h"
+
 namespace meshstream::client {
 
 using Clock = std::chrono::steady_clock;
 
-DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamClient* client,
+DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamSource* client,
                                  LatestFrameMailbox& mailbox, PipelineSettings settings,
                                  FrameObserver observer)
     : decoded_(decoded),
@@ -65,7 +67,7 @@ void DisplayPipeline::loop() {
   auto elapsed = [&] {
     return std::chrono::duration<double, std::milli>(Clock::now() - started).count();
   };
-  Mesh mirror;
+  FrameMeshPool frame_meshes;  // frames' copies of the decoded mesh: only the changes, where free
   MeshChanges changes;
   uint64_t seen_pokes = 0;
   bool outcome_seen = false;
@@ -111,7 +113,7 @@ void DisplayPipeline::loop() {
     DisplayFrame frame;
     FrameInfo info;
     if (pending) {
-      const TakenUpdate u = decoded_.take(mirror, changes);
+      const TakenUpdate u = decoded_.take(frame_meshes, frame.decoded, changes);
       frame.records_decoded = u.records_decoded;
       frame.bytes_received = u.bytes_decoded;
       frame.decode_ms = u.decode_ms;
@@ -122,7 +124,6 @@ void DisplayPipeline::loop() {
           (end_record > 0 && u.records_decoded >= end_record) ||
           (u.ended && decoded_.outcome() && decoded_.outcome()->ok && !decoded_.has_pending());
       info.new_records = true;
-      frame.decoded = std::make_shared<const Mesh>(mirror);
     } else {
       frame = *last;
       frame.decode_ms = 0;

@@ -16,7 +16,7 @@
 #include "client/decoded_stream.h"
 #include "client/display_builder.h"
 #include "client/display_frame.h"
-#include "client/stream_client.h"
+#include "client/stream_source.h"
 
 namespace meshstream::client {
 
@@ -40,7 +40,7 @@ class DisplayPipeline : public StreamControls {
  public:
   // `client` may be null (no pause/rate). The observer runs on the
   // pipeline thread after each publish (events, snapshot files).
-  DisplayPipeline(DecodedStream& decoded, StreamClient* client, LatestFrameMailbox& mailbox,
+  DisplayPipeline(DecodedStream& decoded, StreamSource* client, LatestFrameMailbox& mailbox,
                   PipelineSettings settings, FrameObserver observer);
   ~DisplayPipeline() override;
 
@@ -69,7 +69,7 @@ class DisplayPipeline : public StreamControls {
   void mark_finished(std::optional<Error> error);
 
   DecodedStream& decoded_;
-  StreamClient* client_;
+  StreamSource* client_;
   LatestFrameMailbox& mailbox_;
   FrameObserver observer_;
   DisplayBuilder builder_;

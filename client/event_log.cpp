@@ -109,6 +109,30 @@ void EventLog::reconnecting(const Error& error, int attempt) {
   std::fflush(stderr);
 }
 
+void EventLog::waiting(const v1::ModelInfo& model, double elapsed_ms) {
+  std::lock_guard lock(mutex_);
+  const std::string state = model_state_name(model.state());
+  char percent[32];
+  std::snprintf(percent, sizeof percent, "%.0f %%", model.percent());
+  std::string text = state;
+  if (model.state() == v1::ModelInfo::ENCODING) {
+    text += std::string(", ") + percent + (model.stage().empty() ? "" : " (" + model.stage() + ")");
+  }
+  if (text == last_waiting_) return;
+  last_waiting_ = text;
+  if (json_) {
+    nlohmann::json j{{"event", "waiting"},     {"model", model.name()},
+                     {"state", state},         {"percent", round3(model.percent())},
+                     {"stage", model.stage()}, {"elapsed_ms", round3(elapsed_ms)}};
+    line(j.dump());
+    return;
+  }
+  clear_progress();
+  std::fprintf(stderr, "meshstream-client: waiting for '%s': %s\n", model.name().c_str(),
+               text.c_str());
+  std::fflush(stderr);
+}
+
 void EventLog::done(const DoneSummary& s) {
   std::lock_guard lock(mutex_);
   if (json_) {

@@ -42,6 +42,9 @@ class EventLog {
   void record(const AppliedRecord& record, double elapsed_ms);
   void refinement(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms, double rate);
   void reconnecting(const Error& error, int attempt);
+  // --wait: the model is not ready yet. One line (or `waiting` event) each
+  // time its state or whole percent changes.
+  void waiting(const v1::ModelInfo& model, double elapsed_ms);
   void done(const DoneSummary& summary);
   void error(const std::string& message);
   void note(const std::string& line);  // stderr, human readers only
@@ -53,6 +56,7 @@ class EventLog {
   std::mutex mutex_;
   bool json_, progress_;
   bool progress_shown_ = false;
+  std::string last_waiting_;  // the state last reported by waiting()
 };
 
 }  // namespace meshstream::client

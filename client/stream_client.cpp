@@ -39,6 +39,23 @@ std::string server_error_text(const std::string& peer, const v1::Error& e) {
   return "server " + peer + ": " + e.message() + " [" + v1::Error_Code_Name(e.code()) + "]";
 }
 
+}  // namespace
+
+const char* model_state_name(v1::ModelInfo::State state) {
+  switch (state) {
+    case v1::ModelInfo::ENCODING:
+      return "encoding";
+    case v1::ModelInfo::QUEUED:
+      return "queued";
+    case v1::ModelInfo::FAILED:
+      return "failed";
+    default:
+      return "ready";
+  }
+}
+
+namespace {
+
 // A Connection error's reason without its "server PEER " lead-in.
 std::string reason_only(const std::string& message, const std::string& peer) {
   const std::string lead = "server " + peer + " ";
@@ -211,8 +228,28 @@ StreamClient::Attempt StreamClient::attempt(
       return Attempt::kRetry;
     }
     if (message->has_error()) {
-      error = Error{ErrorCode::kIo, server_error_text(c.peer(), message->error())};
-      return transient(message->error().code()) ? Attempt::kRetry : Attempt::kFatal;
+      const v1::Error& e = message->error();
+      if (e.code() == v1::Error::NOT_READY && target_.wait && !have_header) {
+        // --wait: ask again in a while, on this connection (each request
+        // keeps it from idling out).
+        if (on_waiting_) on_waiting_(e.model());
+        {
+          std::unique_lock lock(pause_mutex_);
+          pause_changed_.wait_for(lock, target_.wait_poll, [&] { return stop_.load(); });
+        }
+        if (stop_) break;
+        if (auto s = c.send(request, policy.connect_timeout); !s) {
+          error = s.error();
+          return Attempt::kRetry;
+        }
+        continue;
+      }
+      error = Error{ErrorCode::kIo, server_error_text(c.peer(), e)};
+      // Resuming a stream after a lost connection: a server that restarted
+      // may still be loading the model (from its cache); try again.
+      if (e.code() == v1::Error::NOT_READY && facts_) return Attempt::kRetry;
+      if (e.code() == v1::Error::NOT_READY) error.message += " (--wait waits until it is ready)";
+      return transient(e.code()) ? Attempt::kRetry : Attempt::kFatal;
     }
     if (message->has_header()) {
       const v1::StreamHeader& h = message->header();

@@ -45,7 +45,17 @@ struct StreamTarget {
   Budget budget;
   uint32_t max_chunk_bytes = 0;  // 0 = server default
   ReconnectPolicy reconnect;
+  // --wait: a model the server is still encoding (Error NOT_READY) is asked
+  // for again every `wait_poll` on the same connection until it is ready
+  // (then streamed), failed (MODEL_FAILED) or withdrawn (UNKNOWN_MODEL).
+  // Without it NOT_READY ends the run.
+  bool wait = false;
+  Millis wait_poll{500};
 };
+
+// "ready", "encoding", "queued" or "failed" (ModelInfo.state; a server that
+// predates the field sends none, which means ready).
+const char* model_state_name(v1::ModelInfo::State state);
 
 // The stream's true rate: bytes over the time since the first byte arrived,
 // and once that is longer than `window`, over the last `window` only (a
@@ -96,6 +106,9 @@ class StreamClient {
   int reconnects() const { return reconnects_.load(); }
   // Called on the network thread before each back-off (for logs).
   void on_retry(std::function<void(const Error&, int attempt)> f) { on_retry_ = std::move(f); }
+  // Called on the network thread at each NOT_READY while --wait waits, with
+  // the model's entry as the server gave it (state, percent, stage).
+  void on_waiting(std::function<void(const v1::ModelInfo&)> f) { on_waiting_ = std::move(f); }
 
  private:
   enum class Attempt { kDone, kRetry, kFatal };
@@ -118,6 +131,7 @@ class StreamClient {
   std::condition_variable pause_changed_;
   RateMeter rate_;
   std::function<void(const Error&, int)> on_retry_;
+  std::function<void(const v1::ModelInfo&)> on_waiting_;
 };
 
 // Hello + ListModels on one connection: the catalog, or the error.

@@ -18,6 +18,7 @@ MESHSTREAM_PACKAGES=(
   xvfb xauth  # viewer tests: a virtual X display for the window
   clang libclang-rt-14-dev  # fuzz targets (libFuzzer) in tests/fuzz
   clang-format  # scripts/check-format, run by scripts/test
+  nginx  # tests/http: the HTTP stream path against a real web server
   haproxy curl  # deploy tests: servers behind a real HAProxy; scraping --metrics
 )
 

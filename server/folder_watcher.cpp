@@ -23,12 +23,8 @@ constexpr auto kEventQuiet = std::chrono::milliseconds(100);
 }  // namespace
 
 FolderWatcher::FolderWatcher(FolderWatchOptions options, ModelRegistry& registry, EncoderPool& pool,
-                             CatalogLog log, std::function<void()> first_scan_done)
-    : options_(std::move(options)),
-      registry_(registry),
-      pool_(pool),
-      log_(std::move(log)),
-      first_scan_done_(std::move(first_scan_done)) {}
+                             CatalogLog log)
+    : options_(std::move(options)), registry_(registry), pool_(pool), log_(std::move(log)) {}
 
 FolderWatcher::~FolderWatcher() {
   stop();
@@ -43,7 +39,20 @@ void FolderWatcher::reserve(const std::string& name) {
   options_.reserved.insert(name);
 }
 
-void FolderWatcher::start() {
+void FolderWatcher::list_initial() {
+  auto scan = scan_models_folder(options_.dir);
+  if (!scan) return;  // the first scan says why
+  for (const auto* files : {&scan->hcs, &scan->meshes}) {
+    for (const ModelFile& file : *files) {
+      registry_.put(ModelStatus{file.name, files == &scan->hcs ? "hcs" : "mesh", file.path,
+                                ModelState::kQueued, 0, "", "", nullptr, 0});
+      prelisted_.insert(file.name);
+    }
+  }
+}
+
+void FolderWatcher::start(std::function<void()> first_scan_done) {
+  first_scan_done_ = std::move(first_scan_done);
   if (::pipe2(wake_pipe_, O_CLOEXEC | O_NONBLOCK) != 0) wake_pipe_[0] = wake_pipe_[1] = -1;
   thread_ = std::thread([this] { run(); });
 }
@@ -155,6 +164,11 @@ Clock::duration FolderWatcher::reconcile(bool first) {
   want(scan->hcs, true);
   want(scan->meshes, false);
 
+  // Listed by list_initial() but gone (or skipped) by the first scan.
+  for (const std::string& name : prelisted_) {
+    if (!wanted.count(name)) registry_.remove(name);
+  }
+  prelisted_.clear();
   // Withdraw what is gone (or now served from another file of that name).
   for (auto it = taken_.begin(); it != taken_.end();) {
     auto w = wanted.find(it->first);

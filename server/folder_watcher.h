@@ -43,15 +43,19 @@ struct FolderWatchOptions {
 
 class FolderWatcher {
  public:
-  // `first_scan_done` runs once on the watcher thread after the first scan
-  // has listed (and submitted) everything the folder held.
   FolderWatcher(FolderWatchOptions options, ModelRegistry& registry, EncoderPool& pool,
-                CatalogLog log, std::function<void()> first_scan_done);
+                CatalogLog log);
   ~FolderWatcher();  // stop()
   FolderWatcher(const FolderWatcher&) = delete;
   FolderWatcher& operator=(const FolderWatcher&) = delete;
 
-  void start();
+  // Lists every model file the folder holds now as queued, before the
+  // server announces its port, so a client that asks at once hears
+  // NOT_READY, not UNKNOWN_MODEL. A directory listing; no file is read.
+  void list_initial();
+  // Starts the thread. `first_scan_done` runs once on it after the first
+  // scan has listed (and submitted) everything the folder held.
+  void start(std::function<void()> first_scan_done);
   // Ends the thread (within one wake-up). Idempotent.
   void stop();
   void reserve(const std::string& name);
@@ -88,6 +92,7 @@ class FolderWatcher {
   std::map<std::string, FileVersion> taken_;  // name -> the file version submitted
   std::map<std::string, Seen> seen_;          // path -> last observed version
   std::set<std::string> warned_;              // warnings already logged (once each)
+  std::set<std::string> prelisted_;           // names list_initial() registered
   std::mutex reserved_mutex_;
   int inotify_fd_ = -1;
   int wake_pipe_[2] = {-1, -1};

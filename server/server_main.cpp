@@ -130,24 +130,44 @@ int main(int argc, char** argv) {
       server.stop();
     }
   };
-  // The demo models, after the folder's first scan (a file of the same name
-  // wins, as it always has).
+  // Everything found at start is listed (queued) before the port is
+  // announced: the folder's files first, then the demo models whose names
+  // they leave free (a file of the same name wins, as it always has).
   std::unique_ptr<FolderWatcher> watcher;
-  auto add_demo_models = [&] {
-    if (options.demo) {
-      if (!demo_models_available()) {
-        spdlog::warn("catalog: --demo: this build has no procedural demo meshes or no encoder");
-      }
-      const auto taken = registry.snapshot();
-      for (EncodeTask& task : demo_tasks(*cache_dir)) {
-        if (taken->count(task.name)) {
-          spdlog::warn("catalog: skipped demo model '{}': name is taken", task.name);
-          continue;
-        }
-        if (watcher) watcher->reserve(task.name);
-        pool.submit(std::move(task));
-      }
+  if (!options.models_dir.empty()) {
+    watcher = std::make_unique<FolderWatcher>(
+        FolderWatchOptions{options.models_dir, *cache_dir, watch_mode(options.watch)}, registry,
+        pool, log_catalog_line);
+    watcher->list_initial();
+  }
+  std::vector<EncodeTask> demo;
+  if (options.demo) {
+    if (!demo_models_available()) {
+      spdlog::warn("catalog: --demo: this build has no procedural demo meshes or no encoder");
     }
+    const auto taken = registry.snapshot();
+    for (EncodeTask& task : demo_tasks(*cache_dir)) {
+      if (taken->count(task.name)) {
+        spdlog::warn("catalog: skipped demo model '{}': name is taken", task.name);
+        continue;
+      }
+      if (watcher) watcher->reserve(task.name);
+      registry.put(ModelStatus{task.name, task.source, task.origin, ModelState::kQueued, 0, "", "",
+                               nullptr, 0});
+      demo.push_back(std::move(task));
+    }
+  }
+  // After the folder's first scan has submitted its files: the demo models,
+  // then the line once all of them are done.
+  auto after_first_scan = [&] {
+    if (watcher && registry.counts().total() == 0) {
+      spdlog::warn(
+          "catalog: no model in {} yet (the server reads files ending in {}); serving them as "
+          "they arrive",
+          options.models_dir, served_extensions());
+    }
+    for (EncodeTask& task : demo) pool.submit(std::move(task));
+    demo.clear();
     pool.when_idle(report_initial);
   };
 
@@ -161,21 +181,10 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   spdlog::info("serving while {} background encoder{} encode what is not cached", pool.encoders(),
                pool.encoders() == 1 ? "" : "s");
-  if (!options.models_dir.empty()) {
-    watcher = std::make_unique<FolderWatcher>(
-        FolderWatchOptions{options.models_dir, *cache_dir, watch_mode(options.watch)}, registry,
-        pool, log_catalog_line, [&] {
-          if (registry.counts().total() == 0) {
-            spdlog::warn(
-                "catalog: no model in {} yet (the server reads files ending in {}); "
-                "serving them as they arrive",
-                options.models_dir, served_extensions());
-          }
-          add_demo_models();
-        });
-    watcher->start();
+  if (watcher) {
+    watcher->start(after_first_scan);
   } else {
-    add_demo_models();
+    after_first_scan();
   }
   server.run();
   if (watcher) watcher->stop();

@@ -43,15 +43,20 @@ int run_decode(const DecodeArgs& args) {
   // Where the budget ends in the whole stream, and what of it the file holds.
   const uint64_t wanted = prefix_for_budget(*index, args.budget);
   const uint64_t available = std::min<uint64_t>(wanted, bytes->size());
-  IncrementalDecoder decoder;
+  // The mesh is built once, for writing, not kept up to date per record.
+  IncrementalDecoder decoder(DecodedMeshUpkeep::kOnRelease);
   auto fed = decoder.feed(std::span<const uint8_t>(bytes->data(), available));
   if (!fed) return report_failure(std::move(fed.error()).with_context(args.input));
-  if (auto s = write_mesh(decoder.mesh(), args.output); !s) return report_failure(s.error());
+  const uint32_t records = decoder.records_decoded();
+  const uint64_t decoded_bytes = decoder.resume_offset();
+  auto mesh = decoder.release_mesh();
+  if (!mesh) return report_failure(std::move(mesh.error()).with_context(args.input));
+  if (auto s = write_mesh(*mesh, args.output); !s) return report_failure(s.error());
   std::printf("%s: decoded %u of %zu records (%llu of %llu bytes): %u vertices, %u faces -> %s\n",
-              args.input.c_str(), decoder.records_decoded(), index->records.size(),
-              static_cast<unsigned long long>(decoder.resume_offset()),
-              static_cast<unsigned long long>(index->total_bytes()), decoder.mesh().vertex_count(),
-              decoder.mesh().face_count(), args.output.c_str());
+              args.input.c_str(), records, index->records.size(),
+              static_cast<unsigned long long>(decoded_bytes),
+              static_cast<unsigned long long>(index->total_bytes()), mesh->vertex_count(),
+              mesh->face_count(), args.output.c_str());
   if (available < wanted) {
     std::string budget_note;
     if (args.budget.kind != Budget::Kind::kAll) {
@@ -62,8 +67,8 @@ int run_decode(const DecodeArgs& args) {
                  "meshstream: warning: %s: file is cut short: it has %llu of %llu bytes: decoded "
                  "%u of %u records%s\n",
                  args.input.c_str(), static_cast<unsigned long long>(in_file.file_bytes),
-                 static_cast<unsigned long long>(in_file.stream_bytes), decoder.records_decoded(),
-                 in_file.records, budget_note.c_str());
+                 static_cast<unsigned long long>(in_file.stream_bytes), records, in_file.records,
+                 budget_note.c_str());
   }
   return 0;
 }

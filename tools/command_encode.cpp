@@ -1,5 +1,6 @@
 // `meshstream encode IN -o OUT.hcs [--quant-bits 12] [--base-vertices N]
-//   [--record-bytes N] [--base-shift B] [--no-bit-planes]`:
+//   [--record-bytes N] [--base-shift B] [--no-bit-planes] [--threads N]
+//   [--progress | --no-progress]`:
 // import and clean a mesh, encode it into one progressive .hcs stream
 // (common/codec/encoder.h), write it, and say what was made.
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include "common/codec/encoder.h"
 #include "common/mesh/import.h"
 #include "tools/commands.h"
+#include "tools/progress_bar.h"
 
 namespace meshstream::tools {
 namespace {
@@ -23,20 +25,31 @@ struct EncodeArgs {
   std::optional<int> base_shift;  // empty: automatic
   bool no_bit_planes = false;
   bool old_flag = false;  // --issue1-order, the old name of --no-bit-planes
+  uint32_t threads = EncodeOptions{}.threads;
+  bool progress = false, no_progress = false;  // neither: a bar when stderr is a terminal
 };
 
 int run_encode(const EncodeArgs& args) {
+  if (args.old_flag)
+    std::fprintf(stderr, "meshstream encode: --issue1-order is deprecated, use --no-bit-planes\n");
+  ProgressBar bar(stderr,
+                  !args.no_progress && (args.progress || ProgressBar::stderr_is_terminal()));
+  bar.show_stage("reading " + args.input);
   auto imported = import_mesh(args.input);
-  if (!imported) return report_failure(imported.error());
+  if (!imported) {
+    bar.finish();
+    return report_failure(imported.error());
+  }
   EncodeOptions options;
   options.quant_bits = args.quant_bits;
   options.target_base_vertices = args.base_vertices;
   options.record_bytes = args.record_bytes;
   options.base_shift = args.base_shift;
   options.embedded = !(args.no_bit_planes || args.old_flag);
-  if (args.old_flag)
-    std::fprintf(stderr, "meshstream encode: --issue1-order is deprecated, use --no-bit-planes\n");
+  options.threads = args.threads;
+  options.progress = [&bar](const EncodeProgress& p) { bar.update(p.stage, p.fraction); };
   auto bytes = encode_hcs(imported->mesh, options);
+  bar.finish();
   if (!bytes) return report_failure(std::move(bytes.error()).with_context(args.input));
   std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes->data()),
@@ -82,6 +95,16 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--no-bit-planes", args->no_bit_planes,
                 "every position exact when its vertex arrives: no plane records, structure "
                 "records in decimation order (the peer benchmarks compare against)");
+  cmd->add_option("--threads", args->threads,
+                  "threads for decimation, the candidate streams and their measurement (0: one "
+                  "per core); the stream is the same for every count")
+      ->check(CLI::Range(0u, 1024u))
+      ->capture_default_str();
+  cmd->add_flag("--progress", args->progress,
+                "a progress bar on stderr (stage, percent, time left), also when "
+                "stderr is not a terminal (the default shows it only there)");
+  cmd->add_flag("--no-progress", args->no_progress,
+                "no progress bar, even on a terminal (wins over --progress)");
   // The old name, hidden from --help; still accepted (scripts, older notes).
   cmd->add_flag("--issue1-order", args->old_flag, "")->group("");
   cmd->callback([args, &exit_code] { exit_code = run_encode(*args); });

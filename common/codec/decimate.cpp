@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 namespace meshstream {
 namespace {
@@ -75,11 +76,19 @@ struct Candidate {
   uint32_t vertex;
 };
 
-class LayerBuilder {
- public:
-  explicit LayerBuilder(EditableMesh& mesh) : m_(mesh) {}
+// The error quadrics of every vertex, shared by the layer builders of
+// every thread (the workers only read them).
+struct QuadricField {
   std::vector<Quadric> quadrics;
   double mean_weight = 0;  // of the initial quadrics: the cost's area unit
+};
+
+class LayerBuilder {
+ public:
+  LayerBuilder(EditableMesh& mesh, QuadricField& field)
+      : quadrics(field.quadrics), mean_weight(field.mean_weight), m_(mesh) {}
+  std::vector<Quadric>& quadrics;
+  double& mean_weight;
 
   // Every face's plane, weighted by area, into its vertices' quadrics; every
   // boundary edge's perpendicular plane too, so boundaries keep their shape.
@@ -242,23 +251,57 @@ uint32_t base_target(uint32_t vertices, const DecimateOptions& options) {
   return std::min(options.target_vertices, std::max(kMinBaseTarget, share));
 }
 
+namespace {
+
+// The removal cost of every live vertex (cost[v]; negative: not
+// removable), on `threads` threads over interleaved blocks of vertex ids.
+// The costs only read the mesh and the quadrics, so every thread sees the
+// same state and the result does not depend on the thread count. (Keeping
+// the costs of vertices no removal touched does not pay: a layer removes
+// about 15 % of the vertices, and their 2-rings, which a cost reads, cover
+// nearly the whole mesh.)
+void update_costs(EditableMesh& mesh, QuadricField& field, const std::vector<uint8_t>& alive,
+                  std::vector<double>& cost, unsigned threads) {
+  const uint32_t n = mesh.vertex_count();
+  constexpr uint32_t kBlock = 4096;
+  const unsigned count = std::clamp<unsigned>((n + kBlock - 1) / kBlock, 1, std::max(threads, 1u));
+  auto work = [&](unsigned t) {
+    LayerBuilder builder(mesh, field);
+    for (uint32_t first = t * kBlock; first < n; first += count * kBlock) {
+      const uint32_t last = std::min(n, first + kBlock);
+      for (uint32_t v = first; v < last; ++v) {
+        if (alive[v]) cost[v] = builder.cost(v);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < count; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (std::thread& th : pool) th.join();
+}
+
+}  // namespace
+
 DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& options) {
   DecimationResult result;
   const uint32_t n = mesh.vertex_count();
   std::vector<uint8_t> alive(n, 1), blocked(n, 0);
   uint32_t alive_count = n;
-  LayerBuilder builder(mesh);
+  QuadricField field;
+  LayerBuilder builder(mesh, field);
   builder.init_quadrics();
-  for (const Quadric& q : builder.quadrics) builder.mean_weight += q.weight / n;
+  for (const Quadric& q : field.quadrics) field.mean_weight += q.weight / n;
   const uint32_t target = base_target(n, options);
+  const unsigned threads =
+      options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::vector<double> cost(n, -1);
   std::vector<Candidate> candidates;
   std::vector<uint32_t> ring, corners;
   while (alive_count > target && result.layers.size() < options.max_layers) {
+    update_costs(mesh, field, alive, cost, threads);
     candidates.clear();
     for (uint32_t v = 0; v < n; ++v) {
-      if (!alive[v]) continue;
-      const double c = builder.cost(v);
-      if (c >= 0) candidates.push_back({c, v});
+      if (alive[v] && cost[v] >= 0) candidates.push_back({cost[v], v});
     }
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
       return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
@@ -284,6 +327,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     if (layer.empty()) break;
     alive_count -= static_cast<uint32_t>(layer.size());
     result.layers.push_back(std::move(layer));
+    if (options.progress) options.progress(double(n - alive_count) / double(n - target));
   }
   std::vector<uint32_t> new_id(n, kNone);
   for (uint32_t v = 0; v < n; ++v) {

@@ -36,6 +36,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "common/codec/editable_mesh.h"
@@ -68,6 +69,12 @@ struct DecimateOptions {
   // outweigh its first refinements. Off, and not an EncodeOptions setting:
   // no share paid on the real meshes (docs/hcs-format.md, "Layers").
   double max_base_share = 0;
+  // Threads for the removal costs: 0 = one per core. The result is the
+  // same for every count.
+  unsigned threads = 0;
+  // Optional: called after each layer, from the calling thread, with the
+  // share of the vertices above the target removed so far (0..1).
+  std::function<void(double)> progress;
 };
 
 inline constexpr uint32_t kMinBaseTarget = 32;

@@ -15,6 +15,23 @@
 
 namespace meshstream {
 
+namespace {
+
+// QuantGrid::dequantize's arithmetic with its step computed once instead of
+// per vertex (same doubles, same floats).
+struct Dequantizer {
+  explicit Dequantizer(const QuantGrid& grid) : step(grid.step()), lo(grid.bounds.min) {}
+  Vec3f operator()(Vec3i q) const {
+    return Vec3f{static_cast<float>(double(lo.x) + q.x * step),
+                 static_cast<float>(double(lo.y) + q.y * step),
+                 static_cast<float>(double(lo.z) + q.z * step)};
+  }
+  double step;
+  Vec3f lo;
+};
+
+}  // namespace
+
 struct IncrementalDecoder::State {
   std::vector<uint8_t> buffer;  // stream bytes [buffer_start, stream_pos)
   uint64_t buffer_start = 0;
@@ -23,7 +40,8 @@ struct IncrementalDecoder::State {
   QuantGrid grid;
   uint32_t records_done = 0;
   std::optional<RefinementState> refine;
-  Mesh mesh;
+  DecodedMeshUpkeep upkeep = DecodedMeshUpkeep::kEveryRecord;
+  Mesh mesh;  // kEveryRecord: the output, record by record
   std::vector<RecordDelta> deltas;
   std::optional<Error> error;
   RefinementFormatInfo format;  // of the stream, from its header (check_header)
@@ -129,20 +147,27 @@ struct IncrementalDecoder::State {
       refine->vertex_layer.reserve(nv);
       refine->vertex_shift.reserve(nv);
       mesh = Mesh{};
-      mesh.positions.reserve(nv);
-      mesh.triangles.reserve(nf);
-      mesh.positions.resize(base->positions.size());
-      for (size_t v = 0; v < base->positions.size(); ++v) {
-        mesh.positions[v] = grid.dequantize(refine->mesh.positions()[v]);
+      if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+        mesh.positions.reserve(nv);
+        mesh.triangles.reserve(nf);
+        mesh.positions.resize(base->positions.size());
+        for (size_t v = 0; v < base->positions.size(); ++v) {
+          mesh.positions[v] = grid.dequantize(refine->mesh.positions()[v]);
+        }
+        mesh.triangles = base->faces;
       }
-      mesh.triangles = base->faces;
       delta.full_rebuild = true;
-      delta.added_vertices.resize(mesh.positions.size());
-      for (uint32_t v = 0; v < delta.added_vertices.size(); ++v) delta.added_vertices[v] = v;
-      delta.touched_faces.resize(mesh.triangles.size());
-      for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
+      if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+        delta.added_vertices.resize(base->positions.size());
+        for (uint32_t v = 0; v < delta.added_vertices.size(); ++v) delta.added_vertices[v] = v;
+        delta.touched_faces.resize(base->faces.size());
+        for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
+      }
     } else {
       AppliedRecord applied;
+      // Without an output mesh nobody follows the changes: the lists would
+      // only grow (a whole stream fed at once keeps every record's delta).
+      applied.record_changes = upkeep == DecodedMeshUpkeep::kEveryRecord;
       if (auto s = apply_refinement_record(*refine, payload, rec.vertices, rec.faces, applied);
           !s) {
         return where(s.error());
@@ -151,34 +176,32 @@ struct IncrementalDecoder::State {
         return where({ErrorCode::kCorrupt,
                       "more layers than the header's " + std::to_string(h.layer_count)});
       }
-      const auto& positions = refine->mesh.positions();
-      // QuantGrid::dequantize's arithmetic with its step computed once per
-      // record instead of per vertex (same doubles, same floats).
-      const double step = grid.step();
-      const Vec3f& lo = grid.bounds.min;
-      auto dequantize = [&](Vec3i q) {
-        return Vec3f{static_cast<float>(double(lo.x) + q.x * step),
-                     static_cast<float>(double(lo.y) + q.y * step),
-                     static_cast<float>(double(lo.z) + q.z * step)};
-      };
-      for (uint32_t v : applied.added_vertices) {
-        if (v >= mesh.positions.size()) mesh.positions.resize(v + 1);
-        mesh.positions[v] = dequantize(positions[v]);
+      if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+        const auto& positions = refine->mesh.positions();
+        const Dequantizer dequantize(grid);
+        for (uint32_t v : applied.added_vertices) {
+          if (v >= mesh.positions.size()) mesh.positions.resize(v + 1);
+          mesh.positions[v] = dequantize(positions[v]);
+        }
+        for (uint32_t v : applied.moved_vertices) mesh.positions[v] = dequantize(positions[v]);
+        mesh.triangles.resize(refine->mesh.face_slot_count());
+        for (uint32_t f : applied.touched_faces) mesh.triangles[f] = refine->mesh.faces()[f];
       }
-      for (uint32_t v : applied.moved_vertices) mesh.positions[v] = dequantize(positions[v]);
-      mesh.triangles.resize(refine->mesh.face_slot_count());
-      for (uint32_t f : applied.touched_faces) mesh.triangles[f] = refine->mesh.faces()[f];
       delta.added_vertices = std::move(applied.added_vertices);
       delta.touched_faces = std::move(applied.touched_faces);
       delta.moved_vertices = std::move(applied.moved_vertices);
-      delta.full_rebuild = !delta.moved_vertices.empty();  // see RecordDelta
+      // Plane records: see RecordDelta; no lists: nothing says what changed.
+      delta.full_rebuild = !delta.moved_vertices.empty() || !applied.record_changes;
     }
     deltas.push_back(std::move(delta));
     return {};
   }
 };
 
-IncrementalDecoder::IncrementalDecoder() : state_(std::make_unique<State>()) {}
+IncrementalDecoder::IncrementalDecoder(DecodedMeshUpkeep upkeep)
+    : state_(std::make_unique<State>()) {
+  state_->upkeep = upkeep;
+}
 IncrementalDecoder::~IncrementalDecoder() = default;
 IncrementalDecoder::IncrementalDecoder(IncrementalDecoder&&) noexcept = default;
 IncrementalDecoder& IncrementalDecoder::operator=(IncrementalDecoder&&) noexcept = default;
@@ -259,6 +282,31 @@ bool IncrementalDecoder::finished() const {
   return state_->index && state_->records_done == state_->index->records.size();
 }
 const Mesh& IncrementalDecoder::mesh() const { return state_->mesh; }
+
+Result<Mesh> IncrementalDecoder::release_mesh() {
+  State& s = *state_;
+  if (s.records_done == 0) {
+    return make_error(ErrorCode::kTruncated, "no mesh decoded: the base mesh has not arrived");
+  }
+  Mesh out;
+  if (s.upkeep == DecodedMeshUpkeep::kEveryRecord) {
+    out = std::move(s.mesh);
+  } else {
+    if (!s.refine) return make_error(ErrorCode::kInvalidArgument, "the decoded mesh was released");
+    if (s.error && !s.error_recoverable) return tl::unexpected(*s.error);
+    const auto& q = s.refine->mesh.positions();
+    out.positions.resize(q.size());
+    const Dequantizer dequantize(s.grid);
+    for (size_t v = 0; v < q.size(); ++v) out.positions[v] = dequantize(q[v]);
+    // The decoder only inserts, so every face slot is a live face.
+    out.triangles = s.refine->mesh.release_faces();
+  }
+  s.refine.reset();
+  s.mesh = Mesh{};
+  s.error = Error{ErrorCode::kInvalidArgument, "the decoded mesh was released"};
+  s.error_recoverable = false;
+  return out;
+}
 const std::vector<RecordDelta>& IncrementalDecoder::last_deltas() const { return state_->deltas; }
 
 bool IncrementalDecoder::error_is_recoverable() const {
@@ -289,14 +337,14 @@ Status IncrementalDecoder::resume_at(uint64_t offset) {
 }
 
 Result<Mesh> decode_hcs(std::span<const uint8_t> stream) {
-  IncrementalDecoder decoder;
+  IncrementalDecoder decoder(DecodedMeshUpkeep::kOnRelease);
   auto fed = decoder.feed(stream);
   if (!fed) return tl::unexpected(fed.error());
   if (decoder.records_decoded() == 0) {
     return make_error(ErrorCode::kTruncated, "stream of " + std::to_string(stream.size()) +
                                                  " bytes ends before its base mesh is complete");
   }
-  return decoder.mesh();
+  return decoder.release_mesh();
 }
 
 uint64_t prefix_for_budget(const StreamIndex& index, const DecodeBudget& budget) {

@@ -35,9 +35,24 @@ struct RecordDelta {
   std::vector<uint32_t> moved_vertices;
 };
 
+// What the decoder keeps of the decoded mesh as records arrive.
+enum class DecodedMeshUpkeep {
+  // mesh() is the mesh after the last applied record, updated by each
+  // record's changes only, and stays the last good mesh after an error: for
+  // consumers that show or hand over the mesh while it streams.
+  kEveryRecord,
+  // No output mesh while decoding: mesh() stays empty and release_mesh()
+  // builds the mesh once, from the decoder's own state (its triangles are
+  // moved out, not copied). For one-shot decodes that write the mesh at the
+  // end (the decode tool, decode_hcs): no second copy of the triangles is
+  // written record by record, and none is held in memory. Its deltas list
+  // no vertices or faces and say full_rebuild (nothing tracks the changes).
+  kOnRelease,
+};
+
 class IncrementalDecoder {
  public:
-  IncrementalDecoder();
+  explicit IncrementalDecoder(DecodedMeshUpkeep upkeep = DecodedMeshUpkeep::kEveryRecord);
   ~IncrementalDecoder();
   IncrementalDecoder(IncrementalDecoder&&) noexcept;
   IncrementalDecoder& operator=(IncrementalDecoder&&) noexcept;
@@ -57,8 +72,16 @@ class IncrementalDecoder {
   // True once every record of the stream is applied.
   bool finished() const;
 
-  // The current mesh: dequantized positions and triangles.
+  // The current mesh: dequantized positions and triangles (kEveryRecord;
+  // empty with kOnRelease).
   const Mesh& mesh() const;
+  // The mesh after the last applied record, moved out of the decoder, which
+  // is spent afterwards (further feeds fail). kTruncated before the base
+  // mesh; with kOnRelease, the feed's error after a record failed to apply
+  // (its half-applied state holds no good mesh; a checksum failure, found
+  // before applying, still leaves one). O(mesh) with kOnRelease (positions
+  // dequantized once), O(1) with kEveryRecord.
+  Result<Mesh> release_mesh();
   // What each record the last feed() applied changed, in order: one delta a
   // record, empty when that call completed none (feed clears them first).
   const std::vector<RecordDelta>& last_deltas() const;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "common/codec/quantize.h"
@@ -27,7 +28,8 @@ struct EncoderTruth {
   // area(now) ~ weight / sqrt(vertices now) measured better than 1 / n
   // (refinement is not uniform: flat regions stay coarse) or no decay.
   std::vector<double> weight;
-  std::vector<Vec3f> input_normal;  // by input id
+  // By input id; the same for every candidate, so computed once and shared.
+  std::span<const Vec3f> input_normal;
   // The original surface in grid units; when set, a vertex's error is its
   // distance to that surface instead of its displacement from its truth.
   const TriangleBvh* surface = nullptr;

@@ -127,6 +127,9 @@ class EditableMesh {
   // The live faces as a plain triangle list (dead slots skipped) and the
   // positions; vertices keep their ids.
   std::vector<Triangle> live_faces() const;
+  // Moves the face slots out (the decoder's output, which has no dead
+  // slots); the mesh is left without faces and must be discarded.
+  std::vector<Triangle> release_faces() { return std::move(faces_); }
 
  private:
   void set_opposite(uint32_t c, uint32_t value) { opposite_[c] = value; }

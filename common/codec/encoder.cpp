@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "common/codec/decimate.h"
+#include "common/codec/distortion_estimate.h"
 #include "common/codec/editable_mesh.h"
 #include "common/codec/quantize.h"
 #include "common/codec/rd_measure.h"
@@ -125,6 +126,42 @@ struct RecordSizing {
   }
 };
 
+// Progress of one encode (encode_progress.h): stages, each a span of the
+// whole, and shares within them, reported from the calling thread only,
+// never decreasing, at most about every 0.2 % (a few hundred calls).
+class ProgressTracker {
+ public:
+  explicit ProgressTracker(const EncodeProgressCallback& callback) : callback_(callback) {}
+
+  // Enters `name`, which spans [lo, hi] of the encode.
+  void stage(std::string_view name, double lo, double hi) {
+    name_ = name;
+    lo_ = lo;
+    hi_ = hi;
+    emit(lo, true);
+  }
+  // The share of the current stage done (0..1).
+  void within(double share) { emit(lo_ + (hi_ - lo_) * std::clamp(share, 0.0, 1.0), false); }
+  // within() as a function for the stages' own loops; empty without a callback.
+  std::function<void(double)> within_function() {
+    if (!callback_) return {};
+    return [this](double share) { within(share); };
+  }
+
+ private:
+  void emit(double fraction, bool stage_changed) {
+    if (!callback_) return;
+    fraction = std::max(fraction, last_);
+    if (!stage_changed && fraction < last_ + 0.002) return;
+    last_ = fraction;
+    callback_(EncodeProgress{name_, fraction});
+  }
+
+  const EncodeProgressCallback& callback_;
+  std::string_view name_;
+  double lo_ = 0, hi_ = 0, last_ = 0;
+};
+
 // The candidate streams, one per ordering, all at the record size the
 // first one settles on; reports[0] is the caller's report.
 struct CandidateStreams {
@@ -140,7 +177,20 @@ struct CandidateStreams {
 template <class EncodeCandidate>
 Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t count,
                                            const RecordSizing& sizing, bool parallel,
-                                           EncodeReport* report) {
+                                           EncodeReport* report,
+                                           const std::function<void(double)>& progress) {
+  // Progress follows the first candidate (on this thread); the others, on
+  // their own threads, run alongside. One after the other, each gets an
+  // equal share.
+  const std::function<void(double)> no_progress;
+  auto progress_of = [&](size_t i) -> std::function<void(double)> {
+    if (!progress) return {};
+    if (parallel) {
+      if (i > 0) return {};
+      return progress;
+    }
+    return [&progress, i, count](double share) { progress((double(i) + share) / double(count)); };
+  };
   CandidateStreams out;
   out.streams.resize(count);
   out.reports.resize(count);
@@ -148,11 +198,12 @@ Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t
   std::vector<std::future<Result<EncodedStream>>> early;  // destroyed (joined) before what it reads
   if (parallel) {
     for (size_t i = 1; i < count; ++i)
-      early.push_back(std::async(std::launch::async, encode, i, sizing.first_bytes, report_of(i)));
+      early.push_back(
+          std::async(std::launch::async, encode, i, sizing.first_bytes, report_of(i), no_progress));
   }
   uint32_t record_bytes = sizing.first_bytes;
   for (int attempt = 0;; ++attempt) {
-    auto encoded = encode(0, record_bytes, report);
+    auto encoded = encode(0, record_bytes, report, progress_of(0));
     if (!encoded) return tl::unexpected(encoded.error());
     out.streams[0] = std::move(*encoded);
     if (!sizing.automatic || sizing.granular(out.streams[0]) || attempt >= 3 || record_bytes <= 16)
@@ -160,9 +211,10 @@ Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t
     record_bytes = std::max<uint32_t>(16, static_cast<uint32_t>(record_bytes * 0.75));
   }
   for (size_t i = 1; i < count; ++i) {
-    auto candidate = parallel ? early[i - 1].get() : encode(i, record_bytes, report_of(i));
+    auto candidate =
+        parallel ? early[i - 1].get() : encode(i, record_bytes, report_of(i), progress_of(i));
     if (parallel && record_bytes != sizing.first_bytes)
-      candidate = encode(i, record_bytes, report_of(i));
+      candidate = encode(i, record_bytes, report_of(i), no_progress);
     if (!candidate) return tl::unexpected(candidate.error());
     out.streams[i] = std::move(*candidate);
   }
@@ -175,27 +227,39 @@ Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t
 // budgets (fractions of the first stream's size). A stream that misses the
 // granularity bound the current choice meets cannot win. The other streams
 // are measured on their own threads when `parallel`.
+constexpr double kPrepareShare = 0.3;
+
 Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
                              const std::vector<EncodedStream>& streams, const RecordSizing& sizing,
-                             bool parallel) {
+                             bool parallel, ProgressTracker& progress) {
   Mesh reference;
   reference.triangles = mesh.triangles;
   reference.positions.reserve(q.size());
   for (const Vec3i& p : q) reference.positions.push_back(grid.dequantize(p));
   auto measure = RdMeasure::prepare(reference);
   if (!measure) return tl::unexpected(measure.error());
+  // About a third of the measuring is this preparation (a hierarchy over
+  // the whole original); the curves share the rest.
+  progress.within(kPrepareShare);
   const uint64_t reference_bytes = streams[0].bytes.size();
-  auto score_of = [&](const std::vector<uint8_t>& bytes) -> Result<double> {
-    auto curve = measure->curve(bytes, reference_bytes);
+  const std::function<void(double)> no_progress;
+  const std::function<void(double)> first_progress = [&](double share) {
+    const double streams_after = parallel ? 1.0 : double(streams.size());
+    progress.within(kPrepareShare + (1 - kPrepareShare) * share / streams_after);
+  };
+  auto score_of = [&](const std::vector<uint8_t>& bytes,
+                      const std::function<void(double)>& on_budget) -> Result<double> {
+    auto curve = measure->curve(bytes, reference_bytes, on_budget);
     if (!curve) return tl::unexpected(curve.error());
     return RdMeasure::score(*curve);
   };
   std::vector<std::future<Result<double>>> other_scores;  // joined before `measure` goes
   for (size_t i = 1; i < streams.size(); ++i) {
     other_scores.push_back(std::async(parallel ? std::launch::async : std::launch::deferred,
-                                      score_of, std::cref(streams[i].bytes)));
+                                      score_of, std::cref(streams[i].bytes),
+                                      std::cref(no_progress)));
   }
-  auto best_score = score_of(streams[0].bytes);
+  auto best_score = score_of(streams[0].bytes, first_progress);
   if (!best_score) return tl::unexpected(best_score.error());
   size_t best = 0;
   for (size_t i = 1; i < streams.size(); ++i) {
@@ -228,44 +292,56 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   std::vector<Vec3i> q = quantize_positions(mesh, *grid);
   auto editable = EditableMesh::build(q, mesh.triangles);
   if (!editable) return tl::unexpected(editable.error());
-  auto report_progress = [&](std::string_view stage, double fraction) {
-    if (options.progress) options.progress(EncodeProgress{stage, fraction});
-  };
-  report_progress("decimating", 0.0);
+  // The stages' shares of the whole, from their times on a 0.8M-triangle
+  // scan on two cores (import is the caller's).
+  const std::vector<RecordOrdering> orderings = orderings_to_try(options);
+  const bool measuring = orderings.size() > 1;
+  const double decimated_at = measuring ? 0.3 : 0.35, coded_at = measuring ? 0.8 : 1.0;
+  ProgressTracker progress(options.progress);
+  progress.stage("decimating", 0.0, decimated_at);
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
-  const DecimationResult dec = decimate_layers(std::move(*editable), dopt);
-  report_progress("coding records", 0.4);
+  dopt.threads = options.threads;
+  dopt.progress = progress.within_function();
+  DecimationResult dec = decimate_layers(std::move(*editable), dopt);
+  progress.stage("coding records", decimated_at, coded_at);
 
   // The candidates.
-  const std::vector<RecordOrdering> orderings = orderings_to_try(options);
   TriangleBvh surface;
   if (std::any_of(orderings.begin(), orderings.end(), [](const RecordOrdering& o) {
         return o.distortion_estimate == DistortionEstimate::kSurfaceDistance;
       })) {
     surface = grid_surface(mesh, q);
   }
-  auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report) {
+  const std::vector<Vec3f> input_normals = vertex_normals(q, mesh.triangles);
+  auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report,
+                              const std::function<void(double)>& candidate_progress) {
     const RecordOrdering& o = orderings[i];
     return encode_once(
-        mesh, *grid, q, dec, options, bytes, o.plane_calibration, candidate_report,
-        o.distortion_estimate == DistortionEstimate::kSurfaceDistance ? &surface : nullptr);
+        mesh, *grid, q, input_normals, dec, options, bytes, o.plane_calibration, candidate_report,
+        o.distortion_estimate == DistortionEstimate::kSurfaceDistance ? &surface : nullptr,
+        candidate_progress);
   };
   const RecordSizing sizing(mesh.vertex_count(), options);
   const bool parallel =
-      orderings.size() > 1 && options.threads != 1 && std::thread::hardware_concurrency() > 1;
-  auto candidates = encode_candidates(encode_candidate, orderings.size(), sizing, parallel, report);
+      measuring && options.threads != 1 && std::thread::hardware_concurrency() > 1;
+  auto candidates = encode_candidates(encode_candidate, orderings.size(), sizing, parallel, report,
+                                      progress.within_function());
   if (!candidates) return tl::unexpected(candidates.error());
-  if (orderings.size() < 2) {
-    report_progress("done", 1.0);
+  if (!measuring) {
+    progress.stage("done", 1.0, 1.0);
     return std::move(candidates->streams[0].bytes);
   }
+  // What the measurement does not need goes before it builds its own
+  // hierarchy over the original: the peak is then one such hierarchy.
+  surface = TriangleBvh{};
+  dec = DecimationResult{};
 
   // The measured choice among them.
-  report_progress("measuring", 0.8);
-  auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel);
+  progress.stage("measuring", coded_at, 1.0);
+  auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel, progress);
   if (!best) return tl::unexpected(best.error());
-  report_progress("done", 1.0);
+  progress.stage("done", 1.0, 1.0);
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
   return std::move(candidates->streams[*best].bytes);
 }

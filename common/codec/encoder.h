@@ -62,9 +62,10 @@ struct EncodeOptions {
   // (docs/hcs-format.md, "Record order and size"), the others are kept for
   // experiments.
   int insertion_shift = 0;
-  // Threads for the automatic ordering's candidates: 0 = as many as help
-  // (one a candidate, when the machine has more than one core), 1 = one
-  // after the other. The stream is the same either way.
+  // Threads: the decimation's removal costs on this many (0 = one per
+  // core), and the automatic ordering's candidates and their measurement
+  // each on its own thread unless 1 (then one after the other). The
+  // stream is the same for every count.
   uint32_t threads = 0;
   // Refinement record format written: kEmbeddedFastStart (what decoders
   // expect today) or kEmbedded (format 2's models, kept as the peer

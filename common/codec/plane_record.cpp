@@ -54,7 +54,7 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
     const Vec3i p = reconstruct(g, state.max_coordinate);
     if (!(p == state.mesh.positions()[v])) {
       state.mesh.set_position(v, p);
-      applied.moved_vertices.push_back(v);
+      if (applied.record_changes) applied.moved_vertices.push_back(v);
     }
   }
   if (dec.exhausted_badly()) return bad("plane record data ends early");

@@ -14,7 +14,8 @@ Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOption
                       "rate-distortion measure: mesh has no triangles");
   RdMeasure m;
   m.options_ = options;
-  const SurfaceSamples area = sample_surface(original, std::max<uint32_t>(options.samples, 1), 1);
+  const SurfaceSamples area =
+      sample_surface_area(original, std::max<uint32_t>(options.samples, 1), 1);
   m.cell_area_ = area.area / std::max<uint32_t>(options.samples, 1);
   // The original never changes, so fixed area samples serve (and cost less
   // than a point per triangle of a large original).
@@ -28,7 +29,8 @@ Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOption
 }
 
 Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
-                                              uint64_t reference_bytes) const {
+                                              uint64_t reference_bytes,
+                                              const std::function<void(double)>& progress) const {
   auto index = read_stream_index(stream);
   if (!index) return tl::unexpected(index.error());
   std::vector<RdPoint> points;
@@ -53,6 +55,7 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
                         "rate-distortion measure: decoded prefix has no triangles");
     p.relative_rms = relative_rms(shown);
     points.push_back(p);
+    if (progress) progress(double(i + 1) / n);
   }
   return points;
 }

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -57,9 +58,10 @@ class RdMeasure {
   // same for every candidate so their curves are compared at equal bytes)
   // and measures each prefix. Fails with the decoder's error on a stream it
   // cannot decode. Cost: one decode plus, per budget, a hierarchy over the
-  // prefix and 2 x samples closest-point queries.
-  Result<std::vector<RdPoint>> curve(std::span<const uint8_t> stream,
-                                     uint64_t reference_bytes) const;
+  // prefix and 2 x samples closest-point queries. `progress`, when set, is
+  // called after each budget with the share of the budgets done.
+  Result<std::vector<RdPoint>> curve(std::span<const uint8_t> stream, uint64_t reference_bytes,
+                                     const std::function<void(double)>& progress = {}) const;
 
   // The symmetric RMS distance of `shown` (e.g. one decoded prefix) to the
   // original, over the original's bounding-box diagonal. Precondition:

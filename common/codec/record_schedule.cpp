@@ -36,12 +36,20 @@ std::vector<Vec3i> coarse_positions(const std::vector<Vec3i>& q, int shift) {
 
 // Encoder-side truth of the base vertices, in decoder ids: true positions,
 // residuals against their coarse anchors, and star areas as the weights.
-EncoderTruth base_truth(const Mesh& mesh, const std::vector<Vec3i>& q, const ChosenBase& base,
+EncoderTruth base_truth(const Mesh& mesh, const std::vector<Vec3i>& q,
+                        const std::vector<Vec3f>& input_normals, const ChosenBase& base,
                         const RefinementState& state, const TriangleBvh* surface) {
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
   EncoderTruth truth;
-  truth.input_normal = vertex_normals(q, mesh.triangles);
+  truth.input_normal = input_normals;
   truth.surface = surface;
+  // Every vertex gets an entry as the records restore it: room for all at
+  // once (growth by doubling kept up to twice this, and a copy while it grew).
+  const uint32_t n = mesh.vertex_count();
+  truth.position.reserve(n);
+  truth.residual.reserve(n);
+  truth.weight.reserve(n);
+  if (surface) truth.cached.reserve(n);
   std::vector<double> star_area(base_n, 0.0);
   for (const Triangle& f : base.decoded.faces) {
     const double a = ring_area(state.mesh.positions(), {f[0], f[1], f[2]});
@@ -67,6 +75,10 @@ class RecordScheduler {
     uint32_t record_bytes;
     double plane_calibration;
     EncodeReport* report;  // optional
+    // Optional: called after each record with the share of the mesh's
+    // vertices restored so far (0..1).
+    const std::function<void(double)>& progress;
+    uint32_t total_vertices;
   };
 
   // `state` is the decoder's state after the base, `truth` the encoder's
@@ -105,6 +117,7 @@ class RecordScheduler {
       const int best = best_plane_group(n_now, best_slope);
       if (structure_left && (best < 0 || structure_slope_ >= best_slope)) {
         if (auto st = write_structure_record(); !st) return st;
+        if (in_.progress) in_.progress(n_now / std::max(1u, in_.total_vertices));
         continue;
       }
       if (best < 0) break;
@@ -163,10 +176,7 @@ class RecordScheduler {
   Status write_structure_record() {
     if (!writer_.layer_open()) {
       --next_layer_;
-      std::vector<Removal> layer = in_.dec.layers[next_layer_];
-      for (Removal& r : layer)
-        for (uint32_t& u : r.ring) u = to_decoder_[u];
-      writer_.start_layer(std::move(layer));
+      writer_.start_layer(in_.dec.layers[next_layer_], to_decoder_);
     }
     const uint32_t first_new = state_.mesh.vertex_count();
     WrittenRecord f;
@@ -276,10 +286,12 @@ Result<EncodedStream> write_stream(const StreamHeader& header, std::vector<Writt
 }  // namespace
 
 Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
-                                  const std::vector<Vec3i>& q, const DecimationResult& dec,
-                                  const EncodeOptions& options, uint32_t record_bytes,
-                                  double plane_calibration, EncodeReport* report,
-                                  const TriangleBvh* surface) {
+                                  const std::vector<Vec3i>& q,
+                                  const std::vector<Vec3f>& input_normals,
+                                  const DecimationResult& dec, const EncodeOptions& options,
+                                  uint32_t record_bytes, double plane_calibration,
+                                  EncodeReport* report, const TriangleBvh* surface,
+                                  const std::function<void(double)>& progress) {
   // The base: coarse positions, the smaller coder, the decoder's state.
   const int bits = grid.bits;
   // check_options let only writable formats through.
@@ -292,10 +304,16 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                                  base_shift);
   if (!state) return tl::unexpected(state.error());
   state->format = format;
+  // The replay ends at the whole mesh: its arrays sized for it once.
+  state->mesh.reserve(mesh.vertex_count(), mesh.face_count());
+  state->vertices.reserve(mesh.vertex_count());
+  state->vertex_layer.reserve(mesh.vertex_count());
+  state->vertex_shift.reserve(mesh.vertex_count());
+  state->geometry.reserve(mesh.vertex_count());
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
   const uint32_t base_faces = static_cast<uint32_t>(base.decoded.faces.size());
 
-  EncoderTruth truth = base_truth(mesh, q, base, *state, surface);
+  EncoderTruth truth = base_truth(mesh, q, input_normals, base, *state, surface);
   std::vector<uint32_t> to_decoder(mesh.vertex_count(), kNone);
   for (uint32_t d = 0; d < base.to_input.size(); ++d) to_decoder[base.to_input[d]] = d;
 
@@ -307,7 +325,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   records.push_back(std::move(base_record));
 
   // The records after the base.
-  const RecordScheduler::Inputs inputs{grid, dec, options, record_bytes, plane_calibration, report};
+  const RecordScheduler::Inputs inputs{
+      grid, dec, options, record_bytes, plane_calibration, report, progress, mesh.vertex_count()};
   RecordScheduler scheduler(inputs, format, *state, truth, std::move(to_decoder), records);
   if (report) {
     report->records.clear();

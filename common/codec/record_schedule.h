@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "common/base/result.h"
@@ -32,9 +33,11 @@ struct EncodedStream {
 // calls that share the read-only inputs. Cost: O(V log V) plus one
 // closest-point query per estimated vertex error with a surface.
 Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
-                                  const std::vector<Vec3i>& q, const DecimationResult& dec,
-                                  const EncodeOptions& options, uint32_t record_bytes,
-                                  double plane_calibration, EncodeReport* report,
-                                  const TriangleBvh* surface);
+                                  const std::vector<Vec3i>& q,
+                                  const std::vector<Vec3f>& input_normals,
+                                  const DecimationResult& dec, const EncodeOptions& options,
+                                  uint32_t record_bytes, double plane_calibration,
+                                  EncodeReport* report, const TriangleBvh* surface,
+                                  const std::function<void(double)>& progress = {});
 
 }  // namespace meshstream

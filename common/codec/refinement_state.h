@@ -67,6 +67,9 @@ struct RefinementState {
 // What one record changed: the decoder's output (IncrementalDecoder turns it
 // into a RecordDelta).
 struct AppliedRecord {
+  // False: the lists stay empty (a decoder that keeps no output mesh needs
+  // no record of what changed; they would grow with the mesh).
+  bool record_changes = true;
   std::vector<uint32_t> added_vertices;
   std::vector<uint32_t> touched_faces;
   std::vector<uint32_t> moved_vertices;  // plane records: positions that changed

@@ -212,10 +212,10 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
       }
     }
     if (dec.exhausted_badly()) return fail("refinement record data ends early");
+    std::vector<uint32_t>* touched = applied.record_changes ? &applied.touched_faces : nullptr;
     for (uint32_t i = 0; i < count; ++i) {
-      const uint32_t v =
-          apply_patch(state, patches[i], opens[i], positions[i], &applied.touched_faces);
-      applied.added_vertices.push_back(v);
+      const uint32_t v = apply_patch(state, patches[i], opens[i], positions[i], touched);
+      if (touched) applied.added_vertices.push_back(v);
     }
     inserted += count;
   }

@@ -7,20 +7,28 @@
 
 namespace meshstream {
 
-void StructureWriter::start_layer(std::vector<Removal> removals) {
-  removals_ = std::move(removals);
+void StructureWriter::start_layer(const std::vector<Removal>& removals,
+                                  const std::vector<uint32_t>& to_decoder) {
+  removals_ = &removals;
+  ring_ids_.clear();
+  ring_start_.clear();
+  for (const Removal& r : removals) {
+    ring_start_.push_back(static_cast<uint32_t>(ring_ids_.size()));
+    for (uint32_t u : r.ring) ring_ids_.push_back(to_decoder[u]);
+  }
+  ring_start_.push_back(static_cast<uint32_t>(ring_ids_.size()));
   const uint32_t n = s_.mesh.vertex_count();
   first_.assign(n, kNone);
-  next_.assign(removals_.size(), kNone);
-  for (uint32_t i = 0; i < removals_.size(); ++i) {
-    const uint32_t apex = removals_[i].ring[0];
+  next_.assign(removals.size(), kNone);
+  for (uint32_t i = 0; i < removals.size(); ++i) {
+    const uint32_t apex = ring(i)[0];
     next_[i] = first_[apex];
     first_[apex] = i;
   }
   s_.layer += 1;
   s_.cursor = s_.order_head;
   s_.last_count = 0;
-  remaining_ = removals_.size();
+  remaining_ = removals.size();
   starts_layer_ = true;
   layer_vertices_ = n;
 }
@@ -81,10 +89,11 @@ Status StructureWriter::find_patches_at(uint32_t u) {
   const uint32_t faces = static_cast<uint32_t>(star_corners_.size());
   order_.clear();
   for (uint32_t i = u < layer_vertices_ ? first_[u] : kNone; i != kNone; i = next_[i]) {
-    const Removal& r = removals_[i];
+    const Removal& r = (*removals_)[i];
+    const std::span<const uint32_t> r_ring = ring(i);
     uint32_t pos = kNone;
     for (uint32_t f = 0; f < faces; ++f) {
-      if (star_ring_[f] == r.ring[1] && star_ring_[(f + 1) % ring_size] == r.ring[2]) pos = f;
+      if (star_ring_[f] == r_ring[1] && star_ring_[(f + 1) % ring_size] == r_ring[2]) pos = f;
     }
     if (pos == kNone)
       return make_error(ErrorCode::kInternal, "encoder replay: the patch of input vertex " +
@@ -130,8 +139,9 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   const uint32_t ring_size = static_cast<uint32_t>(star_ring_.size());
   const uint32_t faces = static_cast<uint32_t>(star_corners_.size());
   RefinementModels& m = s_.models;
-  const Removal& r = removals_[order_[j].second];
-  const uint32_t k = static_cast<uint32_t>(r.ring.size());
+  const Removal& r = (*removals_)[order_[j].second];
+  const std::span<const uint32_t> r_ring = ring(order_[j].second);
+  const uint32_t k = static_cast<uint32_t>(r_ring.size());
   // Valence.
   if (bits_) {
     ++bits_->insertions;
@@ -161,7 +171,7 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   }
   for (uint32_t f = 0; f + 2 < k; ++f) used_[(order_[j].first + f) % faces] = 1;
   if (!resolve_patch(s_.mesh, u, star_ring_, star_corners_, order_[j].first, k, patches_[j]) ||
-      patches_[j].ring != r.ring) {
+      !std::ranges::equal(patches_[j].ring, r_ring)) {
     return make_error(ErrorCode::kInternal, "encoder replay: the patch of input vertex " +
                                                 std::to_string(r.vertex) +
                                                 " does not resolve to its ring");
@@ -205,7 +215,7 @@ double StructureWriter::apply_patches(std::vector<std::pair<uint32_t, uint32_t>>
   const uint32_t vertices_before = s_.mesh.vertex_count();
   double drop = 0;
   for (uint32_t j = 0; j < count; ++j) {
-    const Removal& r = removals_[order_[j].second];
+    const Removal& r = (*removals_)[order_[j].second];
     const VertexGeometry& g = geometry_[j];
     // Distortion estimate: before, the true point lies off the fan by
     // about its normal offset from the prediction; after, by the error of

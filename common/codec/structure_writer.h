@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -47,8 +48,10 @@ class StructureWriter {
   bool layer_open() const { return remaining_ > 0; }
 
   // Starts the next layer (the previous one must be written out).
-  // `removals` are in decoder vertex ids.
-  void start_layer(std::vector<Removal> removals);
+  // `removals` are in input vertex ids and must outlive the layer;
+  // `to_decoder` maps their ring vertices (all restored before the layer
+  // starts) to decoder ids. Only the mapped rings are copied, flat.
+  void start_layer(const std::vector<Removal>& removals, const std::vector<uint32_t>& to_decoder);
 
   // Writes the next record of the open layer, about `target` bytes.
   // `inserted` gets (input id, decoder id) of every vertex it put back.
@@ -75,7 +78,13 @@ class StructureWriter {
   EncoderTruth& t_;
   RefinementFormatInfo format_;
   StructureBits* bits_;
-  std::vector<Removal> removals_;
+  // Removal i's ring in decoder ids.
+  std::span<const uint32_t> ring(uint32_t i) const {
+    return {ring_ids_.data() + ring_start_[i], ring_start_[i + 1] - ring_start_[i]};
+  }
+
+  const std::vector<Removal>* removals_ = nullptr;
+  std::vector<uint32_t> ring_ids_, ring_start_;  // the rings of removals_, flat
   size_t remaining_ = 0;
   bool starts_layer_ = false;
   uint32_t layer_vertices_ = 0;

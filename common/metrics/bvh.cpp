@@ -45,15 +45,17 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh) {
   TriangleBvh bvh;
   const uint32_t n = mesh.face_count();
   if (n == 0) return bvh;
-  std::vector<std::array<Vec3d, 3>> corners(n);
+  // Corner bounds are read from the mesh as needed (no copy of the corners:
+  // it was the largest array of the build).
   std::vector<Vec3d> centroids(n);
   double max_abs = 0;
   for (uint32_t f = 0; f < n; ++f) {
+    std::array<Vec3d, 3> c;
     for (int k = 0; k < 3; ++k) {
-      corners[f][k] = to_double(mesh.positions[mesh.triangles[f][k]]);
-      for (int i = 0; i < 3; ++i) max_abs = std::max(max_abs, std::abs(corners[f][k][i]));
+      c[k] = to_double(mesh.positions[mesh.triangles[f][k]]);
+      for (int i = 0; i < 3; ++i) max_abs = std::max(max_abs, std::abs(c[k][i]));
     }
-    centroids[f] = (corners[f][0] + corners[f][1] + corners[f][2]) * (1.0 / 3.0);
+    centroids[f] = (c[0] + c[1] + c[2]) * (1.0 / 3.0);
   }
   // A computed closest point may stray from its triangle by a few units in
   // the last place of the largest coordinate; boxes grown by far more than
@@ -63,27 +65,36 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh) {
   std::vector<uint32_t> refs(n);
   for (uint32_t f = 0; f < n; ++f) refs[f] = f;
   bvh.nodes_.reserve(2 * n / kMaxLeafTriangles + 1);
-  bvh.build_node(refs, 0, n, 0, corners, centroids);
+  bvh.build_node(refs, 0, n, 0, mesh, centroids);
+  centroids = {};
+  // Leaves hold 1..kMaxLeafTriangles triangles, so the reserve above is
+  // often outgrown (doubling the array): keep only what the tree uses.
+  bvh.nodes_.shrink_to_fit();
 
   bvh.triangles_.resize(n);
   bvh.slot_of_.resize(n);
   for (uint32_t s = 0; s < n; ++s) {
-    bvh.triangles_[s] = Slot{corners[refs[s]], refs[s]};
+    const Triangle& t = mesh.triangles[refs[s]];
+    bvh.triangles_[s] =
+        Slot{{mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]}, refs[s]};
     bvh.slot_of_[refs[s]] = s;
   }
   return bvh;
 }
 
 uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, uint32_t end,
-                                 uint32_t depth, const std::vector<std::array<Vec3d, 3>>& corners,
+                                 uint32_t depth, const Mesh& mesh,
                                  const std::vector<Vec3d>& centroids) {
   depth_ = std::max(depth_, depth + 1);
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
+  auto grow_by_corners = [&](Box& box, uint32_t f) {
+    for (uint32_t v : mesh.triangles[f]) box.grow(to_double(mesh.positions[v]));
+  };
 
   Box bounds, centroid_bounds;
   for (uint32_t i = begin; i < end; ++i) {
-    for (const Vec3d& c : corners[refs[i]]) bounds.grow(c);
+    grow_by_corners(bounds, refs[i]);
     centroid_bounds.grow(centroids[refs[i]]);
   }
   const Vec3d pad{inflate_, inflate_, inflate_};
@@ -116,7 +127,7 @@ uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, ui
     for (uint32_t i = begin; i < end; ++i) {
       const uint32_t b = bin_of(refs[i]);
       ++bin_count[b];
-      for (const Vec3d& c : corners[refs[i]]) bin_box[b].grow(c);
+      grow_by_corners(bin_box[b], refs[i]);
     }
     double right_area[kBins];
     uint32_t right_count[kBins];
@@ -158,8 +169,8 @@ uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, ui
     });
   }
 
-  build_node(refs, begin, mid, depth + 1, corners, centroids);
-  const uint32_t right = build_node(refs, mid, end, depth + 1, corners, centroids);
+  build_node(refs, begin, mid, depth + 1, mesh, centroids);
+  const uint32_t right = build_node(refs, mid, end, depth + 1, mesh, centroids);
   nodes_[index].first = right;
   nodes_[index].count = 0;
   return index;
@@ -170,7 +181,8 @@ ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
   best.squared_distance = std::numeric_limits<double>::infinity();
   auto test_slot = [&](uint32_t s) {
     const Slot& t = triangles_[s];
-    const Vec3d q = closest_point_on_triangle(query, t.corners[0], t.corners[1], t.corners[2]);
+    const Vec3d q = closest_point_on_triangle(query, to_double(t.corners[0]),
+                                              to_double(t.corners[1]), to_double(t.corners[2]));
     const double d2 = squared_length(query - q);
     if (d2 < best.squared_distance) {
       best.squared_distance = d2;

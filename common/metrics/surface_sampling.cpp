@@ -27,7 +27,7 @@ double triangle_area(Vec3d a, Vec3d b, Vec3d c) { return 0.5 * length(cross(b - 
 
 }  // namespace
 
-SurfaceSamples sample_surface(const Mesh& mesh, uint32_t area_samples, uint64_t seed) {
+SurfaceSamples sample_surface_area(const Mesh& mesh, uint32_t area_samples, uint64_t seed) {
   SurfaceSamples out;
   const uint32_t faces = mesh.face_count();
   auto corner = [&](uint32_t f, int k) { return to_double(mesh.positions[mesh.triangles[f][k]]); };
@@ -59,7 +59,12 @@ SurfaceSamples sample_surface(const Mesh& mesh, uint32_t area_samples, uint64_t 
     }
   }
   out.area_count = static_cast<uint32_t>(out.points.size());
+  return out;
+}
 
+SurfaceSamples sample_surface(const Mesh& mesh, uint32_t area_samples, uint64_t seed) {
+  SurfaceSamples out = sample_surface_area(mesh, area_samples, seed);
+  const uint32_t faces = mesh.face_count();
   std::vector<uint8_t> referenced(mesh.vertex_count(), 0);
   std::vector<uint64_t> edges;
   edges.reserve(3ull * faces);

@@ -25,7 +25,7 @@ using namespace std::chrono_literals;
 struct Session {
   DecodedStream decoded;
   LatestFrameMailbox mailbox;
-  std::unique_ptr<StreamClient> client;
+  std::unique_ptr<SourceOf<StreamClient>> client;
   std::unique_ptr<DisplayPipeline> pipeline;
   std::thread network;
 
@@ -34,7 +34,7 @@ struct Session {
     t.host = "127.0.0.1";
     t.port = server.port();
     t.model = "demo";
-    client = std::make_unique<StreamClient>(t);
+    client = std::make_unique<SourceOf<StreamClient>>(t);
     pipeline = std::make_unique<DisplayPipeline>(decoded, client.get(), mailbox, settings, nullptr);
     network = std::thread([this] {
       client->run(decoded, [this](const StreamFacts& f) {

@@ -11,6 +11,7 @@
 #include "client/connection.h"
 #include "client/decoded_stream.h"
 #include "client/display_builder.h"
+#include "client/frame_mesh_pool.h"
 #include "client/stream_client.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
@@ -85,6 +86,37 @@ TEST(DecodedStream, MirrorCopiesOnlyChangesAndStaysEqualToTheDecoder) {
   }
   EXPECT_GT(takes, 3u);
   EXPECT_GT(partial, 1u) << "no take copied only a part of the mesh";
+}
+
+// The pipeline's take: meshes of a FrameMeshPool instead of a mirror. Each
+// equals the decoder's mesh at that take, frames still held keep what they
+// showed, and once a mesh is free again it is updated by the changes alone.
+TEST(DecodedStream, PoolTakeGivesTheDecodedMeshAndKeepsHeldFramesIntact) {
+  auto encoded = encode_hcs(make_demo_mesh(40000));
+  ASSERT_TRUE(encoded);
+  const std::vector<uint8_t>& stream = *encoded;
+  DecodedStream decoded;
+  FrameMeshPool pool;
+  std::vector<std::pair<std::shared_ptr<const Mesh>, Mesh>> held;  // the last two frames
+  uint32_t takes = 0;
+  for (size_t at = 0; at < stream.size(); at += 1500) {
+    const size_t n = std::min<size_t>(1500, stream.size() - at);
+    ASSERT_TRUE(decoded.feed(std::span<const uint8_t>(stream.data() + at, n)));
+    if (!decoded.has_pending()) continue;
+    std::shared_ptr<const Mesh> mesh;
+    MeshChanges changes;
+    const TakenUpdate u = decoded.take(pool, mesh, changes);
+    ++takes;
+    ASSERT_TRUE(mesh);
+    ASSERT_TRUE(same_mesh(*mesh, decode_prefix(stream, u.bytes_decoded)))
+        << "after " << u.records_decoded;
+    held.emplace_back(mesh, *mesh);
+    if (held.size() > 2) held.erase(held.begin());
+    for (const auto& [frame, shown] : held) ASSERT_TRUE(same_mesh(*frame, shown));
+  }
+  EXPECT_GT(takes, 5u);
+  EXPECT_EQ(pool.stats().whole_copies + pool.stats().updates, takes);
+  EXPECT_GT(pool.stats().updates, takes / 2) << "free meshes were copied whole";
 }
 
 TEST(DecodedStream, BarrierHoldsTheNetworkSideUntilThatRecordIsTaken) {

@@ -265,6 +265,90 @@ TEST(Codec, InvalidRecordWithGoodChecksumStaysFatal) {
   EXPECT_FALSE(dec.resume_at(dec.resume_offset()));
 }
 
+// kOnRelease keeps no output mesh while decoding and builds it once from
+// the decoder's state: at every record boundary that mesh is bit for bit
+// the one kEveryRecord keeps record by record, and the decoder is spent
+// afterwards.
+TEST_P(ProceduralRoundTrip, ReleasedMeshEqualsTheMeshKeptRecordByRecord) {
+  Case c = procedural_cases()[GetParam()];
+  EncodeOptions opt;
+  opt.target_base_vertices = 20;
+  opt.record_bytes = 100;
+  auto bytes = encode_hcs(c.mesh, opt);
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  IncrementalDecoder kept;
+  uint64_t fed = 0;
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const uint64_t end = index->records[i].offset + index->records[i].size;
+    ASSERT_TRUE(kept.feed(std::span<const uint8_t>(bytes->data() + fed, end - fed)));
+    fed = end;
+    IncrementalDecoder once(DecodedMeshUpkeep::kOnRelease);
+    ASSERT_TRUE(once.feed(std::span<const uint8_t>(bytes->data(), end)));
+    EXPECT_EQ(once.mesh().vertex_count(), 0u);  // nothing kept while decoding
+    ASSERT_EQ(once.last_deltas().size(), i + 1);
+    for (const RecordDelta& d : once.last_deltas()) {
+      // Nothing tracks the changes: no lists, and a consumer told to rebuild.
+      EXPECT_TRUE(d.full_rebuild);
+      EXPECT_TRUE(d.added_vertices.empty() && d.touched_faces.empty() && d.moved_vertices.empty());
+    }
+    auto released = once.release_mesh();
+    ASSERT_TRUE(released) << released.error().message;
+    ASSERT_EQ(released->positions, kept.mesh().positions) << c.name << " record " << i;
+    ASSERT_EQ(released->triangles, kept.mesh().triangles) << c.name << " record " << i;
+    EXPECT_FALSE(once.release_mesh());
+    EXPECT_FALSE(once.feed(std::span<const uint8_t>(bytes->data(), 1)));
+  }
+  auto moved = kept.release_mesh();
+  ASSERT_TRUE(moved);
+  auto whole = decode_hcs(*bytes);
+  ASSERT_TRUE(whole);
+  EXPECT_EQ(moved->positions, whole->positions);
+  EXPECT_EQ(moved->triangles, whole->triangles);
+}
+
+// kOnRelease has no good mesh once a record failed half-applied, and says
+// so; before the base mesh there is none either. A checksum failure, found
+// before anything is applied, still leaves the mesh of the records before.
+TEST(Codec, ReleaseAfterABadRecordIsAnError) {
+  auto bytes = small_many_record_stream();
+  ASSERT_TRUE(bytes);
+  auto index = read_stream_index(*bytes);
+  ASSERT_TRUE(index);
+  ASSERT_GE(index->records.size(), 4u);
+  {
+    IncrementalDecoder dec(DecodedMeshUpkeep::kOnRelease);
+    ASSERT_TRUE(dec.feed(std::span<const uint8_t>(bytes->data(), index->payload_offset)));
+    auto none = dec.release_mesh();
+    ASSERT_FALSE(none);
+    EXPECT_EQ(none.error().code, ErrorCode::kTruncated);
+  }
+  const RecordEntry& victim = index->records[2];
+  std::vector<uint8_t> invalid = *bytes;
+  std::fill(invalid.begin() + victim.offset, invalid.begin() + victim.offset + victim.size, 0xFF);
+  reseal_checksums(invalid);
+  {
+    IncrementalDecoder dec(DecodedMeshUpkeep::kOnRelease);
+    auto fed = dec.feed(invalid);
+    ASSERT_FALSE(fed);
+    auto released = dec.release_mesh();
+    ASSERT_FALSE(released);
+    EXPECT_EQ(released.error().message, fed.error().message);
+  }
+  std::vector<uint8_t> altered = *bytes;
+  altered[victim.offset + victim.size / 2] ^= 0x10;
+  IncrementalDecoder dec(DecodedMeshUpkeep::kOnRelease);
+  ASSERT_FALSE(dec.feed(altered));
+  ASSERT_TRUE(dec.error_is_recoverable());
+  IncrementalDecoder reference;
+  ASSERT_TRUE(reference.feed(std::span<const uint8_t>(bytes->data(), victim.offset)));
+  auto released = dec.release_mesh();
+  ASSERT_TRUE(released) << released.error().message;
+  EXPECT_EQ(released->positions, reference.mesh().positions);
+  EXPECT_EQ(released->triangles, reference.mesh().triangles);
+}
+
 TEST(Codec, BudgetsSelectTheRightPrefix) {
   Mesh m = icosphere(4, 0.1f);
   EncodeOptions opt;

@@ -109,5 +109,28 @@ TEST_F(EncodeCommand, HelpNamesTheFlagAfterWhatItDoes) {
   EXPECT_EQ(help.find("issue I"), std::string::npos) << help;
 }
 
+// stderr is a file here, not a terminal: no bar and no carriage return
+// unless --progress asks; then the bar names the stages and ends at 100 %
+// (and is cleared). --no-progress wins. The stream is the same every way,
+// and for every --threads.
+TEST_F(EncodeCommand, ProgressBarOnlyWhenAskedOffATerminal) {
+  const std::vector<uint8_t> plain = encode("", "plain.hcs");
+  ASSERT_FALSE(plain.empty());
+  const std::string quiet = read_text(dir_ / "out.txt");
+  EXPECT_EQ(quiet.find('\r'), std::string::npos) << quiet;
+  EXPECT_EQ(quiet.find("encode: "), std::string::npos) << quiet;
+
+  EXPECT_EQ(encode("--progress", "bar.hcs"), plain);
+  const std::string bar = read_text(dir_ / "out.txt");
+  for (const char* part : {"\rencode: reading ", "encode: decimating [", "encode: coding records [",
+                           "encode: measuring [", "] 100 %"})
+    EXPECT_NE(bar.find(part), std::string::npos) << part << " in " << bar;
+
+  EXPECT_EQ(encode("--progress --no-progress", "none.hcs"), plain);
+  EXPECT_EQ(read_text(dir_ / "out.txt").find('\r'), std::string::npos);
+  EXPECT_EQ(encode("--threads 1", "one.hcs"), plain);
+  EXPECT_EQ(encode("--threads 3", "three.hcs"), plain);
+}
+
 }  // namespace
 }  // namespace meshstream

@@ -1,0 +1,131 @@
+// The encoder's heap high-water mark on a generated 1M-triangle mesh: every
+// allocation of this test binary goes through the counting operator new
+// below, so the peak is what the encode holds at its worst moment (the mesh
+// itself included), not an estimate. Generous against the target
+// (peak RSS at most 300 bytes per input vertex for the whole process): it
+// catches a stage that keeps a whole-mesh array too many, not noise.
+#include <gtest/gtest.h>
+#include <malloc.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "common/codec/decoder.h"
+#include "common/codec/encoder.h"
+#include "common/mesh/procedural.h"
+
+namespace {
+
+std::atomic<int64_t> g_live{0};
+std::atomic<int64_t> g_peak{0};
+
+void count_in(void* p) {
+  if (!p) return;
+  const int64_t live =
+      g_live.fetch_add(int64_t(malloc_usable_size(p))) + int64_t(malloc_usable_size(p));
+  int64_t peak = g_peak.load();
+  while (live > peak && !g_peak.compare_exchange_weak(peak, live)) {
+  }
+}
+
+void count_out(void* p) {
+  if (p) g_live.fetch_sub(int64_t(malloc_usable_size(p)));
+}
+
+void* counted_new(std::size_t size) {
+  void* p = std::malloc(size ? size : 1);
+  if (!p) throw std::bad_alloc();
+  count_in(p);
+  return p;
+}
+
+void* counted_new_aligned(std::size_t size, std::size_t alignment) {
+  void* p = std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+  if (!p) throw std::bad_alloc();
+  count_in(p);
+  return p;
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_new(size); }
+void* operator new[](std::size_t size) { return counted_new(size); }
+void* operator new(std::size_t size, std::align_val_t a) {
+  return counted_new_aligned(size, std::size_t(a));
+}
+void* operator new[](std::size_t size, std::align_val_t a) {
+  return counted_new_aligned(size, std::size_t(a));
+}
+void operator delete(void* p) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  count_out(p);
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  count_out(p);
+  std::free(p);
+}
+
+namespace meshstream {
+namespace {
+
+// Measured: 696 bytes a vertex (the two candidate replays, about 180 each,
+// are the largest part; then the decimation layers and the surface
+// hierarchy). The 300-byte target is not met yet; this bound
+// catches a return of the whole-mesh copies (over 1 KB a vertex before).
+constexpr double kBoundBytesPerVertex = 900;
+
+// The counter sees this binary's allocations.
+TEST(EncoderMemory, TheCounterCountsAllocations) {
+  const int64_t before = g_live.load();
+  auto* block = new std::vector<uint8_t>(1 << 20);
+  EXPECT_GE(g_live.load() - before, 1 << 20);
+  delete block;
+  EXPECT_LT(g_live.load() - before, 1 << 10);
+}
+
+// Peak heap of the default encode (both candidate orderings, their
+// measurement) of a 1M-triangle mesh, over its vertex count, mesh included.
+TEST(EncoderMemory, PeakHeapOfAMillionTriangleEncodeIsBounded) {
+  const Mesh mesh = make_demo_mesh(1'000'000);
+  ASSERT_GE(mesh.face_count(), 990'000u);
+  const int64_t base = g_live.load();
+  g_peak.store(base);
+  auto stream = encode_hcs(mesh, EncodeOptions{});
+  ASSERT_TRUE(stream) << stream.error().message;
+  const int64_t stream_bytes = int64_t(stream->size());
+  const int64_t mesh_bytes = int64_t(mesh.positions.capacity() * sizeof(Vec3f) +
+                                     mesh.triangles.capacity() * sizeof(Triangle));
+  const double peak_per_vertex = double(g_peak.load() - base + mesh_bytes) / mesh.vertex_count();
+  RecordProperty("peak_heap_bytes_per_vertex", std::to_string(peak_per_vertex));
+  std::printf("peak heap: %.0f bytes per vertex (%u vertices, stream %lld bytes)\n",
+              peak_per_vertex, mesh.vertex_count(), static_cast<long long>(stream_bytes));
+  EXPECT_LE(peak_per_vertex, kBoundBytesPerVertex);
+}
+
+}  // namespace
+}  // namespace meshstream
