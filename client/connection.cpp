@@ -58,6 +58,16 @@ Result<std::unique_ptr<Connection>> Connection::open(const std::string& host, ui
   return c;
 }
 
+namespace {
+
+// End of file, or a reset because the peer closed with our bytes unread.
+bool closed_by_peer(const boost::system::error_code& e) {
+  return e == asio::error::eof || e == asio::error::connection_reset ||
+         e == asio::error::broken_pipe;
+}
+
+}  // namespace
+
 Status Connection::send(const v1::ClientMessage& message, Millis timeout) {
   const std::vector<uint8_t> frame = proto::encode_frame(message);
   bool done = false;
@@ -67,6 +77,7 @@ Status Connection::send(const v1::ClientMessage& message, Millis timeout) {
     done = true;
   });
   if (!run_until(done, Clock::now() + timeout, nullptr)) result = asio::error::timed_out;
+  peer_closed_ |= closed_by_peer(result);
   if (result)
     return make_error(ErrorCode::kIo, "sending to " + peer_ + " failed: " + result.message());
   return {};
@@ -98,6 +109,7 @@ Result<v1::ServerMessage> Connection::receive(Millis timeout, const std::atomic<
     }
     if (result) {
       if (got > 0) continue;  // parse what arrived first
+      peer_closed_ |= closed_by_peer(result);
       const std::string why = result == asio::error::eof ? "closed the connection"
                               : result == asio::error::timed_out
                                   ? "sent nothing for " + std::to_string(timeout.count()) + " ms"

@@ -44,6 +44,9 @@ class Connection {
 
   // Stream bytes read from the socket so far (frames included).
   uint64_t bytes_read() const { return bytes_read_; }
+  // The peer closed the connection (end of file, or a reset or broken pipe
+  // because it closed with our bytes unread).
+  bool peer_closed() const { return peer_closed_; }
   std::string peer() const { return peer_; }
 
  private:
@@ -58,6 +61,7 @@ class Connection {
   proto::ServerFrameReader reader_{proto::kMaxServerFrameBytes};
   std::vector<uint8_t> buffer_;
   uint64_t bytes_read_ = 0;
+  bool peer_closed_ = false;
   std::string peer_;
 };
 

@@ -190,7 +190,14 @@ StreamClient::Attempt StreamClient::attempt(
     error = s.error();
     if (s.error().code == ErrorCode::kUnsupported) return Attempt::kFatal;
     // A server that answered "busy" (or the like) asks to be tried again; a
-    // peer that never spoke the protocol will not start to.
+    // peer that never spoke the protocol will not start to. A peer that
+    // closed before sending a byte may be a load balancer whose server just
+    // died (HAProxy in TCP mode accepts first, then connects): retried a
+    // few times (docs/deploy.md).
+    if (!handshaken_ && !server_answered && c.bytes_read() == 0 && c.peer_closed() &&
+        ++silent_first_closes_ <= kSilentFirstCloseRetries) {
+      return Attempt::kRetry;
+    }
     return handshaken_ || server_answered ? Attempt::kRetry : Attempt::kFatal;
   }
   handshaken_ = true;

@@ -119,6 +119,9 @@ class StreamClient {
   StreamTarget target_;
   std::function<Status(const StreamFacts&)> check_header_;
   bool handshaken_ = false;  // a handshake succeeded once: later losses are retried
+  // Before the first handshake: connections the peer closed without a byte.
+  static constexpr int kSilentFirstCloseRetries = 3;
+  int silent_first_closes_ = 0;
   std::optional<StreamFacts> facts_;
   bool index_checked_ = false;  // header compared with the stream's own index
   std::atomic<bool> stop_{false};

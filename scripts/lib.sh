@@ -19,6 +19,7 @@ MESHSTREAM_PACKAGES=(
   clang libclang-rt-14-dev  # fuzz targets (libFuzzer) in tests/fuzz
   clang-format  # scripts/check-format, run by scripts/test
   nginx  # tests/http: the HTTP stream path against a real web server
+  haproxy curl  # deploy tests: servers behind a real HAProxy; scraping --metrics
 )
 
 ms_install_packages() {

@@ -5,6 +5,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+
+#include "server/cache_lock.h"
 
 #if MESHSTREAM_HAVE_MESH_ENCODER
 #include "common/codec/encoder.h"
@@ -33,14 +36,24 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir,
           ? fs::path()
           : fs::path(cache_dir) / (job.key + "-q" + std::to_string(options.quant_bits) + "-e" +
                                    std::to_string(kEncoderVersion) + ".hcs");
-  if (!cache_dir.empty() && fs::exists(cached)) {
+  auto map_cached = [&]() -> std::optional<Result<CatalogModel>> {
+    if (cache_dir.empty() || !fs::exists(cached)) return std::nullopt;
     if (auto bytes = map_file(cached.string())) {
       if (auto model = make_model(job.name, job.source, job.origin, std::move(*bytes))) {
         out.from_cache = true;
-        return finish(std::move(model));
+        return model;
       }
     }
-    // A broken cache entry is re-encoded below and replaced.
+    return std::nullopt;  // a broken cache entry is re-encoded below and replaced
+  };
+  if (auto model = map_cached()) return finish(std::move(*model));
+  // Servers sharing the cache folder encode each entry once: the first to
+  // take the entry's lock encodes, the others wait and then map its file.
+  // Without the lock (a read-only folder) temp + rename still keeps it whole.
+  std::optional<CacheEntryLock> lock;
+  if (!cache_dir.empty()) {
+    if (auto taken = CacheEntryLock::acquire(cached.string())) lock.emplace(std::move(*taken));
+    if (auto model = map_cached()) return finish(std::move(*model));
   }
   auto mesh = job.make_mesh();
   if (!mesh) return finish(tl::unexpected(mesh.error()));

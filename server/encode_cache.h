@@ -31,8 +31,10 @@ struct EncodeOutcome {
 
 // Maps the cached stream for `job` or makes, encodes, caches and maps it.
 // `cache_dir` empty = no cache (the stream is kept in memory). A broken
-// cache entry is re-encoded and replaced; writes are atomic (temp + rename).
-// Thread-safe for distinct keys. Cost: an encode on a miss, O(1) on a hit.
+// cache entry is re-encoded and replaced; writes are atomic (temp + rename)
+// and a miss is encoded under the entry's lock (server/cache_lock.h), so
+// threads and processes sharing `cache_dir` encode each entry once and never
+// see it half-written. Cost: an encode on a miss, O(1) on a hit.
 // `progress`, if set, gets the encoder's progress (encode_progress.h) on
 // this thread; a cache hit reports nothing.
 EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir,

@@ -35,6 +35,7 @@ Server::Server(const ServerOptions& options)
   shared_.active_sessions = &active_sessions_;
   shared_.rejecting_sessions = &rejecting_;
   shared_.first_chunks = &first_chunks_;
+  shared_.metrics = &metrics_;
   unsigned threads = options_.threads ? options_.threads : std::thread::hardware_concurrency();
   threads = std::max(1u, threads);
   for (unsigned i = 0; i < threads; ++i) {
@@ -44,7 +45,44 @@ Server::Server(const ServerOptions& options)
   }
 }
 
-Server::~Server() = default;
+Server::~Server() {
+  // Before the counters and the catalog it reads go.
+  if (metrics_endpoint_) metrics_endpoint_->stop();
+}
+
+std::optional<net::tcp::endpoint> Server::metrics_endpoint() const {
+  if (!metrics_endpoint_) return std::nullopt;
+  return metrics_endpoint_->local_endpoint();
+}
+
+Status Server::listen_metrics() {
+  metrics_endpoint_ = std::make_unique<MetricsEndpoint>(
+      [this] {
+        ModelCounts models;
+        if (const ModelRegistry* registry = serving_models_.load()) {
+          const StateCounts counts = registry->counts();
+          models.queued = counts.queued;
+          models.encoding = counts.encoding;
+          models.ready = counts.ready;
+          models.failed = counts.failed;
+        }
+        return render_prometheus(metrics_, active_sessions_.load(), models);
+      },
+      [this] {
+        if (stopping_) return MetricsEndpoint::Health{false, "shutting down"};
+        if (!serving_models_.load() || !initial_models_done_) {
+          return MetricsEndpoint::Health{false, "loading models"};
+        }
+        return MetricsEndpoint::Health{true, ""};
+      });
+  if (auto status = metrics_endpoint_->listen(options_.metrics_host, options_.metrics_port);
+      !status) {
+    metrics_endpoint_.reset();
+    return status;
+  }
+  metrics_endpoint_->start();
+  return {};
+}
 
 Status Server::listen() {
   boost::system::error_code ec;
@@ -80,11 +118,13 @@ Status Server::listen() {
                                           ec.message());
   }
   acceptor_ = std::move(acceptor);
+  if (!options_.metrics_host.empty()) return listen_metrics();
   return {};
 }
 
 void Server::start_serving(const ModelRegistry& models) {
   shared_.models = &models;
+  serving_models_ = &models;
   // Catch SIGINT/SIGTERM from now on (before the port is announced): Asio
   // queues a signal that arrives before run() and delivers it then.
   signals_ = std::make_unique<asio::signal_set>(workers_[0]->io, SIGINT, SIGTERM);
@@ -199,6 +239,8 @@ void Server::run(std::chrono::milliseconds grace) {
   }
   for (auto& t : threads) t.join();
   first_chunks_.stop_waking();
+  // HAProxy's check sees 503 from stop() on; the endpoint closes with us.
+  if (metrics_endpoint_) metrics_endpoint_->stop();
   spdlog::info("server stopped");
 }
 

@@ -8,10 +8,12 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "common/base/result.h"
 #include "common/net/asio.h"
+#include "server/metrics_http.h"
 #include "server/model_registry.h"
 #include "server/server_options.h"
 #include "server/session.h"
@@ -26,12 +28,16 @@ class Server {
   Server& operator=(const Server&) = delete;
 
   // Binds and listens on options.listen_host:listen_port, first of all, so
-  // an unusable address fails at once. Clients that connect before run()
-  // wait in the backlog. kIo when the address is unusable (in use, not local, not an
+  // an unusable address fails at once (and starts the --metrics endpoint,
+  // whose /healthz says 503 until start_serving). Clients that connect
+  // before run() wait in the backlog. kIo when the address is unusable (in
+  // use, not local, not an
   // address); the message names it and the cause.
   Status listen();
   // The bound address (after listen()); port is the real one for port 0.
   net::tcp::endpoint local_endpoint() const;
+  // The --metrics address (after listen()); nullopt without --metrics.
+  std::optional<net::tcp::endpoint> metrics_endpoint() const;
 
   // What the server serves (must outlive it; it may change while the
   // server runs: models are encoded in the background), and from now on
@@ -44,6 +50,9 @@ class Server {
   void run(std::chrono::milliseconds grace = std::chrono::milliseconds(3000));
   // Thread-safe, idempotent: begins the clean shutdown.
   void stop();
+  // Thread-safe: every model found at start is ready or failed; from now on
+  // /healthz answers 200 (a load balancer sends clients only then).
+  void initial_models_done() { initial_models_done_ = true; }
 
  private:
   struct Worker {
@@ -54,9 +63,13 @@ class Server {
 
   net::asio::awaitable<void> accept_loop();
   void begin_shutdown();  // on worker 0
+  Status listen_metrics();
 
   const ServerOptions& options_;
   FirstChunkGate first_chunks_;
+  ServerMetrics metrics_;
+  std::atomic<const ModelRegistry*> serving_models_{nullptr};  // for /metrics, set by start_serving
+  std::unique_ptr<MetricsEndpoint> metrics_endpoint_;
   ServerShared shared_;
   std::atomic<int64_t> active_sessions_{0};
   std::atomic<int64_t> rejecting_{0};
@@ -64,6 +77,7 @@ class Server {
   std::unique_ptr<net::tcp::acceptor> acceptor_;
   std::unique_ptr<net::asio::signal_set> signals_;
   std::atomic<bool> stopping_{false};
+  std::atomic<bool> initial_models_done_{false};
   std::mutex mutex_;
   std::condition_variable stopped_;
   size_t next_worker_ = 0;

@@ -124,6 +124,7 @@ int main(int argc, char** argv) {
     spdlog::info("catalog: initial models done: {} ready, {} failed in {:.2f} s", counts.ready,
                  counts.failed,
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    server.initial_models_done();
     if (counts.ready == 0 && options.watch == "off") {
       nothing_ready = true;
       server.stop();
@@ -173,6 +174,10 @@ int main(int argc, char** argv) {
   server.start_serving(registry);
   std::printf("listening on %s:%u\n", endpoint.address().to_string().c_str(),
               unsigned(endpoint.port()));
+  if (const auto metrics = server.metrics_endpoint()) {
+    std::printf("metrics on %s:%u\n", metrics->address().to_string().c_str(),
+                unsigned(metrics->port()));
+  }
   std::fflush(stdout);
   spdlog::info("serving while {} background encoder{} encode what is not cached", pool.encoders(),
                pool.encoders() == 1 ? "" : "s");

@@ -97,6 +97,10 @@ ParsedOptions parse_server_options(int argc, char** argv) {
                  "go out (0 = no wait)")
       ->capture_default_str()
       ->check(CLI::Range(uint64_t(0), uint64_t(10000)));
+  std::string metrics;
+  app.add_option("--metrics", metrics,
+                 "serve /metrics (Prometheus text format) and /healthz over HTTP on HOST:PORT "
+                 "(port 0 = any free port, printed as 'metrics on HOST:PORT'; default: off)");
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error or off")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
@@ -113,6 +117,11 @@ ParsedOptions parse_server_options(int argc, char** argv) {
   }
   if (!split_listen(listen, o.listen_host, o.listen_port)) {
     std::cerr << "meshstream-server: --listen expects HOST:PORT, got '" << listen
+              << "' (see --help)\n";
+    return 2;
+  }
+  if (!metrics.empty() && !split_listen(metrics, o.metrics_host, o.metrics_port)) {
+    std::cerr << "meshstream-server: --metrics expects HOST:PORT, got '" << metrics
               << "' (see --help)\n";
     return 2;
   }

@@ -32,6 +32,10 @@ struct ServerOptions {
   // (FirstChunkGate); zero = no hold (bulk only steps back once per chunk).
   std::chrono::milliseconds first_chunk_hold{50};
   std::string log_level = "info";
+  // --metrics HOST:PORT: /metrics and /healthz over HTTP (port 0 = any free
+  // port, printed on stdout after the "listening on" line); empty = off.
+  std::string metrics_host;
+  uint16_t metrics_port = 0;
 };
 
 // Outcome of parsing: options to run with, or an exit code to return now

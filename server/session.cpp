@@ -69,6 +69,7 @@ Session::~Session() {
   registry_.held.erase(this);
   while (starting_ > 0) started_one();
   if (counted_) --*shared_.active_sessions;
+  if (stream_) shared_.metrics->count_stream(StreamOutcome::kInterrupted);
   if (reject_) --*shared_.rejecting_sessions;
   const double seconds = std::chrono::duration<double>(Clock::now() - started_).count();
   if (reject_) {
@@ -107,6 +108,7 @@ void Session::note_first_chunk(Clock::time_point requested) {
 
 void Session::start() {
   registry_.sessions.insert(this);
+  if (!reject_) shared_.metrics->sessions_total.fetch_add(1, std::memory_order_relaxed);
   boost::system::error_code ec;
   socket_.set_option(net::tcp::no_delay(true), ec);
   auto executor = socket_.get_executor();
@@ -159,6 +161,7 @@ void Session::send(const google::protobuf::MessageLite& message, bool closing) {
 void Session::send_error(v1::Error::Code code, const std::string& message, bool closing) {
   v1::ServerMessage out;
   v1::Error* error = out.mutable_error();
+  shared_.metrics->count_error(code);
   error->set_code(code);
   error->set_message(message);
   error->set_closing(closing);
@@ -315,6 +318,7 @@ void Session::send_not_servable(const ModelStatus& status) {
                        "; ask again later");
   }
   error->set_closing(false);
+  shared_.metrics->count_error(error->code());
   spdlog::info("session {}: {}", peer_, error->message());
   send(out, false);
 }
@@ -343,6 +347,9 @@ awaitable<bool> Session::write_end(v1::StreamEnd::Reason reason) {
   end->set_end_offset(stream_->position);
   end->set_records_complete(stream_->records_complete);
   stream_.reset();
+  shared_.metrics->count_stream(reason == v1::StreamEnd::COMPLETE ? StreamOutcome::kComplete
+                                : reason == v1::StreamEnd::BUDGET ? StreamOutcome::kBudget
+                                                                  : StreamOutcome::kCancelled);
   last_activity_ = Clock::now();
   const std::vector<uint8_t> bytes = proto::encode_frame(out);
   co_return co_await write(asio::buffer(bytes));
@@ -537,6 +544,7 @@ awaitable<bool> Session::write_chunk(ActiveStream& s) {
   s.records_complete = cut.records_complete;
   ++s.chunks_sent;
   bytes_total_ += size;
+  shared_.metrics->bytes_sent.fetch_add(size, std::memory_order_relaxed);
   co_return true;
 }
 

@@ -21,6 +21,7 @@
 #include "server/catalog.h"
 #include "server/first_chunk_gate.h"
 #include "server/model_registry.h"
+#include "server/server_metrics.h"
 #include "server/server_options.h"
 #include "server/stream_plan.h"
 #include "server/token_bucket.h"
@@ -38,6 +39,7 @@ struct ServerShared {
   std::atomic<int64_t>* active_sessions = nullptr;          // counted toward --max-connections
   std::atomic<int64_t>* rejecting_sessions = nullptr;       // busy sessions still closing
   FirstChunkGate* first_chunks = nullptr;  // bulk waits for new streams' first chunks
+  ServerMetrics* metrics = nullptr;        // counters for --metrics (atomics)
 };
 
 // The sessions of one worker thread, touched only from that thread.

@@ -90,22 +90,37 @@ class ServerProcess {
     }
     ::close(out[1]);
     stdout_fd_ = out[0];
-    std::string line;
     const auto deadline = Clock::now() + timeout;
-    while (Clock::now() < deadline) {
-      pollfd p{stdout_fd_, POLLIN, 0};
-      if (::poll(&p, 1, 50) <= 0) continue;
-      char c;
-      if (::read(stdout_fd_, &c, 1) != 1) return false;
-      if (c == '\n') break;
-      line += c;
-    }
+    const std::string line = read_stdout_line(timeout);
     const auto colon = line.rfind(':');
     if (line.rfind("listening on ", 0) != 0 || colon == std::string::npos) return false;
     port_ = static_cast<uint16_t>(std::stoi(line.substr(colon + 1)));
     if (wait == Wait::kPort) return true;
     return wait_log("initial models done",
                     std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()));
+  }
+
+  // The next line the server prints on stdout (after "listening on": with
+  // --metrics, "metrics on HOST:PORT"); "" at its end or after `timeout`.
+  std::string read_stdout_line(std::chrono::milliseconds timeout = 5s) {
+    std::string line;
+    const auto deadline = Clock::now() + timeout;
+    while (Clock::now() < deadline) {
+      pollfd p{stdout_fd_, POLLIN, 0};
+      if (::poll(&p, 1, 50) <= 0) continue;
+      char c;
+      if (::read(stdout_fd_, &c, 1) != 1) return "";
+      if (c == '\n') return line;
+      line += c;
+    }
+    return "";
+  }
+  // The port of the "metrics on HOST:PORT" line (0 when it is not there).
+  uint16_t read_metrics_port() {
+    const std::string line = read_stdout_line();
+    const auto colon = line.rfind(':');
+    if (line.rfind("metrics on ", 0) != 0 || colon == std::string::npos) return 0;
+    return static_cast<uint16_t>(std::stoi(line.substr(colon + 1)));
   }
 
   // Polls the log until it holds `text` (true) or `timeout` passes.
