@@ -415,6 +415,25 @@ TEST_F(ClientCliTest, SnapshotMistakesAreFoundBeforeStreaming) {
   EXPECT_FALSE(fs::exists(out / "x.jpg"));
 }
 
+// Issue 20: a crease angle below acos(--flatness) leaves ASA nothing to
+// refine; the client (and so its viewer) refuses it before connecting, naming
+// both values and the relation. Without ASA, or with a lower t, it streams.
+TEST_F(ClientCliTest, CreaseBelowTheFlatnessAngleIsAUsageError) {
+  const CliRun clash = client(fast_->address(), {"demo", "--crease", "30"});
+  EXPECT_EQ(clash.status, 2) << clash.err;
+  ASSERT_EQ(lines_of(clash.err).size(), 1u) << clash.err;
+  EXPECT_TRUE(contains(clash.err, "--crease 30 is below acos(--flatness 0.85) = 31.8 degrees"))
+      << clash.err;
+  const CliRun view =
+      client(fast_->address(), {"demo", "--view", "--crease", "20", "--flatness", "0.9"});
+  EXPECT_EQ(view.status, 2) << view.err;
+  EXPECT_TRUE(contains(view.err, "--crease 20 is below acos(--flatness 0.9)")) << view.err;
+  EXPECT_EQ(client(fast_->address(), {"demo", "--crease", "30", "--no-asa", "--json"}).status, 0);
+  EXPECT_EQ(
+      client(fast_->address(), {"demo", "--crease", "30", "--flatness", "0.9", "--json"}).status,
+      0);
+}
+
 // Row 16: a malformed HOST:PORT and an out-of-range port each get their own
 // reason (exit 2); an unknown model prints the server's own message.
 TEST_F(ClientCliTest, AddressAndModelMessagesNameTheirCause) {
