@@ -74,6 +74,9 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->capture_default_str();
   bool no_asa = false;
   app.add_flag("--no-asa", no_asa, "show the decoded mesh without ASA");
+  app.add_flag("--asa-complete", o.asa_complete,
+               "apply ASA to the complete mesh too (default: once every record of the stream "
+               "has arrived, the display, --snapshot and final.ply are the decoded mesh)");
   app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
       ->check(CLI::IsMember({"auto", "full", "incremental"}))
       ->capture_default_str();

@@ -131,8 +131,11 @@ void DisplayPipeline::loop() {
     info.rerun = rerun;
     frame.records_total = records_total;
     frame.bytes_total = bytes_total;
-    auto display = builder_.build(frame.decoded, changes, settings.asa_enabled, settings.asa,
-                                  rerun || !last, info.build);
+    // Nothing is missing once every record is in: show the decoded mesh.
+    const bool complete = records_total > 0 && frame.records_decoded >= records_total;
+    const bool asa_now = settings.asa_enabled && (!complete || settings.asa_on_complete);
+    auto display =
+        builder_.build(frame.decoded, changes, asa_now, settings.asa, rerun || !last, info.build);
     changes.clear();
     if (!display) {
       decoded_.stop();
@@ -159,6 +162,9 @@ void DisplayPipeline::set_asa(bool asa_enabled, const AsaOptions& options) {
     std::lock_guard lock(mutex_);
     settings_.asa_enabled = asa_enabled;
     settings_.asa = options;
+    // A change made while streaming (the viewer's panel) is an explicit
+    // request: it applies to the complete mesh too.
+    settings_.asa_on_complete = true;
   }
   decoded_.poke();
 }
