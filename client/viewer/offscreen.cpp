@@ -72,7 +72,7 @@ Result<RgbaImage> render_offscreen(const Mesh& mesh, const OffscreenRequest& req
     camera.yaw = request.yaw;
     camera.pitch = request.pitch;
     float aspect = static_cast<float>(request.width) / static_cast<float>(request.height);
-    camera.frame(mesh, aspect, request.fill);
+    camera.frame(request.frame_on ? *request.frame_on : mesh, aspect, request.fill);
 
     target->bind_for_drawing();
     renderer->draw(camera, request.width, request.height, request.style);
