@@ -191,6 +191,7 @@ class StreamingRun {
   static PipelineSettings settings_of(const ClientOptions& o) {
     PipelineSettings settings;
     settings.asa_enabled = o.asa_enabled;
+    settings.asa_on_complete = o.asa_complete;
     settings.asa = o.asa;
     settings.path = o.asa_path;
     settings.view.dependent = !o.view_independent;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "common/asa/settings_check.h"
 #include "common/cli/budget_options.h"
 #include "common/cli/version.h"
 
@@ -68,7 +69,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--crease", o.asa.crease_degrees,
                  "edges bending more than DEG degrees stay sharp (0 = off; the picture then "
-                 "keeps edges above 60 degrees sharp)")
+                 "keeps edges above 60 degrees sharp); with ASA, DEG below acos(--flatness) "
+                 "(31.8 at t = 0.85) is refused: every edge ASA refines would stay sharp")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   bool no_asa = false;
@@ -88,6 +90,9 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                  "never show more faces: above it, the update raises the pixel tolerance (the "
                  "refinement event says so)")
       ->capture_default_str();
+  app.add_flag("--asa-complete", o.asa_complete,
+               "apply ASA to the complete mesh too (default: once every record of the stream "
+               "has arrived, the display, --snapshot and final.ply are the decoded mesh)");
   app.add_option("--asa-path", path, "auto, full or incremental (how ASA is recomputed per update)")
       ->check(CLI::IsMember({"auto", "full", "incremental"}))
       ->capture_default_str();
@@ -195,6 +200,10 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   }
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
   o.asa_enabled = !no_asa;
+  if (o.asa_enabled) {
+    if (std::string clash = asa_settings_problem(o.asa, "--crease", "--flatness"); !clash.empty())
+      return usage(clash);
+  }
   o.asa_path = path == "full"          ? AsaPath::kFull
                : path == "incremental" ? AsaPath::kIncremental
                                        : AsaPath::kAuto;

@@ -3,7 +3,7 @@
 //   meshstream-client HOST:PORT [MODEL] | http://HOST[:PORT]/PATH/MODEL.hcs [--list] [--out DIR
 //   [--out-every N]
 //     [--out-at LIST] [--overwrite]] [--asa-levels L]
-//     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa]
+//     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa] [--asa-complete]
 //     [--camera EX,EY,EZ,TX,TY,TZ[,FOV]] [--pixel-tolerance PX] [--view-independent]
 //     [--max-display-faces N]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
@@ -35,6 +35,7 @@ struct ClientOptions {
   std::vector<uint32_t> out_at;       // --out-at: NNNN.ply at these records
   bool overwrite = false;             // --overwrite: reuse a folder of an earlier run
   bool asa_enabled = true;            // --no-asa turns it off
+  bool asa_complete = false;          // --asa-complete: ASA on the complete mesh too
   AsaOptions asa;                     // levels, flatness, rule, crease
   AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)
   // View-dependent ASA (common/asa/view.h): refine for this camera (default:

@@ -163,12 +163,17 @@ void DisplayPipeline::loop() {
     info.rerun = rerun;
     frame.records_total = records_total;
     frame.bytes_total = bytes_total;
-    // A new camera or tolerance alone is no options change: the builder
+    // Nothing is missing once every record is in: show the decoded mesh
+    // (unless asked for ASA there too). A change of that counts as an
+    // options change. A new camera or tolerance alone is none: the builder
     // redoes only what the views may refine.
-    const bool options_changed = !used || asa_settings_changed(settings, *used);
-    used = settings;
-    const AsaOptions options = options_with_view(settings, *frame.decoded, frame.camera);
-    auto display = builder_.build(frame.decoded, changes, settings.asa_enabled, options,
+    const bool complete = records_total > 0 && frame.records_decoded >= records_total;
+    PipelineSettings effective = settings;
+    effective.asa_enabled = settings.asa_enabled && (!complete || settings.asa_on_complete);
+    const bool options_changed = !used || asa_settings_changed(effective, *used);
+    used = effective;
+    const AsaOptions options = options_with_view(effective, *frame.decoded, frame.camera);
+    auto display = builder_.build(frame.decoded, changes, effective.asa_enabled, options,
                                   options_changed || !last, info.build);
     changes.clear();
     if (!display) {
@@ -180,7 +185,7 @@ void DisplayPipeline::loop() {
     frame.display = display->mesh;
     frame.face_kind = display->face_kind;
     frame.asa_ms = info.build.asa_ms;
-    frame.pixel_tolerance = settings.asa_enabled ? info.build.pixel_tolerance : 0;
+    frame.pixel_tolerance = effective.asa_enabled ? info.build.pixel_tolerance : 0;
     frame.budget_limited = info.build.budget_limited;
     info.elapsed_ms = elapsed();
     publish(frame, info);
@@ -198,6 +203,9 @@ void DisplayPipeline::set_asa(bool asa_enabled, const AsaOptions& options) {
     std::lock_guard lock(mutex_);
     settings_.asa_enabled = asa_enabled;
     settings_.asa = options;
+    // A change made while streaming (the viewer's panel) is an explicit
+    // request: it applies to the complete mesh too.
+    settings_.asa_on_complete = true;
   }
   decoded_.poke();
 }

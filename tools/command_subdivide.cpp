@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "common/asa/settings_check.h"
 #include "common/asa/subdivide.h"
 #include "common/mesh/export.h"
 #include "common/mesh/import.h"
@@ -120,7 +121,9 @@ void add_subdivide_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"zorin", "projection"}))
       ->capture_default_str();
   cmd->add_option("--crease", args->options.crease_degrees,
-                  "edges bending more than DEG degrees stay sharp (0 = off)")
+                  "edges bending more than DEG degrees stay sharp (0 = off); without --uniform, "
+                  "DEG below acos(--flatness) (31.8 at t = 0.85) is refused: every edge ASA "
+                  "refines would stay sharp")
       ->check(CLI::Range(0.0f, 180.0f))
       ->capture_default_str();
   cmd->add_option("--tension", args->options.tension, "omega of the ten-point stencil")
@@ -141,6 +144,10 @@ void add_subdivide_command(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(16, 16384))
       ->capture_default_str();
   cmd->callback([args, &exit_code] {
+    // Settings that cancel each other are a usage error (exit 2, like a bad value).
+    if (std::string clash = asa_settings_problem(args->options, "--crease", "--flatness");
+        !clash.empty())
+      throw CLI::ValidationError("subdivide", clash);
     exit_code = set_view(*args);
     if (exit_code == 0) exit_code = run_subdivide(*args);
   });

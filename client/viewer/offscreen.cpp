@@ -75,7 +75,7 @@ Result<RgbaImage> render_offscreen(const Mesh& mesh, const OffscreenRequest& req
     if (request.camera)
       camera.look_from(*request.camera, mesh);
     else
-      camera.frame(mesh, aspect, request.fill);
+      camera.frame(request.frame_on ? *request.frame_on : mesh, aspect, request.fill);
 
     target->bind_for_drawing();
     renderer->draw(camera, request.width, request.height, request.style);

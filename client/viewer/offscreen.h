@@ -25,6 +25,9 @@ struct OffscreenRequest {
   float crease_degrees = 0.0f;
   int samples = 4;     // multisampling
   float fill = 0.85f;  // share of the smaller image side the model spans
+  // When set, the camera frames this mesh instead of the one drawn, so that
+  // several meshes (a prefix, its ASA, the full model) share one camera.
+  const Mesh* frame_on = nullptr;
   // Viewing direction (radians); the distance and target frame the model.
   float yaw = 0.6f;
   float pitch = 0.35f;

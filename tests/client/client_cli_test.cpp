@@ -312,6 +312,36 @@ TEST_F(ClientCliTest, OutWritesTheChosenRecordsWhateverTheTiming) {
   EXPECT_TRUE(same_geometry(load_ply(out / "fast/0017.ply"), load_ply(*dir_ / "sub17.ply")));
 }
 
+// Issue 20: once every record has arrived nothing is missing, so the final
+// display and final.ply are the decoded mesh (ASA of the complete mesh moved
+// it away from the original); a prefix (a budget) is still post-processed,
+// and --asa-complete asks for ASA on the complete mesh.
+TEST_F(ClientCliTest, TheCompleteStreamIsShownAndSavedAsDecoded) {
+  TempDir out;
+  const CliRun full = client(fast_->address(), {"demo", "--json", "--out", out / "full"});
+  ASSERT_EQ(full.status, 0) << full.err;
+  const auto& done = full.events.back();
+  ASSERT_EQ(done["records"], done["records_total"]) << "the stream did not complete";
+  const Mesh decoded = load_ply(out / "full/final.decoded.ply");
+  EXPECT_TRUE(same_geometry(load_ply(out / "full/final.ply"), decoded));
+  EXPECT_EQ(done["display_faces"].get<uint32_t>(), decoded.face_count());
+
+  const CliRun part =
+      client(fast_->address(), {"demo", "--json", "--percent-bytes", "30", "--out", out / "part"});
+  ASSERT_EQ(part.status, 0) << part.err;
+  EXPECT_LT(part.events.back()["records"].get<int>(),
+            part.events.back()["records_total"].get<int>());
+  EXPECT_GT(load_ply(out / "part/final.ply").face_count(),
+            load_ply(out / "part/final.decoded.ply").face_count())
+      << "the prefix was not post-processed";
+
+  const CliRun asked =
+      client(fast_->address(), {"demo", "--json", "--asa-complete", "--out", out / "asked"});
+  ASSERT_EQ(asked.status, 0) << asked.err;
+  EXPECT_GT(load_ply(out / "asked/final.ply").face_count(), decoded.face_count())
+      << "--asa-complete did not post-process the complete mesh";
+}
+
 // Row 6: --out into a folder with files in it is refused (exit 1, naming
 // the folder and --overwrite) before connecting; --overwrite deletes only
 // the files this program writes.
@@ -417,6 +447,25 @@ TEST_F(ClientCliTest, SnapshotMistakesAreFoundBeforeStreaming) {
   EXPECT_TRUE(contains(jpeg.err, "only PNG")) << jpeg.err;
   EXPECT_TRUE(contains(jpeg.err, ".jpg")) << jpeg.err;
   EXPECT_FALSE(fs::exists(out / "x.jpg"));
+}
+
+// Issue 20: a crease angle below acos(--flatness) leaves ASA nothing to
+// refine; the client (and so its viewer) refuses it before connecting, naming
+// both values and the relation. Without ASA, or with a lower t, it streams.
+TEST_F(ClientCliTest, CreaseBelowTheFlatnessAngleIsAUsageError) {
+  const CliRun clash = client(fast_->address(), {"demo", "--crease", "30"});
+  EXPECT_EQ(clash.status, 2) << clash.err;
+  ASSERT_EQ(lines_of(clash.err).size(), 1u) << clash.err;
+  EXPECT_TRUE(contains(clash.err, "--crease 30 is below acos(--flatness 0.85) = 31.8 degrees"))
+      << clash.err;
+  const CliRun view =
+      client(fast_->address(), {"demo", "--view", "--crease", "20", "--flatness", "0.9"});
+  EXPECT_EQ(view.status, 2) << view.err;
+  EXPECT_TRUE(contains(view.err, "--crease 20 is below acos(--flatness 0.9)")) << view.err;
+  EXPECT_EQ(client(fast_->address(), {"demo", "--crease", "30", "--no-asa", "--json"}).status, 0);
+  EXPECT_EQ(
+      client(fast_->address(), {"demo", "--crease", "30", "--flatness", "0.9", "--json"}).status,
+      0);
 }
 
 // Row 16: a malformed HOST:PORT and an out-of-range port each get their own
