@@ -344,35 +344,10 @@ HttpStreamClient::Attempt HttpStreamClient::attempt(
 
 void HttpStreamClient::run(DecodedStream& decoded,
                            const std::function<void(const StreamFacts&)>& on_header) {
-  const ReconnectPolicy& policy = target_.reconnect;
-  int failures = 0;
-  while (!stop_) {
-    bool progressed = false;
-    Error error{ErrorCode::kIo, ""};
-    const Attempt a = attempt(decoded, on_header, progressed, error);
-    if (a == Attempt::kDone) return;
-    if (stop_) break;
-    if (a == Attempt::kFatal) {
-      decoded.finish(StreamOutcome{false, "error", error});
-      return;
-    }
-    if (progressed) failures = 0;
-    if (++failures > policy.max_attempts) {
-      error.message =
-          "giving up after " + std::to_string(policy.max_attempts) + " attempts: " + error.message;
-      decoded.finish(StreamOutcome{false, "error", error});
-      return;
-    }
-    ++reconnects_;
-    if (on_retry_) on_retry_(error, failures);
-    const auto delay =
-        std::min<Millis>(policy.max_delay, policy.first_delay * (1 << std::min(failures - 1, 16)));
-    std::unique_lock lock(pause_mutex_);
-    pause_changed_.wait_for(lock, delay, [&] { return stop_.load(); });
-  }
-  StreamOutcome cancelled;
-  cancelled.reason = "cancelled";
-  decoded.finish(cancelled);
+  run_attempts(decoded, target_.reconnect, stop_, pause_mutex_, pause_changed_, reconnects_,
+               on_retry_, [&](bool& progressed, Error& error) {
+                 return attempt(decoded, on_header, progressed, error);
+               });
 }
 
 }  // namespace meshstream::client

@@ -67,7 +67,7 @@ class HttpStreamClient {
   bool range_ignored() const { return range_ignored_; }
 
  private:
-  enum class Attempt { kDone, kRetry, kFatal };
+  using Attempt = AttemptEnd;
   Attempt attempt(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header,
                   bool& progressed, Error& error);
   // One request and its response: [next_, last] (`last` nullopt: to the end).

@@ -351,17 +351,19 @@ StreamClient::Attempt StreamClient::attempt(
   return Attempt::kDone;
 }
 
-void StreamClient::run(DecodedStream& decoded,
-                       const std::function<void(const StreamFacts&)>& on_header) {
-  const ReconnectPolicy& policy = target_.reconnect;
+void run_attempts(DecodedStream& decoded, const ReconnectPolicy& policy,
+                  const std::atomic<bool>& stop, std::mutex& mutex, std::condition_variable& wake,
+                  std::atomic<int>& reconnects,
+                  const std::function<void(const Error&, int attempt)>& on_retry,
+                  const std::function<AttemptEnd(bool& progressed, Error& error)>& attempt) {
   int failures = 0;
-  while (!stop_) {
+  while (!stop) {
     bool progressed = false;
     Error error{ErrorCode::kIo, ""};
-    const Attempt a = attempt(decoded, on_header, progressed, error);
-    if (a == Attempt::kDone) return;
-    if (stop_) break;  // stop() (Ctrl-C) cut the attempt short: not its error
-    if (a == Attempt::kFatal) {
+    const AttemptEnd a = attempt(progressed, error);
+    if (a == AttemptEnd::kDone) return;
+    if (stop) break;  // stop() (Ctrl-C) cut the attempt short: not its error
+    if (a == AttemptEnd::kFatal) {
       decoded.finish(StreamOutcome{false, "error", error});
       return;
     }
@@ -372,17 +374,25 @@ void StreamClient::run(DecodedStream& decoded,
       decoded.finish(StreamOutcome{false, "error", error});
       return;
     }
-    ++reconnects_;
-    if (on_retry_) on_retry_(error, failures);
+    ++reconnects;
+    if (on_retry) on_retry(error, failures);
     // Bounded exponential back-off, interruptible by stop().
     const auto delay =
         std::min<Millis>(policy.max_delay, policy.first_delay * (1 << std::min(failures - 1, 16)));
-    std::unique_lock lock(pause_mutex_);
-    pause_changed_.wait_for(lock, delay, [&] { return stop_.load(); });
+    std::unique_lock lock(mutex);
+    wake.wait_for(lock, delay, [&] { return stop.load(); });
   }
   StreamOutcome cancelled;
   cancelled.reason = "cancelled";
   decoded.finish(cancelled);
+}
+
+void StreamClient::run(DecodedStream& decoded,
+                       const std::function<void(const StreamFacts&)>& on_header) {
+  run_attempts(decoded, target_.reconnect, stop_, pause_mutex_, pause_changed_, reconnects_,
+               on_retry_, [&](bool& progressed, Error& error) {
+                 return attempt(decoded, on_header, progressed, error);
+               });
 }
 
 }  // namespace meshstream::client

@@ -38,6 +38,23 @@ struct ReconnectPolicy {
   Millis read_timeout{15000};  // silence that counts as a lost connection
 };
 
+// How one connection attempt of a transport (StreamClient, HttpStreamClient)
+// ended: the stream is finished, worth another attempt, or beyond retrying.
+enum class AttemptEnd { kDone, kRetry, kFatal };
+
+// The reconnect loop every transport shares: calls `attempt` until it is done
+// or fatal, `stop` is set (Ctrl-C: the attempt's error is not reported), or
+// `policy.max_attempts` attempts in a row made no progress. Between attempts
+// it counts a reconnect, tells `on_retry` (if set) and backs off
+// exponentially, bounded by the policy and interrupted by `wake` (under
+// `mutex`) once `stop` is set. Finishes `decoded` unless the attempt did
+// (kDone).
+void run_attempts(DecodedStream& decoded, const ReconnectPolicy& policy,
+                  const std::atomic<bool>& stop, std::mutex& mutex, std::condition_variable& wake,
+                  std::atomic<int>& reconnects,
+                  const std::function<void(const Error&, int attempt)>& on_retry,
+                  const std::function<AttemptEnd(bool& progressed, Error& error)>& attempt);
+
 struct StreamTarget {
   std::string host;
   uint16_t port = 0;
@@ -111,7 +128,7 @@ class StreamClient {
   void on_waiting(std::function<void(const v1::ModelInfo&)> f) { on_waiting_ = std::move(f); }
 
  private:
-  enum class Attempt { kDone, kRetry, kFatal };
+  using Attempt = AttemptEnd;
   Attempt attempt(DecodedStream& decoded, const std::function<void(const StreamFacts&)>& on_header,
                   bool& progressed, Error& error);
   bool wait_while_paused();
