@@ -16,13 +16,108 @@ BoundingBox bounding_box(const Mesh& mesh) {
   return box;
 }
 
+namespace {
+
+Status attribute_error(const std::string& what) {
+  return make_error(ErrorCode::kInvalidMesh, what);
+}
+
+// A corner attribute is empty, or has one in-range value index per corner.
+template <typename T>
+Status check_corner_attribute(const CornerAttribute<T>& attribute, size_t corner_count,
+                              size_t per_vertex_size, const char* kind) {
+  if (attribute.corners.empty()) {
+    if (!attribute.values.empty()) {
+      return attribute_error(std::string("per-corner ") + kind + " have values but no corners");
+    }
+    return {};
+  }
+  if (per_vertex_size != 0) {
+    return attribute_error(std::string(kind) + " are given both per vertex and per corner");
+  }
+  if (attribute.corners.size() != corner_count) {
+    return attribute_error(std::string("per-corner ") + kind + ": " +
+                           std::to_string(attribute.corners.size()) + " corners for " +
+                           std::to_string(corner_count / 3) + " triangles");
+  }
+  for (size_t c = 0; c < corner_count; ++c) {
+    if (attribute.corners[c] >= attribute.values.size()) {
+      return attribute_error(std::string("per-corner ") + kind + ": corner " + std::to_string(c) +
+                             " refers to value " + std::to_string(attribute.corners[c]) +
+                             " but there are only " + std::to_string(attribute.values.size()));
+    }
+  }
+  return {};
+}
+
+Status check_texture_index(int32_t index, size_t texture_count, size_t material) {
+  if (index < -1 || (index >= 0 && static_cast<size_t>(index) >= texture_count)) {
+    return attribute_error("material " + std::to_string(material) + " refers to texture " +
+                           std::to_string(index) + " but there are only " +
+                           std::to_string(texture_count));
+  }
+  return {};
+}
+
+}  // namespace
+
 Status check_attribute_counts(const Mesh& mesh) {
   const size_t n = mesh.positions.size();
   auto attribute_ok = [n](size_t size) { return size == 0 || size == n; };
   if (!attribute_ok(mesh.normals.size()) || !attribute_ok(mesh.colors.size()) ||
       !attribute_ok(mesh.texcoords.size())) {
-    return make_error(ErrorCode::kInvalidMesh, "per-vertex attribute count does not match the " +
-                                                   std::to_string(n) + " vertices");
+    return attribute_error("per-vertex attribute count does not match the " + std::to_string(n) +
+                           " vertices");
+  }
+  const size_t corners = 3 * mesh.triangles.size();
+  if (auto ok = check_corner_attribute(mesh.corner_normals, corners, mesh.normals.size(),
+                                       "normals");
+      !ok) {
+    return ok;
+  }
+  if (auto ok =
+          check_corner_attribute(mesh.corner_colors, corners, mesh.colors.size(), "colours");
+      !ok) {
+    return ok;
+  }
+  if (auto ok = check_corner_attribute(mesh.corner_texcoords, corners, mesh.texcoords.size(),
+                                       "texture coordinates");
+      !ok) {
+    return ok;
+  }
+  for (const ExtraAttribute& extra : mesh.extra_attributes) {
+    if (extra.components < 1 || extra.components > 4) {
+      return attribute_error("attribute " + extra.name + " has " +
+                             std::to_string(extra.components) + " components (1 to 4 allowed)");
+    }
+    if (extra.bytes.size() != corners * element_size(extra)) {
+      return attribute_error("attribute " + extra.name + " has " +
+                             std::to_string(extra.bytes.size()) + " bytes, not one element for " +
+                             "each of the " + std::to_string(corners) + " corners");
+    }
+  }
+  if (!mesh.face_materials.empty()) {
+    if (mesh.face_materials.size() != mesh.triangles.size()) {
+      return attribute_error("face materials: " + std::to_string(mesh.face_materials.size()) +
+                             " entries for " + std::to_string(mesh.triangles.size()) +
+                             " triangles");
+    }
+    for (size_t f = 0; f < mesh.face_materials.size(); ++f) {
+      if (mesh.face_materials[f] >= mesh.materials.size()) {
+        return attribute_error("triangle " + std::to_string(f) + " uses material " +
+                               std::to_string(mesh.face_materials[f]) + " but there are only " +
+                               std::to_string(mesh.materials.size()));
+      }
+    }
+  }
+  for (size_t m = 0; m < mesh.materials.size(); ++m) {
+    const Material& material = mesh.materials[m];
+    for (int32_t texture :
+         {material.base_color_texture, material.normal_texture,
+          material.metallic_roughness_texture, material.occlusion_texture,
+          material.emissive_texture}) {
+      if (auto ok = check_texture_index(texture, mesh.textures.size(), m); !ok) return ok;
+    }
   }
   return {};
 }

@@ -1,7 +1,10 @@
 // The triangle mesh every module exchanges: plain arrays, nothing hidden.
 //
-// Optional attributes are either empty or have exactly one entry per vertex.
-// Adjacency (see adjacency.h) is a separate structure built from a Mesh.
+// Optional per-vertex attributes are either empty or have exactly one entry
+// per vertex. An attribute with seams (values that differ between the corners
+// of one vertex) is held per corner instead (attributes.h); a mesh has each
+// kind (normals, colours, texture coordinates) in at most one of the two
+// forms. Adjacency (see adjacency.h) is a separate structure built from a Mesh.
 #pragma once
 
 #include <array>
@@ -9,6 +12,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/mesh/attributes.h"
 #include "common/mesh/vec.h"
 
 namespace meshstream {
@@ -21,6 +25,16 @@ struct Mesh {
   std::vector<Vec3f> normals;    // optional, per vertex
   std::vector<Vec4f> colors;     // optional, per vertex, RGBA in [0, 1]
   std::vector<Vec2f> texcoords;  // optional, per vertex
+
+  // With seams: used instead of the per-vertex array of the same kind.
+  CornerAttribute<Vec3f> corner_normals;
+  CornerAttribute<Vec4f> corner_colors;
+  CornerAttribute<Vec2f> corner_texcoords;
+
+  std::vector<Material> materials;
+  std::vector<uint32_t> face_materials;  // optional, per triangle: index into materials
+  std::vector<Texture> textures;         // images the materials use
+  std::vector<ExtraAttribute> extra_attributes;  // carried, not modelled (attributes.h)
 
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
   uint32_t face_count() const { return static_cast<uint32_t>(triangles.size()); }
@@ -35,8 +49,12 @@ struct BoundingBox {
 // Bounding box of the positions; {0,0,0}-{0,0,0} for an empty mesh. O(V).
 BoundingBox bounding_box(const Mesh& mesh);
 
-// Every per-vertex attribute array is empty or has one value per vertex;
-// kInvalidMesh otherwise. O(1).
+// Every per-vertex attribute array is empty or has one value per vertex,
+// every corner attribute has 3 entries per triangle (each a valid index into
+// its values) and is not doubled by a per-vertex array of its kind, every
+// extra attribute has one element per corner, face_materials is empty or one
+// valid index per triangle, and material texture indices are valid;
+// kInvalidMesh naming the first broken rule otherwise. O(corners).
 Status check_attribute_counts(const Mesh& mesh);
 
 // Checks the array-level rules: attribute sizes match, every index is in
