@@ -96,8 +96,8 @@ void add_encode_command(CLI::App& app, int& exit_code) {
                 "every position exact when its vertex arrives: no plane records, structure "
                 "records in decimation order (the peer benchmarks compare against)");
   cmd->add_option("--threads", args->threads,
-                  "threads for decimation, the candidate streams and their measurement (0: one "
-                  "per core); the stream is the same for every count")
+                  "threads for decimation and the measurement of the candidate record "
+                  "orderings (0: one per core); the stream is the same for every count")
       ->check(CLI::Range(0u, 1024u))
       ->capture_default_str();
   cmd->add_flag("--progress", args->progress,

@@ -345,6 +345,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     }
     if (layer.empty()) break;
     alive_count -= static_cast<uint32_t>(layer.size());
+    layer.shrink_to_fit();  // kept until the encode ends: no growth slack
     result.layers.push_back(std::move(layer));
     if (options.progress) options.progress(double(n - alive_count) / double(n - target));
   }

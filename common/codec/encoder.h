@@ -51,9 +51,17 @@ struct EncodeOptions {
   // records against structure records (record_schedule.h). 0 = automatic: the
   // streams of the kOrderingCandidates are decoded at log-spaced budgets and
   // the one with the smallest measured surface distance to the original
-  // wins (rd_measure.h; one encode and 5 distance measurements a candidate).
-  // A fixed balance encodes once. Embedded only.
+  // wins (rd_measure.h; 5 distance measurements a candidate). The first
+  // candidate is encoded whole, the others only as far as the measurement
+  // decodes them (1/8 of the first one's size), and a winner other than the
+  // first is then encoded whole (docs/hcs-format.md, "Record order and
+  // size"). A fixed balance encodes once. Embedded only.
   double plane_calibration = 0;
+  // The automatic choice as it was before issue 15's encoder work, kept as
+  // the peer the benchmarks compare against: every candidate encoded whole
+  // and measured at budgets relative to the first one's size (about twice
+  // the encode time, and the peak memory of two encodes at once).
+  bool measure_whole_candidates = false;
   // How a vertex's error enters that estimate. Embedded only; a value
   // outside the enum is kInvalidArgument.
   DistortionEstimate distortion_estimate = DistortionEstimate::kAutomatic;
