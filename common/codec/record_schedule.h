@@ -23,6 +23,7 @@ struct EncodedStream {
   std::vector<uint8_t> bytes;
   size_t largest_refinement = 0;
   size_t records = 0;
+  std::vector<uint32_t> to_decoder;  // input vertex id -> the decoder's id
 };
 
 // Encodes `mesh` (quantized to `q` on `grid`, decimated to `dec`) with
