@@ -775,24 +775,42 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   return std::move(written->bytes);
 }
 
-Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> payload) {
+Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payload,
+                                              std::span<const uint8_t> final_payload) {
   AttributeParts parts;
-  if (payload.size() < 2 || payload[0] != kRecordAttributes)
-    return tl::unexpected(parse_error("not an attribute record"));
-  Reader r{payload, 2};
-  if (payload[1] == kAttributePartBase) {
-    auto layout_bytes = r.section();
-    if (!r.ok) return tl::unexpected(parse_error("truncated"));
-    auto layout = read_layout(layout_bytes);
-    if (!layout) return tl::unexpected(layout.error());
-    parts["layout"] += layout_bytes.size();
-    if (any_corner_channel(*layout)) parts["seams"] += r.section().size();
-    for (const AttributeChannel& c : layout->channels) parts[attribute_kind_name(c.kind)] += r.section().size();
-    // The final record's channels are in the same order: the caller asks with the layout known.
-    if (!r.ok) return tl::unexpected(parse_error("truncated"));
-    return parts;
+  if (base_payload.size() < 2 || base_payload[0] != kRecordAttributes ||
+      base_payload[1] != kAttributePartBase)
+    return tl::unexpected(parse_error("record 1 is not the base attribute record"));
+  Reader r{base_payload, 2};
+  auto layout_bytes = r.section();
+  if (!r.ok) return tl::unexpected(parse_error("truncated"));
+  auto layout = read_layout(layout_bytes);
+  if (!layout) return tl::unexpected(layout.error());
+  parts["layout"] += layout_bytes.size();
+  if (any_corner_channel(*layout)) parts["seams"] += r.section().size();
+  for (const AttributeChannel& c : layout->channels)
+    parts[attribute_kind_name(c.kind)] += r.section().size();
+  if (!r.ok) return tl::unexpected(parse_error("base attribute record truncated"));
+  if (final_payload.empty()) return parts;
+  if (final_payload.size() < 2 || final_payload[0] != kRecordAttributes ||
+      final_payload[1] != kAttributePartFinal)
+    return tl::unexpected(parse_error("the last record is not the final attribute record"));
+  Reader f{final_payload, 2};
+  for (const AttributeChannel& c : layout->channels)
+    parts[attribute_kind_name(c.kind)] += f.section().size();
+  const uint32_t extras = f.varint();
+  for (uint32_t i = 0; i < extras && f.ok && i < 64; ++i) {
+    const size_t before = f.pos;
+    f.string(4096);
+    f.u8();
+    f.u8();
+    f.u8();
+    f.varint();
+    f.section();
+    parts["extra"] += f.pos - before;
   }
-  return tl::unexpected(parse_error("the final record's parts need the layout"));
+  if (!f.ok) return tl::unexpected(parse_error("final attribute record truncated"));
+  return parts;
 }
 
 // ---------------- decoder ----------------

@@ -116,9 +116,11 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
                                                    AttributeParts* parts,
                                                    std::vector<uint32_t>* payload_sizes);
 
-// The parts of one attribute record's payload (for `meshstream info`).
-// kParse when it is not a well-formed attribute record.
-Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> payload);
+// The parts of a stream's two attribute records' payloads (for `meshstream
+// info`; `final_payload` may be empty when the file is cut short). kParse when
+// they are not well-formed attribute records.
+Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payload,
+                                              std::span<const uint8_t> final_payload);
 
 // The decoder's side: see the file comment.
 class AttributeDecoder {
