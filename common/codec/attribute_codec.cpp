@@ -12,6 +12,8 @@
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
 #include "common/codec/range_coder.h"
+#include "common/codec/refinement_state.h"
+#include "common/codec/stream_format.h"
 
 namespace meshstream {
 
@@ -160,8 +162,10 @@ bool value_of(const AttributeChannel& c, int32_t max, int32_t pred, int64_t r, i
   return true;
 }
 
-bool use_geometric(const AttributeChannel& c, bool final_record) {
-  return final_record && c.kind == AttributeKind::kNormal;
+// Normals are predicted from the geometry: in the last record from the exact
+// positions, in record 1 from the base's coarse ones (what the decoder has).
+bool use_geometric(const AttributeChannel& c, bool /*final_record*/) {
+  return c.kind == AttributeKind::kNormal;
 }
 
 // The wedges of every vertex of `m` from per-corner values (all corner
@@ -564,10 +568,21 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   IncrementalDecoder base_decoder;
   if (auto f = base_decoder.feed(stream.subspan(0, idx.records[0].offset + idx.records[0].size)); !f)
     return tl::unexpected(f.error());
-  std::vector<Vec3i> base_positions(base_n);
-  for (uint32_t v = 0; v < base_n; ++v) base_positions[v] = q[to_input[v]];
-  auto base = EditableMesh::build(base_positions, base_decoder.mesh().triangles);
-  if (!base) return tl::unexpected(base.error());
+  // The base as the decoder's state holds it after record 0: coarse
+  // positions q >> b at the middle of their unknown low bits.
+  const int quant_bits = idx.header.quant_bits;
+  const auto format = idx.header.extra.empty()
+                          ? std::nullopt
+                          : RefinementFormatInfo::from_header_byte(idx.header.extra[0]);
+  const int base_shift =
+      format && format->embedded && idx.header.extra.size() > 1 ? idx.header.extra[1] : 0;
+  std::vector<Vec3i> coarse(base_n);
+  for (uint32_t v = 0; v < base_n; ++v)
+    for (int a = 0; a < 3; ++a) coarse[v][a] = q[to_input[v]][a] >> base_shift;
+  auto base_state = RefinementState::from_coarse_base(coarse, base_decoder.mesh().triangles,
+                                                      quant_bits, base_shift);
+  if (!base_state) return tl::unexpected(base_state.error());
+  const EditableMesh* base = &base_state->mesh;
   auto decoded = decode_hcs(stream);
   if (!decoded) return tl::unexpected(decoded.error());
   std::vector<Vec3i> positions(n);

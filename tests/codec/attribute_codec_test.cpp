@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <tuple>
 
@@ -200,6 +202,11 @@ TEST(AttributeCodec, FacetedCubeRoundTripsExactlyWithSeamsMaterialsAndExtras) {
   expect_materials_equal(*decoded, expected);
   EXPECT_EQ(decoded->corner_normals.corners.size(), 3 * decoded->triangles.size());
   EXPECT_EQ(decoded->colors.size(), decoded->positions.size());
+  // The seeds of tests/fuzz/corpus/hcs_decoder with seams came from here.
+  if (const char* seeds = std::getenv("MESHSTREAM_WRITE_FUZZ_SEEDS")) {
+    std::ofstream(std::string(seeds) + "/faceted_cube.hcs", std::ios::binary)
+        .write(reinterpret_cast<const char*>(stream->data()), std::streamsize(stream->size()));
+  }
   // The incremental decoder's complete mesh is the same.
   IncrementalDecoder inc;
   ASSERT_TRUE(inc.feed(*stream));
