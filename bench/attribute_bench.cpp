@@ -180,8 +180,8 @@ int main(int argc, char** argv) {
   std::string table =
       "| model | vertices | attributes | ours total | Draco total | ratio | ours geometry | Draco "
       "geometry | normals ours/Draco | uv ours/Draco | colors ours/Draco | seams | locked vertices | "
-      "geometry without attributes (base vertices) | exact | decode ms ours / Draco |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      "geometry without attributes (base vertices) | first display: bytes with attributes / without | exact | decode ms ours / Draco |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const fs::path& file : files) {
     auto read = draco::ReadMeshFromFile(file.string());
     const std::string name = fs::relative(file, dir).string();
@@ -228,6 +228,11 @@ int main(int argc, char** argv) {
       if ((*stream)[index->records[i].offset] == kRecordAttributes) attribute_records += index->records[i].size;
     const uint64_t ours_total = stream->size();
     const uint64_t ours_geometry = ours_total - attribute_records;
+    // The first display with attributes: through record 1 (record 0 when
+    // the stream has none); without: the plain stream's base.
+    const size_t shown = index->records.size() > 1 && (*stream)[index->records[1].offset] == kRecordAttributes ? 1 : 0;
+    const uint64_t first_display = index->records[shown].offset + index->records[shown].size;
+    const uint64_t plain_first = plain_index ? plain_index->records[0].offset + plain_index->records[0].size : 0;
     Result<Mesh> decoded = decode_hcs(*stream);
     const bool exact = decoded && testing::faces_of(*decoded) == testing::faces_of(testing::expected_mesh(mesh, options));
     const double ours_ms = median_ms([&] { (void)decode_hcs(*stream); });
@@ -259,7 +264,7 @@ int main(int argc, char** argv) {
     };
     char row[1024];
     std::snprintf(row, sizeof row,
-                  "| %s | %u | %s | %llu | %zu | %.3f | %llu | %zu | %s | %s | %s | %llu | %u | %zu (%u) | %s | %.2f / %.2f |\n",
+                  "| %s | %u | %s | %llu | %zu | %.3f | %llu | %zu | %s | %s | %s | %llu | %u | %zu (%u) | %llu / %llu (%.2f) | %s | %.2f / %.2f |\n",
                   name.c_str(), mesh.vertex_count(), kinds.c_str(), (unsigned long long)ours_total, draco_all,
                   draco_all ? double(ours_total) / draco_all : 0.0, (unsigned long long)ours_geometry,
                   draco_geometry,
@@ -268,7 +273,9 @@ int main(int argc, char** argv) {
                   cell(ours_cost("colors", !mesh.corner_colors.empty()), draco_cost(draco::GeometryAttribute::COLOR)).c_str(),
                   (unsigned long long)seams, report.attribute_locked_vertices,
                   plain_stream ? plain_stream->size() : 0,
-                  plain_index ? plain_index->header.base_vertex_count : 0, exact ? "yes" : "NO", ours_ms,
+                  plain_index ? plain_index->header.base_vertex_count : 0,
+                  (unsigned long long)first_display, (unsigned long long)plain_first,
+                  plain_first ? double(first_display) / plain_first : 0.0, exact ? "yes" : "NO", ours_ms,
                   draco_ms);
     std::printf("%s", row);
     std::printf("  base vertices with attributes %u, without %u\n", index->header.base_vertex_count,
