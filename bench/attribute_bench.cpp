@@ -54,7 +54,8 @@ double median_ms(F&& f, int runs = 5) {
   for (int i = 0; i < runs; ++i) {
     const auto a = std::chrono::steady_clock::now();
     f();
-    t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+    t.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
   }
   return median(t);
 }
@@ -85,7 +86,8 @@ Mesh to_mesh(const draco::Mesh& dm, std::string& kinds) {
   std::vector<uint32_t> corner_point;
   for (uint32_t f = 0; f < dm.num_faces(); ++f) {
     const auto& face = dm.face(draco::FaceIndex(f));
-    m.triangles.push_back({vertex_of[face[0].value()], vertex_of[face[1].value()], vertex_of[face[2].value()]});
+    m.triangles.push_back(
+        {vertex_of[face[0].value()], vertex_of[face[1].value()], vertex_of[face[2].value()]});
     for (int k = 0; k < 3; ++k) corner_point.push_back(face[k].value());
   }
   // One attribute: per vertex when every corner of each vertex agrees.
@@ -99,8 +101,10 @@ Mesh to_mesh(const draco::Mesh& dm, std::string& kinds) {
     for (size_t c = 0; c < corner_point.size(); ++c) {
       const auto value = value_at(att, draco::PointIndex(corner_point[c]));
       auto& f = first[m.triangles[c / 3][c % 3]];
-      if (f.empty()) f = value;
-      else if (f != value) seams = true;
+      if (f.empty())
+        f = value;
+      else if (f != value)
+        seams = true;
     }
     if (!seams) {
       for (uint32_t v = 0; v < nv; ++v) per_vertex.push_back(make(first[v]));
@@ -117,15 +121,22 @@ Mesh to_mesh(const draco::Mesh& dm, std::string& kinds) {
       }
     }
     kinds += std::string(kinds.empty() ? "" : ", ") +
-             (type == draco::GeometryAttribute::NORMAL ? "normals" : type == draco::GeometryAttribute::TEX_COORD ? "uv" : "colors") +
+             (type == draco::GeometryAttribute::NORMAL      ? "normals"
+              : type == draco::GeometryAttribute::TEX_COORD ? "uv"
+                                                            : "colors") +
              (seams ? " (seams)" : "");
   };
   take(draco::GeometryAttribute::NORMAL, m.normals, m.corner_normals,
-       [](const std::vector<float>& v) { return Vec3f{v[0], v[1], v[2]}; });
+       [](const std::vector<float>& v) {
+         return Vec3f{v[0], v[1], v[2]};
+       });
   take(draco::GeometryAttribute::TEX_COORD, m.texcoords, m.corner_texcoords,
-       [](const std::vector<float>& v) { return Vec2f{v[0], v[1]}; });
+       [](const std::vector<float>& v) {
+         return Vec2f{v[0], v[1]};
+       });
   take(draco::GeometryAttribute::COLOR, m.colors, m.corner_colors, [](const std::vector<float>& v) {
-    return Vec4f{v[0], v.size() > 1 ? v[1] : 0, v.size() > 2 ? v[2] : 0, v.size() > 3 ? v[3] : 1.0f};
+    return Vec4f{v[0], v.size() > 1 ? v[1] : 0, v.size() > 2 ? v[2] : 0,
+                 v.size() > 3 ? v[3] : 1.0f};
   });
   return m;
 }
@@ -168,19 +179,24 @@ int main(int argc, char** argv) {
   std::string dir = "/work/shared/models", out_path;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc) out_path = argv[++i];
-    else dir = a;
+    if (a == "--out" && i + 1 < argc)
+      out_path = argv[++i];
+    else
+      dir = a;
   }
   std::vector<fs::path> files;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     const std::string ext = e.path().extension().string();
-    if (ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".gltf") files.push_back(e.path());
+    if (ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".gltf")
+      files.push_back(e.path());
   }
   std::sort(files.begin(), files.end());
   std::string table =
       "| model | vertices | attributes | ours total | Draco total | ratio | ours geometry | Draco "
-      "geometry | normals ours/Draco | uv ours/Draco | colors ours/Draco | seams | locked vertices | "
-      "geometry without attributes (base vertices) | first display: bytes with attributes / without | exact | decode ms ours / Draco |\n"
+      "geometry | normals ours/Draco | uv ours/Draco | colors ours/Draco | seams | locked vertices "
+      "| "
+      "geometry without attributes (base vertices) | first display: bytes with attributes / "
+      "without | exact | decode ms ours / Draco |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const fs::path& file : files) {
     auto read = draco::ReadMeshFromFile(file.string());
@@ -217,7 +233,9 @@ int main(int argc, char** argv) {
     plain.corner_texcoords = {};
     plain.corner_colors = {};
     auto plain_stream = encode_hcs(plain, options);
-    const auto plain_index = plain_stream ? read_stream_index(*plain_stream) : Result<StreamIndex>(tl::unexpected(Error{ErrorCode::kInternal, ""}));
+    const auto plain_index =
+        plain_stream ? read_stream_index(*plain_stream)
+                     : Result<StreamIndex>(tl::unexpected(Error{ErrorCode::kInternal, ""}));
     auto index = read_stream_index(*stream);
     uint64_t attribute_total = 0;
     for (const auto& [k, n] : report.attribute_bytes) attribute_total += n;
@@ -225,19 +243,26 @@ int main(int argc, char** argv) {
     // minus the records' payload sections counted above is ours geometry.
     uint64_t attribute_records = 0;
     for (size_t i = 1; i < index->records.size(); ++i)
-      if ((*stream)[index->records[i].offset] == kRecordAttributes) attribute_records += index->records[i].size;
+      if ((*stream)[index->records[i].offset] == kRecordAttributes)
+        attribute_records += index->records[i].size;
     const uint64_t ours_total = stream->size();
     const uint64_t ours_geometry = ours_total - attribute_records;
     // The first display with attributes: through record 1 (record 0 when
     // the stream has none); without: the plain stream's base.
-    const size_t shown = index->records.size() > 1 && (*stream)[index->records[1].offset] == kRecordAttributes ? 1 : 0;
+    const size_t shown =
+        index->records.size() > 1 && (*stream)[index->records[1].offset] == kRecordAttributes ? 1
+                                                                                              : 0;
     const uint64_t first_display = index->records[shown].offset + index->records[shown].size;
-    const uint64_t plain_first = plain_index ? plain_index->records[0].offset + plain_index->records[0].size : 0;
+    const uint64_t plain_first =
+        plain_index ? plain_index->records[0].offset + plain_index->records[0].size : 0;
     Result<Mesh> decoded = decode_hcs(*stream);
-    const bool exact = decoded && testing::faces_of(*decoded) == testing::faces_of(testing::expected_mesh(mesh, options));
+    const bool exact = decoded && testing::faces_of(*decoded) ==
+                                      testing::faces_of(testing::expected_mesh(mesh, options));
     const double ours_ms = median_ms([&] { (void)decode_hcs(*stream); });
 
-    const std::vector<draco::GeometryAttribute::Type> all = {draco::GeometryAttribute::NORMAL, draco::GeometryAttribute::TEX_COORD, draco::GeometryAttribute::COLOR};
+    const std::vector<draco::GeometryAttribute::Type> all = {draco::GeometryAttribute::NORMAL,
+                                                             draco::GeometryAttribute::TEX_COORD,
+                                                             draco::GeometryAttribute::COLOR};
     std::vector<uint8_t> draco_stream;
     const size_t draco_all = draco_bytes(*draco_only(dm, {}), &draco_stream);
     const size_t draco_geometry = draco_bytes(*draco_only(dm, all));
@@ -251,7 +276,8 @@ int main(int argc, char** argv) {
       if (!dm.GetNamedAttribute(t)) return -1;
       return long(draco_all) - long(draco_bytes(*draco_only(dm, {t})));
     };
-    const uint64_t seams = report.attribute_bytes.count("seams") ? report.attribute_bytes["seams"] : 0;
+    const uint64_t seams =
+        report.attribute_bytes.count("seams") ? report.attribute_bytes["seams"] : 0;
     auto ours_cost = [&](const char* part, bool per_corner) -> long {
       if (!report.attribute_bytes.count(part)) return -1;
       return long(report.attribute_bytes[part] + (per_corner ? seams : 0));
@@ -259,24 +285,32 @@ int main(int argc, char** argv) {
     auto cell = [](long ours, long draco) {
       if (ours < 0 && draco < 0) return std::string("-");
       char b[96];
-      std::snprintf(b, sizeof b, "%ld / %ld (%.2f)", ours, draco, draco > 0 ? double(ours) / draco : 0.0);
+      std::snprintf(b, sizeof b, "%ld / %ld (%.2f)", ours, draco,
+                    draco > 0 ? double(ours) / draco : 0.0);
       return std::string(b);
     };
     char row[1024];
     std::snprintf(row, sizeof row,
-                  "| %s | %u | %s | %llu | %zu | %.3f | %llu | %zu | %s | %s | %s | %llu | %u | %zu (%u) | %llu / %llu (%.2f) | %s | %.2f / %.2f |\n",
-                  name.c_str(), mesh.vertex_count(), kinds.c_str(), (unsigned long long)ours_total, draco_all,
-                  draco_all ? double(ours_total) / draco_all : 0.0, (unsigned long long)ours_geometry,
-                  draco_geometry,
-                  cell(ours_cost("normals", !mesh.corner_normals.empty()), draco_cost(draco::GeometryAttribute::NORMAL)).c_str(),
-                  cell(ours_cost("texcoords", !mesh.corner_texcoords.empty()), draco_cost(draco::GeometryAttribute::TEX_COORD)).c_str(),
-                  cell(ours_cost("colors", !mesh.corner_colors.empty()), draco_cost(draco::GeometryAttribute::COLOR)).c_str(),
+                  "| %s | %u | %s | %llu | %zu | %.3f | %llu | %zu | %s | %s | %s | %llu | %u | "
+                  "%zu (%u) | %llu / %llu (%.2f) | %s | %.2f / %.2f |\n",
+                  name.c_str(), mesh.vertex_count(), kinds.c_str(), (unsigned long long)ours_total,
+                  draco_all, draco_all ? double(ours_total) / draco_all : 0.0,
+                  (unsigned long long)ours_geometry, draco_geometry,
+                  cell(ours_cost("normals", !mesh.corner_normals.empty()),
+                       draco_cost(draco::GeometryAttribute::NORMAL))
+                      .c_str(),
+                  cell(ours_cost("texcoords", !mesh.corner_texcoords.empty()),
+                       draco_cost(draco::GeometryAttribute::TEX_COORD))
+                      .c_str(),
+                  cell(ours_cost("colors", !mesh.corner_colors.empty()),
+                       draco_cost(draco::GeometryAttribute::COLOR))
+                      .c_str(),
                   (unsigned long long)seams, report.attribute_locked_vertices,
                   plain_stream ? plain_stream->size() : 0,
                   plain_index ? plain_index->header.base_vertex_count : 0,
                   (unsigned long long)first_display, (unsigned long long)plain_first,
-                  plain_first ? double(first_display) / plain_first : 0.0, exact ? "yes" : "NO", ours_ms,
-                  draco_ms);
+                  plain_first ? double(first_display) / plain_first : 0.0, exact ? "yes" : "NO",
+                  ours_ms, draco_ms);
     std::printf("%s", row);
     std::printf("  base vertices with attributes %u, without %u\n", index->header.base_vertex_count,
                 plain_index ? plain_index->header.base_vertex_count : 0);

@@ -58,7 +58,7 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
       positions += r.size;
     } else if (k == "attributes") {
       (payload.size() > 1 && payload[1] == kAttributePartBase ? base_attributes
-                                                               : final_attributes) = payload;
+                                                              : final_attributes) = payload;
     } else {
       connectivity += r.size;
     }

@@ -19,10 +19,14 @@ namespace meshstream {
 
 const char* attribute_kind_name(AttributeKind kind) {
   switch (kind) {
-    case AttributeKind::kNormal: return "normals";
-    case AttributeKind::kTexcoord: return "texcoords";
-    case AttributeKind::kColor: return "colors";
-    case AttributeKind::kMaterial: return "materials";
+    case AttributeKind::kNormal:
+      return "normals";
+    case AttributeKind::kTexcoord:
+      return "texcoords";
+    case AttributeKind::kColor:
+      return "colors";
+    case AttributeKind::kMaterial:
+      return "materials";
   }
   return "unknown";
 }
@@ -143,8 +147,10 @@ int32_t residual_of(const AttributeChannel& c, int32_t max, int32_t value, int32
   int32_t r = value - pred;
   if (c.kind == AttributeKind::kNormal) {
     const int32_t span = max + 1;
-    if (r > span / 2) r -= span;
-    else if (r < -((span - 1) / 2)) r += span;
+    if (r > span / 2)
+      r -= span;
+    else if (r < -((span - 1) / 2))
+      r += span;
   }
   return r;
 }
@@ -232,8 +238,8 @@ std::vector<uint8_t> write_layout(const AttributeLayout& l) {
   put_varint(out, uint32_t(l.materials.size()));
   for (const Material& m : l.materials) {
     put_string(out, m.name);
-    for (float f : {m.base_color.x, m.base_color.y, m.base_color.z, m.base_color.w, m.metallic,
-                    m.roughness})
+    for (float f :
+         {m.base_color.x, m.base_color.y, m.base_color.z, m.base_color.w, m.metallic, m.roughness})
       put_f32(out, f);
     for (int32_t t : {m.base_color_texture, m.normal_texture, m.metallic_roughness_texture,
                       m.occlusion_texture, m.emissive_texture})
@@ -379,17 +385,18 @@ struct ValueCoder {
       const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
       const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
-        const int ctx =
-            predict(m, truth, layout, ch, v, w, use_geometric(c, final_record), pred, ring, corners);
+        const int ctx = predict(m, truth, layout, ch, v, w, use_geometric(c, final_record), pred,
+                                ring, corners);
         for (uint32_t i = 0; i < n; ++i)
-          models.residual[ctx][i].encode(enc, residual_of(c, max, truth.data[ch][w * n + i], pred[i]));
+          models.residual[ctx][i].encode(enc,
+                                         residual_of(c, max, truth.data[ch][w * n + i], pred[i]));
       }
     }
     return enc.finish();
   }
 
-  Status decode(const EditableMesh& m, AttributeValues& a, size_t ch, uint32_t first,
-                uint32_t last, std::span<const uint8_t> bytes) {
+  Status decode(const EditableMesh& m, AttributeValues& a, size_t ch, uint32_t first, uint32_t last,
+                std::span<const uint8_t> bytes) {
     const AttributeChannel& c = layout.channels[ch];
     const uint32_t n = c.components();
     const int32_t max = layout.max_value(c);
@@ -421,7 +428,7 @@ struct ValueCoder {
 // Seam bits of the base: per vertex one bit "more than one wedge", then one
 // bit per interior edge of its star (is it a seam at the vertex).
 struct SeamModels {
-  BitModel split[2];   // by boundary
+  BitModel split[2];    // by boundary
   BitModel edge[2][2];  // by boundary, previous edge bit
 };
 
@@ -452,7 +459,9 @@ Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>
   plan.extras = &mesh.extra_attributes;
   const size_t corners = 3 * mesh.triangles.size();
   auto finite2 = [](Vec2f v) { return std::isfinite(v.x) && std::isfinite(v.y); };
-  auto finite3 = [](Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  auto finite3 = [](Vec3f v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
   // Normals.
   auto add_normals = [&](const Vec3f* values, size_t count, const uint32_t* index, size_t n,
                          bool per_corner) -> Status {
@@ -471,7 +480,9 @@ Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>
     return {};
   };
   if (!mesh.normals.empty()) {
-    if (auto s = add_normals(mesh.normals.data(), mesh.normals.size(), nullptr, mesh.normals.size(), false); !s)
+    if (auto s = add_normals(mesh.normals.data(), mesh.normals.size(), nullptr, mesh.normals.size(),
+                             false);
+        !s)
       return tl::unexpected(s.error());
   } else if (!mesh.corner_normals.empty()) {
     if (auto s = add_normals(mesh.corner_normals.values.data(), mesh.corner_normals.values.size(),
@@ -566,7 +577,8 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   const uint32_t base_n = idx.records[0].vertices;
   // The decoder's base and final meshes, as it will hold them.
   IncrementalDecoder base_decoder;
-  if (auto f = base_decoder.feed(stream.subspan(0, idx.records[0].offset + idx.records[0].size)); !f)
+  if (auto f = base_decoder.feed(stream.subspan(0, idx.records[0].offset + idx.records[0].size));
+      !f)
     return tl::unexpected(f.error());
   // The base as the decoder's state holds it after record 0: coarse
   // positions q >> b at the middle of their unknown low bits.
@@ -599,7 +611,8 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   };
   auto hash = [](std::tuple<uint32_t, uint32_t, uint32_t> t) {
     const auto [a, b, c] = t;
-    return (uint64_t(a) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b) << 21) ^ (uint64_t(c) * 0xC2B2AE3D27D4EB4Full);
+    return (uint64_t(a) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b) << 21) ^
+           (uint64_t(c) * 0xC2B2AE3D27D4EB4Full);
   };
   std::unordered_multimap<uint64_t, uint32_t> faces_by_key;
   faces_by_key.reserve(mesh.triangles.size());
@@ -725,11 +738,14 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     // The base's values predicted over the base mesh (the decoder's state
     // after record 0); the wedge tables of base vertices are the same.
     AttributeValues base_truth;
-    base_truth.wedge_start.assign(truth.wedge_start.begin(), truth.wedge_start.begin() + base_n + 1);
-    base_truth.wedge_key.assign(truth.wedge_key.begin(), truth.wedge_key.begin() + base_truth.wedge_start.back());
+    base_truth.wedge_start.assign(truth.wedge_start.begin(),
+                                  truth.wedge_start.begin() + base_n + 1);
+    base_truth.wedge_key.assign(truth.wedge_key.begin(),
+                                truth.wedge_key.begin() + base_truth.wedge_start.back());
     base_truth.data.resize(layout.channels.size());
     const AttributeChannel& c = layout.channels[ch];
-    const size_t count = size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
+    const size_t count =
+        size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
     base_truth.data[ch].assign(truth.data[ch].begin(), truth.data[ch].begin() + count);
     const std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
     put_section(first, bytes);
@@ -884,7 +900,8 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
   ValueCoder coder{layout_, false, {}, {}};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
-    values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(), 0);
+    values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),
+                            0);
     auto bytes = r.section();
     if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
     if (auto s = coder.decode(base, values_, ch, 0, n, bytes); !s) return s;
@@ -956,7 +973,8 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
           parse_error("extra attribute '" + e.name + "' size differs from the corners'"));
     const unsigned long long frame = ZSTD_getFrameContentSize(packed.data(), packed.size());
     if (frame != raw)
-      return tl::unexpected(parse_error("extra attribute '" + e.name + "' is not a zstd frame of its size"));
+      return tl::unexpected(
+          parse_error("extra attribute '" + e.name + "' is not a zstd frame of its size"));
     e.bytes.resize(raw);
     const size_t got = ZSTD_decompress(e.bytes.data(), raw, packed.data(), packed.size());
     if (ZSTD_isError(got) || got != raw)
@@ -974,13 +992,16 @@ void AttributeDecoder::write_vertex_values(uint32_t first_vertex, Mesh& out) con
     const AttributeChannel& c = layout_.channels[ch];
     const auto& d = values_.data[ch];
     if (c.kind == AttributeKind::kMaterial) continue;
-    const uint32_t w0 = c.per_corner ? values_.wedge_start[std::min(first_vertex, n)] : first_vertex;
+    const uint32_t w0 =
+        c.per_corner ? values_.wedge_start[std::min(first_vertex, n)] : first_vertex;
     const uint32_t w1 = c.per_corner ? uint32_t(values_.wedge_key.size()) : n;
     auto normal = [&](uint32_t w) { return dequantize_normal({d[2 * w], d[2 * w + 1]}, c.bits); };
     auto uv = [&](uint32_t w) { return dequantize_texcoord(c.uv, {d[2 * w], d[2 * w + 1]}); };
     auto color = [&](uint32_t w) {
-      return Vec4f{dequantize_color_channel(d[4 * w], c.bits), dequantize_color_channel(d[4 * w + 1], c.bits),
-                   dequantize_color_channel(d[4 * w + 2], c.bits), dequantize_color_channel(d[4 * w + 3], c.bits)};
+      return Vec4f{dequantize_color_channel(d[4 * w], c.bits),
+                   dequantize_color_channel(d[4 * w + 1], c.bits),
+                   dequantize_color_channel(d[4 * w + 2], c.bits),
+                   dequantize_color_channel(d[4 * w + 3], c.bits)};
     };
     switch (c.kind) {
       case AttributeKind::kNormal: {
@@ -1001,7 +1022,8 @@ void AttributeDecoder::write_vertex_values(uint32_t first_vertex, Mesh& out) con
         for (uint32_t w = w0; w < w1; ++w) target[w] = color(w);
         break;
       }
-      case AttributeKind::kMaterial: break;
+      case AttributeKind::kMaterial:
+        break;
     }
   }
 }
@@ -1037,7 +1059,8 @@ void AttributeDecoder::write_mesh(const EditableMesh& m, Mesh& out) const {
     if (!c.per_corner) continue;
     if (c.kind == AttributeKind::kMaterial) out.face_materials.assign(faces, 0);
     if (c.kind == AttributeKind::kNormal) out.corner_normals.corners.assign(3 * size_t(faces), 0);
-    if (c.kind == AttributeKind::kTexcoord) out.corner_texcoords.corners.assign(3 * size_t(faces), 0);
+    if (c.kind == AttributeKind::kTexcoord)
+      out.corner_texcoords.corners.assign(3 * size_t(faces), 0);
     if (c.kind == AttributeKind::kColor) out.corner_colors.corners.assign(3 * size_t(faces), 0);
   }
   for (uint32_t f = 0; f < faces; ++f) write_face(m, f, out);

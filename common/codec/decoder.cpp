@@ -121,16 +121,14 @@ struct IncrementalDecoder::State {
   Status apply_attribute_record(uint32_t i, std::span<const uint8_t> payload) {
     const StreamHeader& h = index->header;
     if (payload.size() >= 2 && payload[1] == kAttributePartBase) {
-      if (i != 1)
-        return make_error(ErrorCode::kParse, "base attribute record is not record 1");
+      if (i != 1) return make_error(ErrorCode::kParse, "base attribute record is not record 1");
       if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
     } else {
       if (i + 1 != index->records.size())
         return make_error(ErrorCode::kParse, "final attribute record is not the last record");
       if (refine->mesh.vertex_count() != h.vertex_count ||
           refine->mesh.face_slot_count() != h.face_count)
-        return make_error(ErrorCode::kParse,
-                          "final attribute record before the mesh is complete");
+        return make_error(ErrorCode::kParse, "final attribute record before the mesh is complete");
       if (auto s = attributes.read_final(payload, refine->mesh); !s) return s;
     }
     if (upkeep == DecodedMeshUpkeep::kEveryRecord) {

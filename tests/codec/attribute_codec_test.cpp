@@ -1,6 +1,8 @@
 // Attributes in the stream (attribute_codec.h): exact at full rate (per
 // vertex and per corner, seams, materials, extra attributes), valid at every
 // prefix, 8-bit colours exact, damaged attribute records refused by name.
+#include "common/codec/attribute_codec.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 #include <map>
 #include <tuple>
 
-#include "common/codec/attribute_codec.h"
 #include "common/codec/attribute_quantize.h"
 #include "common/codec/byte_io.h"
 #include "common/codec/container.h"
@@ -164,8 +165,8 @@ void expect_valid_prefixes(const std::vector<uint8_t>& stream) {
     ASSERT_TRUE(fed) << fed.error().message;
     at = end;
     const Mesh& m = decoder.mesh();
-    ASSERT_TRUE(check_attribute_counts(m)) << "record " << i << ": "
-                                           << check_attribute_counts(m).error().message;
+    ASSERT_TRUE(check_attribute_counts(m))
+        << "record " << i << ": " << check_attribute_counts(m).error().message;
     ASSERT_TRUE(validate_arrays(m)) << "record " << i;
     if (i >= 1) {
       EXPECT_FALSE(m.colors.empty() && m.normals.empty() && m.corner_texcoords.empty())
@@ -299,11 +300,11 @@ TEST(AttributeCodec, DamagedAttributeRecordsAreRefused) {
   ASSERT_TRUE(get_varint(*stream, pos, layout_length));
   const uint64_t layout_at = pos;
   const Damage damages[] = {
-      {first.offset + 1, 1, "not the last record"},     // base part claims to be the final
-      {first.offset + 3, 0xFF, "attribute record"},     // layout length past the record
-      {layout_at + 1, 9, "unknown attribute kind"},     // first channel's kind
-      {layout_at + 3, 40, "quantization bits"},         // first channel's bits
-      {last.offset + 1, 0, "not record 1"},                // final part claims to be the base
+      {first.offset + 1, 1, "not the last record"},             // base part claims to be the final
+      {first.offset + 3, 0xFF, "attribute record"},             // layout length past the record
+      {layout_at + 1, 9, "unknown attribute kind"},             // first channel's kind
+      {layout_at + 3, 40, "quantization bits"},                 // first channel's bits
+      {last.offset + 1, 0, "not record 1"},                     // final part claims to be the base
       {last.offset + last.size - 6, 0xFF, "attribute record"},  // the zstd frame's end
   };
   for (const Damage& d : damages) {

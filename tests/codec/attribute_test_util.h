@@ -17,7 +17,9 @@ namespace meshstream::testing {
 // through its quantization.
 inline Mesh expected_mesh(const Mesh& in, const EncodeOptions& o) {
   Mesh e = *quantized_reference(in, o.quant_bits);
-  auto n = [&](Vec3f v) { return dequantize_normal(quantize_normal(v, o.quant_normal), o.quant_normal); };
+  auto n = [&](Vec3f v) {
+    return dequantize_normal(quantize_normal(v, o.quant_normal), o.quant_normal);
+  };
   for (const Vec3f& v : in.normals) e.normals.push_back(n(v));
   e.corner_normals.corners = in.corner_normals.corners;
   for (const Vec3f& v : in.corner_normals.values) e.corner_normals.values.push_back(n(v));
@@ -25,11 +27,14 @@ inline Mesh expected_mesh(const Mesh& in, const EncodeOptions& o) {
     return make_texcoord_grid(values.data(), values.size(), o.quant_uv);
   };
   const TexcoordGrid g1 = uv_grid(in.texcoords), g2 = uv_grid(in.corner_texcoords.values);
-  for (const Vec2f& v : in.texcoords) e.texcoords.push_back(dequantize_texcoord(g1, quantize_texcoord(g1, v)));
+  for (const Vec2f& v : in.texcoords)
+    e.texcoords.push_back(dequantize_texcoord(g1, quantize_texcoord(g1, v)));
   e.corner_texcoords.corners = in.corner_texcoords.corners;
   for (const Vec2f& v : in.corner_texcoords.values)
     e.corner_texcoords.values.push_back(dequantize_texcoord(g2, quantize_texcoord(g2, v)));
-  auto c = [&](float x) { return dequantize_color_channel(quantize_color_channel(x, o.quant_color), o.quant_color); };
+  auto c = [&](float x) {
+    return dequantize_color_channel(quantize_color_channel(x, o.quant_color), o.quant_color);
+  };
   for (const Vec4f& v : in.colors) e.colors.push_back({c(v.x), c(v.y), c(v.z), c(v.w)});
   e.face_materials = in.face_materials;
   e.materials = in.materials;

@@ -128,7 +128,8 @@ int main(int argc, char** argv) {
     for (uint32_t f = 0; f < seamed.face_count(); ++f) {
       for (int k = 0; k < 3; ++k) {
         seamed.corner_texcoords.corners.push_back(uint32_t(seamed.corner_texcoords.values.size()));
-        seamed.corner_texcoords.values.push_back({float(f % 16) / 16 + 0.01f * k, float(f / 16) / 16});
+        seamed.corner_texcoords.values.push_back(
+            {float(f % 16) / 16 + 0.01f * k, float(f / 16) / 16});
       }
       seamed.face_materials.push_back(f % 2);
     }

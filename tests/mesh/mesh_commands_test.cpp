@@ -146,7 +146,8 @@ TEST(MeshCommands, InfoOfKeptAttributesSaysEncodeCarriesThem) {
                           "carried by encode)"),
             std::string::npos)
       << text.out;
-  EXPECT_NE(text.out.find("attributes      texture coordinates (carried by encode"), std::string::npos)
+  EXPECT_NE(text.out.find("attributes      texture coordinates (carried by encode"),
+            std::string::npos)
       << text.out;
   const auto json = nlohmann::json::parse(json_run.out);
   EXPECT_EQ(json["contents"]["texcoords"]["kept_by_import"], true);
