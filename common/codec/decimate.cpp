@@ -320,7 +320,8 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     update_costs(mesh, field, alive, cost, threads);
     candidates.clear();
     for (uint32_t v = 0; v < n; ++v) {
-      if (alive[v] && cost[v] >= 0) candidates.push_back({cost[v], v});
+      const bool locked = v < options.locked.size() && options.locked[v] != 0;
+      if (alive[v] && cost[v] >= 0 && !locked) candidates.push_back({cost[v], v});
     }
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
       return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);

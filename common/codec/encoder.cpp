@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "common/codec/attribute_codec.h"
 #include "common/codec/decimate.h"
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/editable_mesh.h"
@@ -292,6 +293,54 @@ Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std:
 
 }  // namespace
 
+std::vector<std::string> encode_warnings(const Mesh& mesh) {
+  std::vector<std::string> warnings;
+  if (!mesh.textures.empty()) {
+    warnings.push_back(std::to_string(mesh.textures.size()) +
+                       " texture image(s) are not carried by the stream (the material table "
+                       "keeps their indices)");
+  }
+  return warnings;
+}
+
+namespace {
+
+// The geometry stream `bytes` (candidate `stream`) with the attribute
+// records added (attribute_codec.h), and the report's records to match.
+Result<std::vector<uint8_t>> with_attributes(const AttributePlan& plan, const Mesh& mesh,
+                                             const std::vector<Vec3i>& q, EncodedStream& stream,
+                                             EncodeReport* report) {
+  if (plan.empty()) return std::move(stream.bytes);
+  std::vector<uint32_t> to_input(stream.to_decoder.size(), kNone);
+  for (uint32_t v = 0; v < stream.to_decoder.size(); ++v) {
+    if (stream.to_decoder[v] >= to_input.size())
+      return make_error(ErrorCode::kInternal, "encoder: a vertex has no decoder id");
+    to_input[stream.to_decoder[v]] = v;
+  }
+  AttributeParts parts;
+  std::vector<uint32_t> sizes;
+  auto bytes = add_attribute_records(plan, mesh, q, stream.bytes, to_input, &parts, &sizes);
+  if (!bytes) return bytes;
+  if (report) {
+    report->attribute_bytes = parts;
+    report->attribute_locked_vertices = plan.locked_count;
+    if (!report->records.empty()) {
+      EncodedRecord first = report->records[0];
+      first.bytes = sizes.size() > 1 ? sizes[1] : 0;
+      first.distortion_drop = 0;
+      report->records.insert(report->records.begin() + 1, first);
+      EncodedRecord last = report->records.back();
+      last.plane = false;
+      last.bytes = sizes.empty() ? 0 : sizes.back();
+      last.distortion_drop = 0;
+      report->records.push_back(last);
+    }
+  }
+  return bytes;
+}
+
+}  // namespace
+
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
   return encode_hcs(mesh, options, nullptr);
 }
@@ -305,6 +354,9 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
   if (mesh.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "mesh has no triangles");
   std::vector<Vec3i> q = quantize_positions(mesh, *grid);
+  auto plan =
+      plan_attributes(mesh, q, {options.quant_normal, options.quant_uv, options.quant_color});
+  if (!plan) return tl::unexpected(plan.error());
   auto editable = EditableMesh::build(q, mesh.triangles);
   if (!editable) return tl::unexpected(editable.error());
   // The stages' shares of the whole, from their times on a 0.8M-triangle
@@ -322,6 +374,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   dopt.target_vertices = options.target_base_vertices;
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
+  dopt.locked = plan->locked;
   DecimationResult dec = decimate_layers(std::move(*editable), dopt);
 
   // The candidates.
@@ -396,8 +449,10 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
                                       progress.within_function());
   if (!candidates) return tl::unexpected(candidates.error());
   if (!measuring) {
+    auto out = with_attributes(*plan, mesh, q, candidates->streams[0], report);
+    if (report) report->warnings = encode_warnings(mesh);
     progress.stage("done", 1.0, 1.0);
-    return std::move(candidates->streams[0].bytes);
+    return out;
   }
   // The peer (EncodeOptions::measure_whole_candidates). What the
   // measurement does not need goes before it builds its own hierarchy over
@@ -409,9 +464,11 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   progress.stage("measuring", coded_at, 1.0);
   auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel, progress);
   if (!best) return tl::unexpected(best.error());
-  progress.stage("done", 1.0, 1.0);
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
-  return std::move(candidates->streams[*best].bytes);
+  auto out = with_attributes(*plan, mesh, q, candidates->streams[*best], report);
+  if (report) report->warnings = encode_warnings(mesh);
+  progress.stage("done", 1.0, 1.0);
+  return out;
 }
 
 }  // namespace meshstream

@@ -8,7 +8,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/base/result.h"
@@ -83,6 +85,13 @@ struct EncodeOptions {
   // Called as the encode advances (encode_progress.h); empty = no calls. It
   // does not change the stream.
   EncodeProgressCallback progress;
+  // Attribute quantization (attribute_quantize.h), 2..16 bits, else
+  // kInvalidArgument: normals per octahedral coordinate, texture coordinates
+  // per axis over their box, colours per channel on [0, 1] (8: 8-bit colours
+  // come back exactly). `meshstream encode --quant-normal/--quant-uv/--quant-color`.
+  int quant_normal = 8;
+  int quant_uv = 12;
+  int quant_color = 8;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each
@@ -138,7 +147,19 @@ struct EncodeReport {
   // The record ordering the stream was written with (the measured choice's
   // winner when automatic).
   RecordOrdering ordering{0, DistortionEstimate::kAutomatic};
+  // Bytes of the attribute records' parts ("layout", "seams", "normals",
+  // "texcoords", "colors", "materials", "extra"; attribute_codec.h).
+  std::map<std::string, uint64_t> attribute_bytes;
+  // Vertices kept out of decimation because a seam or a material border
+  // passes through them.
+  uint32_t attribute_locked_vertices = 0;
+  // What the stream does not carry (encode_warnings).
+  std::vector<std::string> warnings;
 };
+
+// The data of `mesh` an encode does not carry, one message each (empty when
+// everything is carried): `meshstream encode` prints them, the server logs them.
+std::vector<std::string> encode_warnings(const Mesh& mesh);
 
 // Encodes a clean manifold mesh (see import.h). kInvalidArgument for bad
 // options, kNonManifold / kInvalidMesh for a mesh the codec cannot take;

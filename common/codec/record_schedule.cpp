@@ -133,6 +133,9 @@ class RecordScheduler {
     return in_.stop_after_bytes > 0 && refinement_bytes_ >= in_.stop_after_bytes;
   }
 
+  // The input -> decoder vertex map once the replay is done.
+  std::vector<uint32_t> take_to_decoder() { return std::move(to_decoder_); }
+
  private:
   // Plane groups: about a record's worth of plane bits each. New ids join
   // the last group while it has not been sent and has room.
@@ -376,7 +379,9 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   header.geometry_coder = kGeometryCoderEmbedded;
   header.layer_count = static_cast<uint32_t>(dec.layers.size());
   header.extra = {format.header_byte(), static_cast<uint8_t>(base_shift)};
-  return write_stream(header, std::move(records));
+  auto out = write_stream(header, std::move(records));
+  if (out) out->to_decoder = scheduler.take_to_decoder();
+  return out;
 }
 
 }  // namespace meshstream

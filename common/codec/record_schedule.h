@@ -24,6 +24,7 @@ struct EncodedStream {
   size_t largest_refinement = 0;
   size_t records = 0;
   uint64_t payload_offset = 0;  // bytes of magic, header and index
+  std::vector<uint32_t> to_decoder;  // input vertex id -> the decoder's id
 };
 
 // Encodes `mesh` (quantized to `q` on `grid`, decimated to `dec`) with
