@@ -12,6 +12,7 @@
 #include "common/codec/quantize.h"
 #include "common/codec/refinement_codec.h"
 #include "common/codec/stream_format.h"
+#include "common/codec/texture_record.h"
 
 namespace meshstream {
 
@@ -50,6 +51,11 @@ struct IncrementalDecoder::State {
   // that failed its checksum before being applied): fetching the bytes again
   // may succeed, so resume_at clears it.
   bool error_recoverable = false;
+  // Texture records (texture_record.h): the textures so far, the level of
+  // each and whether it is the original (nothing may follow it).
+  std::vector<Texture> textures;
+  std::vector<uint32_t> texture_level;
+  std::vector<bool> texture_original;
 
   uint64_t consumed_end() const {
     if (!index) return 0;
@@ -113,6 +119,52 @@ struct IncrementalDecoder::State {
     return {};
   }
 
+  // A texture record: checked (texture_record.h), then its image replaces
+  // the texture's smaller level. Levels of a texture only grow, textures
+  // are numbered in order of arrival, and the record adds nothing else.
+  Status apply_texture_record(uint32_t i, std::span<const uint8_t> payload, RecordDelta& delta) {
+    const RecordEntry& rec = index->records[i];
+    const RecordEntry& before = index->records[i - 1];
+    if (rec.vertices != before.vertices || rec.faces != before.faces) {
+      return make_error(ErrorCode::kParse, "texture record where the index says the mesh grows");
+    }
+    auto level = read_texture_record(payload);
+    if (!level) return tl::unexpected(level.error());
+    const uint32_t t = level->texture;
+    const std::string what = "texture " + std::to_string(t) + " (\"" + level->name + "\") level " +
+                             std::to_string(level->level);
+    if (t > textures.size()) {
+      return make_error(ErrorCode::kParse, what + ": textures " + std::to_string(textures.size()) +
+                                               ".." + std::to_string(t - 1) +
+                                               " have not come yet (textures come in order)");
+    }
+    if (t < textures.size()) {
+      if (texture_original[t]) {
+        return make_error(ErrorCode::kParse, what + ": comes after the original image");
+      }
+      if (level->level <= texture_level[t]) {
+        return make_error(ErrorCode::kParse,
+                          what + ": level " + std::to_string(texture_level[t]) + " came already");
+      }
+      if (level->name != textures[t].name) {
+        return make_error(ErrorCode::kParse,
+                          what + ": an earlier level is named \"" + textures[t].name + "\"");
+      }
+    } else {
+      textures.emplace_back();
+      texture_level.push_back(0);
+      texture_original.push_back(false);
+    }
+    textures[t].name = level->name;
+    textures[t].mime_type = mime_type_of(level->format);
+    textures[t].bytes = std::move(level->bytes);
+    texture_level[t] = level->level;
+    texture_original[t] = level->original;
+    if (upkeep == DecodedMeshUpkeep::kEveryRecord) mesh.textures = textures;
+    delta.textures_changed = true;
+    return {};
+  }
+
   Status apply_record(uint32_t i, std::span<const uint8_t> payload) {
     const RecordEntry& rec = index->records[i];
     const StreamHeader& h = index->header;
@@ -161,6 +213,8 @@ struct IncrementalDecoder::State {
         delta.touched_faces.resize(base->faces.size());
         for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
       }
+    } else if (!payload.empty() && payload[0] == kRecordTexture) {
+      if (auto st = apply_texture_record(i, payload, delta); !st) return where(st.error());
     } else {
       AppliedRecord applied;
       // Without an output mesh nobody follows the changes: the lists would
@@ -298,6 +352,7 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
     for (size_t v = 0; v < q.size(); ++v) out.positions[v] = dequantize(q[v]);
     // The decoder only inserts, so every face slot is a live face.
     out.triangles = s.refine->mesh.release_faces();
+    out.textures = std::move(s.textures);
   }
   s.refine.reset();
   s.mesh = Mesh{};
@@ -306,6 +361,9 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
   return out;
 }
 const std::vector<RecordDelta>& IncrementalDecoder::last_deltas() const { return state_->deltas; }
+const std::vector<bool>& IncrementalDecoder::textures_original() const {
+  return state_->texture_original;
+}
 
 bool IncrementalDecoder::error_is_recoverable() const {
   return state_->error && state_->error_recoverable;

@@ -17,6 +17,7 @@
 #include "common/codec/quantize.h"
 #include "common/codec/rd_measure.h"
 #include "common/codec/record_schedule.h"
+#include "common/codec/texture_stream.h"
 #include "common/metrics/bvh.h"
 
 namespace meshstream {
@@ -330,7 +331,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (!candidates) return tl::unexpected(candidates.error());
   if (!measuring) {
     progress.stage("done", 1.0, 1.0);
-    return std::move(candidates->streams[0].bytes);
+    return add_texture_records(std::move(candidates->streams[0].bytes), mesh.textures);
   }
   // What the measurement does not need goes before it builds its own
   // hierarchy over the original: the peak is then one such hierarchy.
@@ -343,7 +344,8 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (!best) return tl::unexpected(best.error());
   progress.stage("done", 1.0, 1.0);
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
-  return std::move(candidates->streams[*best].bytes);
+  // Textures go in last: the record order and sizes above are the geometry's.
+  return add_texture_records(std::move(candidates->streams[*best].bytes), mesh.textures);
 }
 
 }  // namespace meshstream

@@ -99,5 +99,6 @@ inline constexpr uint32_t kMaxInsertedValence = 16;
 // has 0 or kRecordStartsLayer, a plane record exactly kRecordPlane.
 inline constexpr uint8_t kRecordStartsLayer = 1;
 inline constexpr uint8_t kRecordPlane = 2;
+// A texture record starts with kRecordTexture (4): texture_record.h.
 
 }  // namespace meshstream
