@@ -40,6 +40,20 @@ DisplayBuilder::~DisplayBuilder() = default;
 DisplayBuilder::DisplayBuilder(DisplayBuilder&&) noexcept = default;
 DisplayBuilder& DisplayBuilder::operator=(DisplayBuilder&&) noexcept = default;
 
+namespace {
+
+// What ASA's output lacks of the decoded mesh's surface: its materials and
+// textures (mesh-wide, unchanged by subdivision). Per-face materials and
+// per-corner attributes are not carried through ASA yet: such a mesh shows
+// material 0 and no per-corner values when ASA is on.
+std::shared_ptr<const Mesh> with_surface(Mesh display, const Mesh& decoded) {
+  display.materials = decoded.materials;
+  display.textures = decoded.textures;
+  return std::make_shared<const Mesh>(std::move(display));
+}
+
+}  // namespace
+
 Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& decoded_shared,
                                           const MeshChanges& changes, bool asa_enabled,
                                           const AsaOptions& options, bool options_changed,
@@ -113,7 +127,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
     report.incremental = false;
     report.asa_ms = ms_since(start);
     DisplayMesh out;
-    out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
+    out.mesh = with_surface(std::move(result.mesh), mesh);
     out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
     return out;
   };
@@ -126,7 +140,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
     report.asa_ms = ms_since(start);
     if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
     DisplayMesh out;
-    out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
+    out.mesh = with_surface(std::move(result.mesh), mesh);
     out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
     return out;
   }
@@ -145,7 +159,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   const IncrementalStats& stats = s.incremental->last_update();
   const AsaResult& result = s.incremental->result();
   if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();
-  auto display = std::make_shared<const Mesh>(result.mesh);
+  auto display = with_surface(result.mesh, mesh);
   auto kinds = std::make_shared<const std::vector<FaceKind>>(result.face_kind);
   report.asa_ms = ms_since(start);
   report.incremental = !stats.full;

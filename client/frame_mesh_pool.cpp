@@ -2,6 +2,8 @@
 
 #include <atomic>
 
+#include "client/surface_attributes.h"
+
 namespace meshstream::client {
 
 namespace {
@@ -19,6 +21,8 @@ void fall_behind(MeshChanges& behind, const MeshChanges& changes, const Mesh& mi
   behind.vertices.insert(behind.vertices.end(), changes.vertices.begin(), changes.vertices.end());
   behind.faces.insert(behind.faces.end(), changes.faces.begin(), changes.faces.end());
   behind.moved.insert(behind.moved.end(), changes.moved.begin(), changes.moved.end());
+  behind.attributes = behind.attributes || changes.attributes;
+  behind.textures = behind.textures || changes.textures;
   if (behind.vertices.size() + behind.faces.size() + behind.moved.size() >
       mirror.positions.size() + mirror.triangles.size()) {
     behind.clear();
@@ -31,8 +35,10 @@ void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror) {
   if (behind.full) {
     mesh.positions.assign(mirror.positions.begin(), mirror.positions.end());
     mesh.triangles.assign(mirror.triangles.begin(), mirror.triangles.end());
+    copy_surface_attributes(mirror, mesh, true);
     return;
   }
+  if (behind.attributes) copy_surface_attributes(mirror, mesh, behind.textures);
   // The mirror only grows between full changes: added vertices and faces are
   // in the lists, so resizing and copying the listed entries is exact.
   mesh.positions.resize(mirror.positions.size());
