@@ -10,6 +10,7 @@
 #include "client/viewer/offscreen.h"
 #include "common/mesh/textured_sphere.h"
 #include "tests/viewer/image_checks.h"
+#include "tests/viewer/saturated_pixels.h"
 
 namespace meshstream::client {
 namespace {
@@ -30,34 +31,11 @@ RgbaImage render_or_fail(const Mesh& mesh, const OffscreenRequest& r, const char
   return *image;
 }
 
-// Pixels by the checker colour they are nearest to in hue (red, green,
-// blue, yellow), counting only clearly saturated ones (max - min channel
-// above 60 of 255): grey shading and the background count nowhere.
-std::array<int, 4> saturated_by_hue(const RgbaImage& image) {
-  std::array<int, 4> counts{};
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      const uint8_t* p = image.pixel(x, y);
-      const int r = p[0], g = p[1], b = p[2];
-      if (std::max({r, g, b}) - std::min({r, g, b}) <= 60) continue;
-      if (r > 2 * b && g > 2 * b && std::abs(r - g) < (r + g) / 4)
-        ++counts[3];  // yellow: red and green, no blue
-      else if (r >= g && r >= b)
-        ++counts[0];
-      else if (g >= r && g >= b)
-        ++counts[1];
-      else
-        ++counts[2];
-    }
-  }
-  return counts;
-}
-
 TEST(TexturedRender, TheCheckerTextureShowsInItsColours) {
   const Mesh sphere = make_textured_uv_sphere(32, 64, 256);
   const RgbaImage lit = render_or_fail(sphere, request(), "lit");
   ASSERT_GT(lit.width, 0);
-  const auto hues = saturated_by_hue(lit);
+  const auto hues = testing::saturated_by_hue(lit);
   int total = 0, present = 0;
   for (int c : hues) {
     total += c;
@@ -72,13 +50,13 @@ TEST(TexturedRender, TheCheckerTextureShowsInItsColours) {
   plain.textures.clear();
   plain.materials.clear();
   plain.face_materials.clear();
-  const auto grey = saturated_by_hue(render_or_fail(plain, request(), "plain"));
+  const auto grey = testing::saturated_by_hue(render_or_fail(plain, request(), "plain"));
   EXPECT_EQ(grey[0] + grey[1] + grey[2] + grey[3], 0);
 
   // The unlit texture mode shows the texture itself: more saturated pixels
   // than lit (no shading towards black at the rim).
   const auto flat =
-      saturated_by_hue(render_or_fail(sphere, request(SurfaceMode::kTexture), "flat"));
+      testing::saturated_by_hue(render_or_fail(sphere, request(SurfaceMode::kTexture), "flat"));
   EXPECT_GE(flat[0] + flat[1] + flat[2] + flat[3], total);
 }
 
@@ -92,7 +70,7 @@ TEST(TexturedRender, VertexColoursShow) {
   for (uint32_t v = 0; v < sphere.vertex_count(); ++v)
     sphere.colors[v] =
         sphere.positions[v].z > 0 ? Vec4f{0.9f, 0.1f, 0.1f, 1} : Vec4f{0.1f, 0.2f, 0.9f, 1};
-  const auto hues = saturated_by_hue(render_or_fail(sphere, request(), "colors"));
+  const auto hues = testing::saturated_by_hue(render_or_fail(sphere, request(), "colors"));
   EXPECT_GT(hues[0], 500) << "red upper half";
   EXPECT_GT(hues[2], 500) << "blue lower half";
 }
