@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "common/asa/corner_attributes.h"
 #include "common/asa/display_budget.h"
 #include "common/asa/incremental.h"
 
@@ -43,9 +44,8 @@ DisplayBuilder& DisplayBuilder::operator=(DisplayBuilder&&) noexcept = default;
 namespace {
 
 // What ASA's output lacks of the decoded mesh's surface: its materials and
-// textures (mesh-wide, unchanged by subdivision). Per-face materials and
-// per-corner attributes are not carried through ASA yet: such a mesh shows
-// material 0 and no per-corner values when ASA is on.
+// textures (mesh-wide, unchanged by subdivision; per-corner attributes and
+// face materials ASA carries itself).
 std::shared_ptr<const Mesh> with_surface(Mesh display, const Mesh& decoded) {
   display.materials = decoded.materials;
   display.textures = decoded.textures;
@@ -106,7 +106,12 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   } else if (path_ == AsaPath::kAuto && changes.full) {
     plain_full = true;
   }
-  if (plain_full && options.view.enabled && path_ != AsaPath::kFull) {
+  // Per-corner attributes and face materials ride through the full
+  // subdivision only (corner_attributes.h; the incremental subdivider's
+  // region merge does not carry them yet).
+  const bool corner_data = asa::has_corner_data(mesh);
+  if (corner_data) plain_full = true;
+  if (plain_full && !corner_data && options.view.enabled && path_ != AsaPath::kFull) {
     // A camera bounds the work: the incremental subdivider's full update
     // subdivides only the region the screen may refine (incremental.h).
     if (s.incremental) s.incremental->reset();
