@@ -41,7 +41,11 @@ Result<ImageFacts> check_image(std::span<const uint8_t> bytes, const std::string
     }
     facts.width = big_endian_u32(bytes.data() + 16);
     facts.height = big_endian_u32(bytes.data() + 20);
-    if (std::memcmp(bytes.data() + bytes.size() - 12, kPngEnd, 12) != 0) {
+    // glTF buffer views are padded to 4 bytes: zeros after IEND are allowed
+    // (its CRC ends in 0x82, so they cannot be part of it).
+    size_t end = bytes.size();
+    while (end > 8 + 25 + 12 && bytes[end - 1] == 0) --end;
+    if (std::memcmp(bytes.data() + end - 12, kPngEnd, 12) != 0) {
       return tl::unexpected(
           parse_error(what, "PNG image is truncated (it does not end with an IEND chunk)"));
     }

@@ -99,7 +99,10 @@ Result<std::vector<TextureLevel>> texture_levels(const Texture& texture, uint32_
 
   std::vector<TextureLevel> levels;
   const uint32_t long_side = std::max(facts->width, facts->height);
-  constexpr int kPreviewSides[] = {32, 16, 8, 4};
+  constexpr int kPreviewSides[] = {32, 16, 8, 4, 2, 1};
+  // What a record adds to the image: flags, varints, the name, the CRC
+  // trailer and about 2 index bytes.
+  const size_t record_overhead = 16 + std::min<size_t>(texture.name.size(), kMaxTextureNameBytes);
   if (long_side > uint32_t(kPreviewSides[std::size(kPreviewSides) - 1])) {
     Pixels pixels;
     std::unique_ptr<uint8_t, void (*)(void*)> decoded(
@@ -118,7 +121,7 @@ Result<std::vector<TextureLevel>> texture_levels(const Texture& texture, uint32_
     for (int side : kPreviewSides) {
       if (uint32_t(side) >= long_side) continue;
       preview = derived_level(scaled(pixels, side), index, 0, texture.name, false);
-      if (preview.bytes.size() <= preview_bytes) break;
+      if (preview.bytes.size() + record_overhead <= preview_bytes) break;
     }
     if (!preview.bytes.empty()) levels.push_back(std::move(preview));
     if (options.middle_side > 0 && long_side >= 2 * options.middle_side) {

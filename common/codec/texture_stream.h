@@ -32,13 +32,13 @@ struct TextureStreamOptions {
 };
 
 // The pyramid levels of `texture` (index `index`), smallest first, the
-// last the original bytes: a preview that fits `preview_bytes` (the
-// largest long side of 32, 16, 8, 4 pixels whose PNG or JPEG does; 4 when
-// none does), the middle level when the image is at least twice its size and
-// the level under half the original's bytes,
-// then the original. An image no larger than the preview goes as its
-// original alone. kInvalidMesh naming the texture when its bytes are not
-// a whole PNG or JPEG image (check_image). O(pixels).
+// last the original bytes: a preview whose record fits `preview_bytes` (the
+// largest long side of 32, 16, 8, 4, 2, 1 pixels whose PNG or JPEG, with
+// the record's own bytes, does; 1 pixel when none does), the middle level
+// when the image is at least twice its size and the level under half the
+// original's bytes, then the original. A 1-pixel image goes as its
+// original alone. kInvalidMesh naming the texture when its bytes are not a
+// whole PNG or JPEG image (check_image). O(pixels).
 Result<std::vector<TextureLevel>> texture_levels(const Texture& texture, uint32_t index,
                                                  size_t preview_bytes,
                                                  const TextureStreamOptions& options);

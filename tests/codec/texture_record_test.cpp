@@ -90,6 +90,9 @@ TEST(TextureRecords, PreviewFollowsTheBaseAndTheOriginalComesBackExactly) {
   ASSERT_TRUE(index);
   ASSERT_GE(index->records.size(), 3u);
   EXPECT_TRUE(is_texture(stream, index->records[1])) << "the preview is record 1";
+  // Its record within 10 % of the first display's bytes (header, index, base).
+  EXPECT_LE(index->records[1].size,
+            0.10 * double(index->payload_offset + index->records[0].size) + 2);
   size_t textures = 0;
   for (const RecordEntry& r : index->records) textures += is_texture(stream, r);
   EXPECT_EQ(textures, 3u) << "preview, 128-pixel level and the original of a 256-pixel image";
@@ -281,21 +284,23 @@ TEST(TextureRecords, AMeshWithoutTexturesKeepsItsStreamAndABadImageIsNamed) {
 }
 
 TEST(TextureRecords, PreviewFitsItsShareOfTheFirstDisplay) {
-  // The preview level chosen for a budget is within it when a 4-pixel
-  // image fits at all (texture_levels' rule), and the original is the
-  // file's bytes.
+  // The preview level's record fits the budget whenever a 1-pixel image
+  // does (texture_levels' rule), larger budgets give larger previews, and
+  // the original is the file's bytes.
   Texture t;
   t.name = "checker.png";
   t.mime_type = "image/png";
   t.bytes = make_checker_png(512);
+  uint32_t last_width = 0;
   for (size_t budget : {100u, 200u, 400u, 1000u, 4000u}) {
     auto levels = texture_levels(t, 0, budget, TextureStreamOptions{});
     ASSERT_TRUE(levels);
     ASSERT_EQ(levels->size(), 2u) << "a checker's JPEG middle level does not pay";
     const TextureLevel& preview = levels->front();
-    if (preview.width > 4) {
-      EXPECT_LE(preview.bytes.size(), budget) << preview.width;
-    }
+    const size_t record = write_texture_record(preview).size() + 4;  // and its CRC trailer
+    if (preview.width > 1) EXPECT_LE(record + 2, budget) << preview.width;
+    EXPECT_GE(preview.width, last_width);
+    last_width = preview.width;
     EXPECT_EQ(levels->back().bytes, t.bytes);
     EXPECT_TRUE(levels->back().original);
   }

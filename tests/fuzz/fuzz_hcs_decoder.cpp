@@ -8,7 +8,9 @@
 // IncrementalDecoder fed piece by piece never crash, never read out of
 // bounds (ASan) and never hit undefined behaviour (UBSan); once the decoder
 // reports an error it stays in error and keeps its last good (valid) mesh; a resume
-// at the decoder's own resume offset is accepted.
+// at the decoder's own resume offset is accepted; every texture the decoder
+// shows is a whole PNG or JPEG image (texture records are checked before
+// they are shown), one original flag per texture.
 //
 // The container's CRC-32s would stop almost every mutation at the index or
 // at a record's checksum, so the payload decoders (base mesh, refinement
@@ -26,6 +28,7 @@
 #include "common/codec/container.h"
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
+#include "common/codec/texture_record.h"
 #include "common/mesh/mesh.h"
 
 namespace {
@@ -86,6 +89,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(decoder.resume_offset() == resume);
     const Mesh& mesh = decoder.mesh();
     check(validate_arrays(mesh).has_value());  // every index names a vertex
+  }
+  if (decoder.records_decoded() > 0) {
+    const Mesh& mesh = decoder.mesh();
+    check(mesh.textures.size() == decoder.textures_original().size());
+    for (const Texture& t : mesh.textures) check(check_image(t.bytes, t.name).has_value());
   }
   return 0;
 }
