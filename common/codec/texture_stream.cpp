@@ -100,9 +100,11 @@ Result<std::vector<TextureLevel>> texture_levels(const Texture& texture, uint32_
   std::vector<TextureLevel> levels;
   const uint32_t long_side = std::max(facts->width, facts->height);
   constexpr int kPreviewSides[] = {32, 16, 8, 4, 2, 1};
-  // What a record adds to the image: flags, varints, the name, the CRC
-  // trailer and about 2 index bytes.
-  const size_t record_overhead = 16 + std::min<size_t>(texture.name.size(), kMaxTextureNameBytes);
+  // What the preview adds to the first display besides its image: the
+  // record's flags, varints, name and CRC trailer (12 + name), and the
+  // index entries of the texture's records, which come before the base
+  // (about 4 bytes each, for up to 3 levels).
+  const size_t record_overhead = 24 + std::min<size_t>(texture.name.size(), kMaxTextureNameBytes);
   if (long_side > uint32_t(kPreviewSides[std::size(kPreviewSides) - 1])) {
     Pixels pixels;
     std::unique_ptr<uint8_t, void (*)(void*)> decoded(
