@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "client/frame_mesh_pool.h"
+#include "client/surface_attributes.h"
 
 namespace meshstream::client {
 
@@ -34,6 +35,8 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
       pending_.faces.insert(pending_.faces.end(), d.touched_faces.begin(), d.touched_faces.end());
       pending_.moved.insert(pending_.moved.end(), d.moved_vertices.begin(), d.moved_vertices.end());
     }
+    pending_.attributes = true;
+    pending_.textures = pending_.textures || d.textures_changed;
   }
   // Past one entry per face, copying the whole mesh is cheaper than the
   // list (and the list would grow without bound behind a slow pipeline).
@@ -42,6 +45,7 @@ Result<uint32_t> DecodedStream::feed(std::span<const uint8_t> bytes) {
     pending_.clear();
     pending_.full = true;
   }
+  if (pending_.full) pending_.attributes = pending_.textures = true;
   pending_updates_ += *applied;
   pending_decode_ms_ += ms;
   lock.unlock();
@@ -171,7 +175,8 @@ TakenUpdate DecodedStream::take(Mesh& mirror, MeshChanges& changes) {
       for (uint32_t v : pending_.moved) mirror.positions[v] = m.positions[v];
       for (uint32_t f : pending_.faces) mirror.triangles[f] = m.triangles[f];
     }
-    copy_attributes(m, mirror);
+    if (pending_.full || pending_.attributes)
+      copy_surface_attributes(m, mirror, pending_.full || pending_.textures);
     u = hand_over_pending(changes);
   }
   changed_.notify_all();  // releases a network thread waiting at the barrier
@@ -203,6 +208,8 @@ TakenUpdate DecodedStream::hand_over_pending(MeshChanges& changes) {
     changes.faces.insert(changes.faces.end(), pending_.faces.begin(), pending_.faces.end());
     changes.moved.insert(changes.moved.end(), pending_.moved.begin(), pending_.moved.end());
   }
+  changes.attributes = changes.attributes || pending_.attributes || pending_.full;
+  changes.textures = changes.textures || pending_.textures || pending_.full;
   pending_.clear();
   u.records_decoded = decoder_.records_decoded();
   u.bytes_decoded = decoder_.resume_offset();

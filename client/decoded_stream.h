@@ -35,11 +35,19 @@ struct MeshChanges {
   // moved_vertices; may repeat): their positions changed, no face changed
   // its corners, so the faces around them changed shape only.
   std::vector<uint32_t> moved;
+  // Records arrived that may have changed the other arrays (normals,
+  // colours, texture coordinates, materials: surface_attributes.h), or
+  // that changed the textures (texture records, RecordDelta::
+  // textures_changed). `full` implies both.
+  bool attributes = false;
+  bool textures = false;
   void clear() {
     full = false;
     vertices.clear();
     faces.clear();
     moved.clear();
+    attributes = false;
+    textures = false;
   }
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "common/asa/corner_attributes.h"
 #include "common/asa/display_budget.h"
 #include "common/asa/incremental.h"
 
@@ -39,6 +40,19 @@ DisplayBuilder::DisplayBuilder() : state_(std::make_unique<State>()) {}
 DisplayBuilder::~DisplayBuilder() = default;
 DisplayBuilder::DisplayBuilder(DisplayBuilder&&) noexcept = default;
 DisplayBuilder& DisplayBuilder::operator=(DisplayBuilder&&) noexcept = default;
+
+namespace {
+
+// What ASA's output lacks of the decoded mesh's surface: its materials and
+// textures (mesh-wide, unchanged by subdivision; per-corner attributes and
+// face materials ASA carries itself).
+std::shared_ptr<const Mesh> with_surface(Mesh display, const Mesh& decoded) {
+  display.materials = decoded.materials;
+  display.textures = decoded.textures;
+  return std::make_shared<const Mesh>(std::move(display));
+}
+
+}  // namespace
 
 Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& decoded_shared,
                                           const MeshChanges& changes, bool asa_enabled,
@@ -92,7 +106,12 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   } else if (path_ == AsaPath::kAuto && changes.full) {
     plain_full = true;
   }
-  if (plain_full && options.view.enabled && path_ != AsaPath::kFull) {
+  // Per-corner attributes and face materials ride through the full
+  // subdivision only (corner_attributes.h; the incremental subdivider's
+  // region merge does not carry them yet).
+  const bool corner_data = asa::has_corner_data(mesh);
+  if (corner_data) plain_full = true;
+  if (plain_full && !corner_data && options.view.enabled && path_ != AsaPath::kFull) {
     // A camera bounds the work: the incremental subdivider redoes the
     // region the change and the screen ask for, and where that is most of
     // the mesh its own full update subdivides only the region the screen
@@ -115,7 +134,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
     report.incremental = false;
     report.asa_ms = ms_since(start);
     DisplayMesh out;
-    out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
+    out.mesh = with_surface(std::move(result.mesh), mesh);
     out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
     return out;
   };
@@ -128,7 +147,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
     report.asa_ms = ms_since(start);
     if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
     DisplayMesh out;
-    out.mesh = std::make_shared<const Mesh>(std::move(result.mesh));
+    out.mesh = with_surface(std::move(result.mesh), mesh);
     out.face_kind = std::make_shared<const std::vector<FaceKind>>(std::move(result.face_kind));
     return out;
   }
@@ -156,7 +175,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   const IncrementalStats& stats = s.incremental->last_update();
   const AsaResult& result = s.incremental->result();
   if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();
-  auto display = std::make_shared<const Mesh>(result.mesh);
+  auto display = with_surface(result.mesh, mesh);
   auto kinds = std::make_shared<const std::vector<FaceKind>>(result.face_kind);
   report.asa_ms = ms_since(start);
   report.incremental = !stats.full;

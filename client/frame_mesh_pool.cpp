@@ -2,20 +2,9 @@
 
 #include <atomic>
 
-namespace meshstream::client {
+#include "client/surface_attributes.h"
 
-void copy_attributes(const Mesh& from, Mesh& to) {
-  to.normals = from.normals;
-  to.colors = from.colors;
-  to.texcoords = from.texcoords;
-  to.corner_normals = from.corner_normals;
-  to.corner_colors = from.corner_colors;
-  to.corner_texcoords = from.corner_texcoords;
-  to.materials = from.materials;
-  to.face_materials = from.face_materials;
-  to.textures = from.textures;
-  to.extra_attributes = from.extra_attributes;
-}
+namespace meshstream::client {
 
 namespace {
 
@@ -32,6 +21,8 @@ void fall_behind(MeshChanges& behind, const MeshChanges& changes, const Mesh& mi
   behind.vertices.insert(behind.vertices.end(), changes.vertices.begin(), changes.vertices.end());
   behind.faces.insert(behind.faces.end(), changes.faces.begin(), changes.faces.end());
   behind.moved.insert(behind.moved.end(), changes.moved.begin(), changes.moved.end());
+  behind.attributes = behind.attributes || changes.attributes;
+  behind.textures = behind.textures || changes.textures;
   if (behind.vertices.size() + behind.faces.size() + behind.moved.size() >
       mirror.positions.size() + mirror.triangles.size()) {
     behind.clear();
@@ -44,9 +35,10 @@ void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror) {
   if (behind.full) {
     mesh.positions.assign(mirror.positions.begin(), mirror.positions.end());
     mesh.triangles.assign(mirror.triangles.begin(), mirror.triangles.end());
-    copy_attributes(mirror, mesh);
+    copy_surface_attributes(mirror, mesh, true);
     return;
   }
+  if (behind.attributes) copy_surface_attributes(mirror, mesh, behind.textures);
   // The mirror only grows between full changes: added vertices and faces are
   // in the lists, so resizing and copying the listed entries is exact.
   mesh.positions.resize(mirror.positions.size());
@@ -54,7 +46,6 @@ void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror) {
   for (uint32_t v : behind.vertices) mesh.positions[v] = mirror.positions[v];
   for (uint32_t v : behind.moved) mesh.positions[v] = mirror.positions[v];
   for (uint32_t f : behind.faces) mesh.triangles[f] = mirror.triangles[f];
-  copy_attributes(mirror, mesh);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ MESHSTREAM_PACKAGES=(
   libopenmesh-dev libmeshoptimizer-dev
   gnuplot-nox  # bench: the codec rate-distortion plot
   libglfw3-dev libimgui-dev libosmesa6-dev libpng-dev  # viewer: window, panel, off-screen, PNG
+  libstb-dev  # stb_image, _resize, _write: texture records (pyramid levels, checks), viewer textures
   xvfb xauth  # viewer tests: a virtual X display for the window
   clang libclang-rt-14-dev  # fuzz targets (libFuzzer) in tests/fuzz
   clang-format  # scripts/check-format, run by scripts/test

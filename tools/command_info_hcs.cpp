@@ -12,6 +12,7 @@
 #include "common/codec/base_coder.h"
 #include "common/codec/container.h"
 #include "common/codec/refinement_codec.h"
+#include "common/codec/texture_record.h"
 #include "tools/commands.h"
 #include "tools/hcs_file.h"
 
@@ -30,12 +31,14 @@ const char* base_coder_name(uint8_t id) {
   return "unknown";
 }
 
-// "base", "structure", "plane" (bit planes of positions), or nullptr when
-// the record's first byte is not in the file (it is cut short).
+// "base", "structure", "plane" (bit planes of positions), "texture" (an
+// image level, texture_record.h), or nullptr when the record's first byte
+// is not in the file (it is cut short).
 const char* record_kind(const std::vector<uint8_t>& bytes, const RecordEntry& r, size_t i) {
   if (i == 0) return "base";
   if (r.offset >= bytes.size() || r.size == 0) return nullptr;
   if (bytes[r.offset] == kRecordAttributes) return "attributes";
+  if (bytes[r.offset] == kRecordTexture) return "texture";
   return bytes[r.offset] == kRecordPlane ? "plane" : "structure";
 }
 
@@ -43,7 +46,8 @@ const char* record_kind(const std::vector<uint8_t>& bytes, const RecordEntry& r,
 // positions sent after their vertices), "connectivity" (the base and the
 // structure records: connectivity with the coarse position residuals of the
 // inserted vertices), each attribute and its seams ("normals", "texcoords",
-// "colors", "materials", "extra", "seams", "layout"), records counted
+// "colors", "materials", "extra", "seams", "layout"; textures are
+// texture_bytes), records counted
 // with their CRC trailers and read from the file's records that are whole.
 nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& index,
                           const FileCoverage& in_file) {
@@ -54,6 +58,7 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
     const char* kind = record_kind(bytes, r, i);
     const std::string k = kind ? kind : "";
     auto payload = record_payload(r, std::span<const uint8_t>(bytes.data() + r.offset, r.size));
+    if (k == "texture") continue;  // texture_bytes
     if (k == "plane") {
       positions += r.size;
     } else if (k == "attributes") {
@@ -75,6 +80,44 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
   return out;
 }
 
+// The texture records of the file: per texture its levels (record, level,
+// size, pixels); a level whose record is not whole in the file, or that
+// does not read, is listed with its bytes and an "error".
+nlohmann::json texture_summary(const std::vector<uint8_t>& bytes, const StreamIndex& index,
+                               uint64_t& texture_bytes) {
+  nlohmann::json textures = nlohmann::json::array();
+  texture_bytes = 0;
+  for (size_t i = 1; i < index.records.size(); ++i) {
+    const RecordEntry& r = index.records[i];
+    const char* kind = record_kind(bytes, r, i);
+    if (!kind || std::string(kind) != "texture") continue;
+    texture_bytes += r.size;
+    nlohmann::json level = {{"record", i}, {"bytes", r.size}};
+    uint32_t texture = 0;
+    if (r.offset + r.size <= bytes.size()) {
+      auto read = read_texture_record(record_payload(r, {bytes.data() + r.offset, r.size}));
+      if (read) {
+        texture = read->texture;
+        level["level"] = read->level;
+        level["width"] = read->width;
+        level["height"] = read->height;
+        level["format"] = read->format == ImageFormat::kJpeg ? "jpeg" : "png";
+        level["original"] = read->original;
+        while (textures.size() <= texture) textures.push_back({{"index", textures.size()}});
+        textures[texture]["name"] = read->name;
+      } else {
+        level["error"] = read.error().message;
+      }
+    } else {
+      level["error"] = "not whole in the file";
+    }
+    while (textures.size() <= texture) textures.push_back({{"index", textures.size()}});
+    textures[texture]["bytes"] = textures[texture].value("bytes", uint64_t(0)) + r.size;
+    textures[texture]["levels"].push_back(level);
+  }
+  return textures;
+}
+
 // Whether record i is whole in the file, begun, or absent.
 const char* record_presence(const FileCoverage& in_file, size_t i) {
   if (i < in_file.complete_records) return "complete";
@@ -94,15 +137,18 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
   const uint64_t total = index->total_bytes();
   const FileCoverage in_file = coverage_of(*index, bytes.size());
   const double bpv = h.vertex_count ? 8.0 * double(total) / h.vertex_count : 0.0;
-  size_t structure = 0, planes = 0, unknown = 0;  // kinds after the base
+  size_t structure = 0, planes = 0, texture_records = 0, unknown = 0;  // kinds after the base
   for (size_t i = 1; i < index->records.size(); ++i) {
     const char* kind = record_kind(bytes, index->records[i], i);
     if (!kind) {
       ++unknown;
       continue;
     }
-    (std::string(kind) == "plane" ? planes : structure) += 1;
+    const std::string k = kind;
+    (k == "plane" ? planes : k == "texture" ? texture_records : structure) += 1;
   }
+  uint64_t texture_bytes = 0;
+  const nlohmann::json textures = texture_summary(bytes, *index, texture_bytes);
   if (json) {
     nlohmann::json records = nlohmann::json::array();
     for (size_t i = 0; i < index->records.size(); ++i) {
@@ -142,6 +188,8 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
                             {"structure", h.structure_coder},
                             {"geometry", h.geometry_coder}}},
                           {"parts", part_bytes(bytes, *index, in_file)},
+                          {"texture_bytes", texture_bytes},
+                          {"textures", textures},
                           {"records", records}};
     std::cout << out.dump() << "\n";
     return 0;
@@ -172,9 +220,17 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
               h.base_face_count, index->records[0].size);
   std::string not_in_file;
   if (unknown > 0) not_in_file = "; " + std::to_string(unknown) + " not in the file, kind unknown";
-  std::printf("records: %u (base, %zu structure, %zu plane: bit planes of positions%s)%s\n",
-              in_file.records, structure, planes, not_in_file.c_str(),
+  std::string texture_part;
+  if (texture_records > 0) texture_part = ", " + std::to_string(texture_records) + " texture";
+  std::printf("records: %u (base, %zu structure, %zu plane: bit planes of positions%s%s)%s\n",
+              in_file.records, structure, planes, texture_part.c_str(), not_in_file.c_str(),
               list_records ? "" : "; --records lists them");
+  for (const auto& t : textures) {
+    std::printf("texture %u \"%s\": %llu bytes in %zu levels\n", t["index"].get<unsigned>(),
+                t.value("name", std::string("?")).c_str(),
+                static_cast<unsigned long long>(t.value("bytes", uint64_t(0))),
+                t.contains("levels") ? t["levels"].size() : size_t(0));
+  }
   if (!list_records) return 0;
   // The "in file" column only when there is something to say.
   const bool presence = in_file.cut_short();

@@ -68,6 +68,12 @@ namespace meshstream::client {
   X(void, DeleteTextures, (GLsizei n, const GLuint* textures))                               \
   X(void, ActiveTexture, (GLenum texture))                                                   \
   X(void, TexBuffer, (GLenum target, GLenum internalformat, GLuint buffer))                  \
+  X(void, TexImage2D,                                                                        \
+    (GLenum target, GLint level, GLint internalformat, GLsizei width, GLsizei height,        \
+     GLint border, GLenum format, GLenum type, const void* pixels))                          \
+  X(void, TexParameteri, (GLenum target, GLenum pname, GLint param))                         \
+  X(void, GenerateMipmap, (GLenum target))                                                   \
+  X(void, Uniform4f, (GLint location, GLfloat v0, GLfloat v1, GLfloat v2, GLfloat v3))       \
   X(void, GenFramebuffers, (GLsizei n, GLuint * framebuffers))                               \
   X(void, BindFramebuffer, (GLenum target, GLuint framebuffer))                              \
   X(void, DeleteFramebuffers, (GLsizei n, const GLuint* framebuffers))                       \

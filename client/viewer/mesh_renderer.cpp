@@ -1,5 +1,9 @@
 #include "client/viewer/mesh_renderer.h"
 
+#include <stb_image.h>
+
+#include <cstring>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -23,6 +27,36 @@ Result<GLuint> compile(const GlFunctions& gl, GLenum type, const char* source, c
   }
   return shader;
 }
+
+// FNV-1a over the bytes and their count: whether a texture changed.
+uint64_t bytes_key(const std::vector<uint8_t>& bytes) {
+  uint64_t h = 1469598103934665603ull ^ bytes.size();
+  for (uint8_t b : bytes) h = (h ^ b) * 1099511628211ull;
+  return h | 1;  // never 0 (0: no texture)
+}
+
+// The texture the mesh's surface shows: the base colour texture of the
+// material of face 0 (or of material 0), else texture 0 when there is no
+// material; -1 for none or an index out of range.
+int32_t shown_texture(const Mesh& mesh) {
+  int32_t t = -1;
+  if (!mesh.materials.empty()) {
+    uint32_t m = mesh.face_materials.empty() ? 0 : mesh.face_materials[0];
+    if (m < mesh.materials.size()) t = mesh.materials[m].base_color_texture;
+  } else if (!mesh.textures.empty()) {
+    t = 0;
+  }
+  return t >= 0 && size_t(t) < mesh.textures.size() ? t : -1;
+}
+
+// The material colour factor of face f (white without materials).
+Vec4f material_color(const Mesh& mesh, uint32_t f) {
+  if (mesh.materials.empty()) return {1, 1, 1, 1};
+  uint32_t m = f < mesh.face_materials.size() ? mesh.face_materials[f] : 0;
+  return m < mesh.materials.size() ? mesh.materials[m].base_color : Vec4f{1, 1, 1, 1};
+}
+
+Vec4f times(Vec4f a, Vec4f b) { return {a.x * b.x, a.y * b.y, a.z * b.z, a.w * b.w}; }
 
 }  // namespace
 
@@ -69,21 +103,29 @@ Result<MeshRenderer> MeshRenderer::create(const GlFunctions& gl) {
   u.wire_width = gl.GetUniformLocation(program, "u_wire_width");
   u.distance_max = gl.GetUniformLocation(program, "u_distance_max");
   u.face_kind = gl.GetUniformLocation(program, "u_face_kind");
+  u.has_color = gl.GetUniformLocation(program, "u_has_color");
+  u.has_texture = gl.GetUniformLocation(program, "u_has_texture");
+  u.surface = gl.GetUniformLocation(program, "u_surface");
+  u.base_texture = gl.GetUniformLocation(program, "u_base_texture");
 
   gl.GenVertexArrays(1, &r.vao_);
-  GLuint buffers[5];
-  gl.GenBuffers(5, buffers);
+  GLuint buffers[7];
+  gl.GenBuffers(7, buffers);
   r.position_buffer_ = buffers[0];
   r.normal_buffer_ = buffers[1];
   r.distance_buffer_ = buffers[2];
   r.index_buffer_ = buffers[3];
   r.face_kind_buffer_ = buffers[4];
+  r.color_buffer_ = buffers[5];
+  r.uv_buffer_ = buffers[6];
   gl.GenTextures(1, &r.face_kind_texture_);
+  gl.GenTextures(1, &r.base_texture_);
 
   gl.BindVertexArray(r.vao_);
-  const GLuint per_vertex[3] = {r.position_buffer_, r.normal_buffer_, r.distance_buffer_};
-  const GLint sizes[3] = {3, 3, 1};
-  for (GLuint i = 0; i < 3; ++i) {
+  const GLuint per_vertex[5] = {r.position_buffer_, r.normal_buffer_, r.distance_buffer_,
+                                r.color_buffer_, r.uv_buffer_};
+  const GLint sizes[5] = {3, 3, 1, 4, 2};
+  for (GLuint i = 0; i < 5; ++i) {
     gl.BindBuffer(GL_ARRAY_BUFFER, per_vertex[i]);
     gl.EnableVertexAttribArray(i);
     gl.VertexAttribPointer(i, sizes[i], GL_FLOAT, GL_FALSE, 0, nullptr);
@@ -109,6 +151,13 @@ MeshRenderer& MeshRenderer::operator=(MeshRenderer&& other) noexcept {
     index_buffer_ = other.index_buffer_;
     face_kind_buffer_ = other.face_kind_buffer_;
     face_kind_texture_ = other.face_kind_texture_;
+    color_buffer_ = other.color_buffer_;
+    uv_buffer_ = other.uv_buffer_;
+    base_texture_ = other.base_texture_;
+    has_colors_ = other.has_colors_;
+    has_texture_ = other.has_texture_;
+    corner_vertex_ = std::move(other.corner_vertex_);
+    texture_key_ = other.texture_key_;
     vertex_count_ = other.vertex_count_;
     copied_from_ = std::move(other.copied_from_);
     triangle_count_ = other.triangle_count_;
@@ -123,10 +172,11 @@ MeshRenderer::~MeshRenderer() { release(); }
 void MeshRenderer::release() {
   if (!created_) return;
   created_ = false;
-  GLuint buffers[5] = {position_buffer_, normal_buffer_, distance_buffer_, index_buffer_,
-                       face_kind_buffer_};
-  gl_.DeleteBuffers(5, buffers);
+  GLuint buffers[7] = {position_buffer_,  normal_buffer_, distance_buffer_, index_buffer_,
+                       face_kind_buffer_, color_buffer_,  uv_buffer_};
+  gl_.DeleteBuffers(7, buffers);
   gl_.DeleteTextures(1, &face_kind_texture_);
+  gl_.DeleteTextures(1, &base_texture_);
   gl_.DeleteVertexArrays(1, &vao_);
   gl_.DeleteProgram(program_);
 }
@@ -141,10 +191,72 @@ void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_ki
     gl_.BindBuffer(target, buffer);
     gl_.BufferData(target, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
   };
+  const uint32_t F = mesh.face_count();
+  const bool per_corner = !mesh.corner_colors.empty() || !mesh.corner_texcoords.empty() ||
+                          !mesh.corner_normals.empty() || mesh.materials.size() > 1;
+  const bool colors =
+      !mesh.colors.empty() || !mesh.corner_colors.empty() || !mesh.materials.empty();
+  std::vector<Vec4f> drawn_colors;
+  std::vector<Vec2f> drawn_uvs;
+  corner_vertex_.clear();
+  if (per_corner) {
+    // Every corner its own drawn vertex: positions and crease normals of
+    // its (split) vertex, its own colour, texture coordinate and normal.
+    std::vector<Vec3f> positions(3 * size_t(F)), normals(3 * size_t(F));
+    drawn_colors.assign(3 * size_t(F), Vec4f{1, 1, 1, 1});
+    drawn_uvs.assign(3 * size_t(F), Vec2f{0, 0});
+    corner_vertex_.resize(3 * size_t(F));
+    for (uint32_t f = 0; f < F; ++f) {
+      const Vec4f factor = material_color(mesh, f);
+      for (int k = 0; k < 3; ++k) {
+        const size_t c = 3 * size_t(f) + k;
+        const uint32_t v = mesh.triangles[f][k];
+        const uint32_t drawn = shading.triangles[f][k];
+        corner_vertex_[c] = v;
+        positions[c] = shading.positions[drawn];
+        normals[c] = mesh.corner_normals.empty() ? shading.normals[drawn]
+                                                 : normalized(mesh.corner_normals.at_corner(c));
+        Vec4f color = !mesh.corner_colors.empty() ? mesh.corner_colors.at_corner(c)
+                      : !mesh.colors.empty()      ? mesh.colors[v]
+                                                  : Vec4f{1, 1, 1, 1};
+        drawn_colors[c] = times(color, factor);
+        if (!mesh.corner_texcoords.empty())
+          drawn_uvs[c] = mesh.corner_texcoords.at_corner(c);
+        else if (!mesh.texcoords.empty())
+          drawn_uvs[c] = mesh.texcoords[v];
+      }
+    }
+    shading.positions = std::move(positions);
+    shading.normals = std::move(normals);
+    for (uint32_t f = 0; f < F; ++f) shading.triangles[f] = {3 * f, 3 * f + 1, 3 * f + 2};
+  } else {
+    // The mesh's vertices, then the crease copies, each with its vertex's values.
+    const Vec4f factor = material_color(mesh, 0);
+    const size_t n = shading.positions.size();
+    drawn_colors.assign(n, factor);
+    drawn_uvs.assign(n, Vec2f{0, 0});
+    auto source = [&](size_t i) {
+      return i < vertex_count_ ? uint32_t(i) : copied_from_[i - vertex_count_];
+    };
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t v = source(i);
+      if (!mesh.colors.empty()) drawn_colors[i] = times(mesh.colors[v], factor);
+      if (!mesh.texcoords.empty()) drawn_uvs[i] = mesh.texcoords[v];
+    }
+  }
+  has_colors_ = colors;
   send(GL_ARRAY_BUFFER, position_buffer_, shading.positions.size() * sizeof(Vec3f),
        shading.positions.data());
   send(GL_ARRAY_BUFFER, normal_buffer_, shading.normals.size() * sizeof(Vec3f),
        shading.normals.data());
+  send(GL_ARRAY_BUFFER, color_buffer_, drawn_colors.size() * sizeof(Vec4f), drawn_colors.data());
+  send(GL_ARRAY_BUFFER, uv_buffer_, drawn_uvs.size() * sizeof(Vec2f), drawn_uvs.data());
+  const bool uvs = !mesh.texcoords.empty() || !mesh.corner_texcoords.empty();
+  if (uvs) {
+    upload_texture(mesh);
+  } else {
+    has_texture_ = false;
+  }
   std::vector<float> zeros(shading.positions.size(), 0.0f);
   send(GL_ARRAY_BUFFER, distance_buffer_, zeros.size() * sizeof(float), zeros.data());
   has_distances_ = false;
@@ -166,12 +278,57 @@ void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_ki
   gl_.BindBuffer(GL_TEXTURE_BUFFER, 0);
 }
 
+void MeshRenderer::upload_texture(const Mesh& mesh) {
+  const int32_t t = shown_texture(mesh);
+  if (t < 0) {
+    has_texture_ = false;
+    return;
+  }
+  const std::vector<uint8_t>& bytes = mesh.textures[size_t(t)].bytes;
+  const uint64_t key = bytes_key(bytes);
+  if (key == texture_key_) {
+    has_texture_ = true;
+    return;
+  }
+  int w = 0, h = 0, n = 0;
+  std::unique_ptr<uint8_t, void (*)(void*)> pixels(
+      bytes.size() < size_t(INT32_MAX)
+          ? stbi_load_from_memory(bytes.data(), int(bytes.size()), &w, &h, &n, 4)
+          : nullptr,
+      stbi_image_free);
+  // An image that does not decode shows untextured (the decoder has
+  // checked its headers; a broken body is the only way here).
+  has_texture_ = pixels != nullptr;
+  texture_key_ = has_texture_ ? key : 0;
+  if (!has_texture_) return;
+  // Rows top first in the file, texture coordinate v = 0 at the bottom
+  // (glTF's v points down: its importers flip v when they read it).
+  gl_.BindTexture(GL_TEXTURE_2D, base_texture_);
+  gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  std::vector<uint8_t> flipped(size_t(w) * h * 4);
+  for (int y = 0; y < h; ++y)
+    std::memcpy(&flipped[size_t(h - 1 - y) * w * 4], pixels.get() + size_t(y) * w * 4,
+                size_t(w) * 4);
+  gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
+  gl_.GenerateMipmap(GL_TEXTURE_2D);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  gl_.BindTexture(GL_TEXTURE_2D, 0);
+}
+
 void MeshRenderer::upload_distances(const std::vector<float>& distances) {
   if (distances.size() != vertex_count_) return;
   std::vector<float> drawn;
-  drawn.reserve(distances.size() + copied_from_.size());
-  drawn.assign(distances.begin(), distances.end());
-  for (uint32_t v : copied_from_) drawn.push_back(distances[v]);
+  if (!corner_vertex_.empty()) {
+    drawn.resize(corner_vertex_.size());
+    for (size_t i = 0; i < drawn.size(); ++i) drawn[i] = distances[corner_vertex_[i]];
+  } else {
+    drawn.reserve(distances.size() + copied_from_.size());
+    drawn.assign(distances.begin(), distances.end());
+    for (uint32_t v : copied_from_) drawn.push_back(distances[v]);
+  }
   gl_.BindBuffer(GL_ARRAY_BUFFER, distance_buffer_);
   gl_.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(drawn.size() * sizeof(float)),
                  drawn.data(), GL_STATIC_DRAW);
@@ -203,11 +360,21 @@ void MeshRenderer::draw(const OrbitCamera& camera, int width, int height,
   gl_.ActiveTexture(GL_TEXTURE0);
   gl_.BindTexture(GL_TEXTURE_BUFFER, face_kind_texture_);
   gl_.Uniform1i(uniforms_.face_kind, 0);
+  gl_.Uniform1i(uniforms_.has_color, has_colors_ ? 1 : 0);
+  gl_.Uniform1i(uniforms_.has_texture, has_texture_ ? 1 : 0);
+  gl_.Uniform1i(uniforms_.surface, static_cast<int>(style.surface));
+  gl_.ActiveTexture(GL_TEXTURE1);
+  gl_.BindTexture(GL_TEXTURE_2D, base_texture_);
+  gl_.Uniform1i(uniforms_.base_texture, 1);
+  gl_.ActiveTexture(GL_TEXTURE0);
   gl_.BindVertexArray(vao_);
   gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(triangle_count_ * 3), GL_UNSIGNED_INT,
                    nullptr);
   gl_.BindVertexArray(0);
   gl_.BindTexture(GL_TEXTURE_BUFFER, 0);
+  gl_.ActiveTexture(GL_TEXTURE1);
+  gl_.BindTexture(GL_TEXTURE_2D, 0);
+  gl_.ActiveTexture(GL_TEXTURE0);
   gl_.UseProgram(0);
   gl_.Disable(GL_DEPTH_TEST);
 }

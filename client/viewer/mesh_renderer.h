@@ -30,8 +30,16 @@ enum class ColorMode : int {
   kDistance = 2,  // per-vertex distance ramp, blue (0) to red (distance_max)
 };
 
+// How ColorMode::kShaded shows a mesh with colours or a texture.
+enum class SurfaceMode : int {
+  kLit = 0,        // base colour x texture, lit
+  kBaseColor = 1,  // the vertex / material colour alone, unlit
+  kTexture = 2,    // the texture alone, unlit
+};
+
 struct RenderStyle {
   ColorMode coloring = ColorMode::kShaded;
+  SurfaceMode surface = SurfaceMode::kLit;
   bool wireframe = false;
   float wire_width_px = 1.0f;
   float distance_max = 1.0f;  // the distance shown in full red
@@ -62,6 +70,16 @@ class MeshRenderer {
   void upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
               float crease_degrees = 0.0f);
 
+  // Colours and texture (ColorMode::kShaded): per-vertex or per-corner
+  // colours times the material's base colour factor, per-vertex or
+  // per-corner texture coordinates, and the base colour texture of the
+  // material of face 0 (one texture per mesh: a mesh whose materials use
+  // several shows the first one's), decoded with stb_image and kept while
+  // its bytes stay the same. With any per-corner attribute or several
+  // materials every corner gets its own drawn vertex.
+  bool has_colors() const { return has_colors_; }
+  bool has_texture() const { return has_texture_; }
+
   // Per-vertex distances for ColorMode::kDistance; ignored unless the size
   // equals the uploaded mesh's vertex count (copies made at creases take
   // their vertex's distance). O(V).
@@ -72,7 +90,10 @@ class MeshRenderer {
   void draw(const OrbitCamera& camera, int width, int height, const RenderStyle& style) const;
 
   uint32_t vertex_count() const { return vertex_count_; }  // of the uploaded mesh
-  uint32_t drawn_vertex_count() const { return vertex_count_ + uint32_t(copied_from_.size()); }
+  uint32_t drawn_vertex_count() const {
+    return corner_vertex_.empty() ? vertex_count_ + uint32_t(copied_from_.size())
+                                  : uint32_t(corner_vertex_.size());
+  }
   uint32_t triangle_count() const { return triangle_count_; }
   bool has_distances() const { return has_distances_; }
 
@@ -85,12 +106,21 @@ class MeshRenderer {
   GLuint vao_ = 0;
   GLuint position_buffer_ = 0, normal_buffer_ = 0, distance_buffer_ = 0, index_buffer_ = 0;
   GLuint face_kind_buffer_ = 0, face_kind_texture_ = 0;
+  GLuint color_buffer_ = 0, uv_buffer_ = 0, base_texture_ = 0;
+  bool has_colors_ = false, has_texture_ = false;
+  // Per drawn vertex, the mesh vertex it shows, when corners are drawn
+  // apart (empty otherwise: the drawn vertices are the mesh's, then the
+  // crease copies).
+  std::vector<uint32_t> corner_vertex_;
+  uint64_t texture_key_ = 0;  // hash of the texture bytes now in base_texture_ (0: none)
+  void upload_texture(const Mesh& mesh);
   uint32_t vertex_count_ = 0, triangle_count_ = 0;
   std::vector<uint32_t> copied_from_;  // the vertex each crease copy repeats
   bool has_distances_ = false;
   struct Uniforms {
     GLint view = -1, projection = -1, viewport = -1, coloring = -1, wireframe = -1, wire_width = -1,
-          distance_max = -1, face_kind = -1;
+          distance_max = -1, face_kind = -1, has_color = -1, has_texture = -1, surface = -1,
+          base_texture = -1;
   } uniforms_;
 };
 

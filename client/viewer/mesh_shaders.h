@@ -7,12 +7,18 @@ inline constexpr const char* kVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in float a_distance;
+layout(location = 3) in vec4 a_color;
+layout(location = 4) in vec2 a_uv;
 uniform mat4 u_view;
 uniform mat4 u_projection;
 out vec3 v_view_pos;
 out vec3 v_view_normal;
 out float v_distance;
+out vec4 v_color;
+out vec2 v_uv;
 void main() {
+  v_color = a_color;
+  v_uv = a_uv;
   vec4 view_pos = u_view * vec4(a_position, 1.0);
   v_view_pos = view_pos.xyz;
   v_view_normal = mat3(u_view) * a_normal;  // the view has no scaling
@@ -30,10 +36,14 @@ layout(triangle_strip, max_vertices = 3) out;
 in vec3 v_view_pos[];
 in vec3 v_view_normal[];
 in float v_distance[];
+in vec4 v_color[];
+in vec2 v_uv[];
 uniform vec2 u_viewport;
 out vec3 g_view_pos;
 out vec3 g_view_normal;
 out float g_distance;
+out vec4 g_color;
+out vec2 g_uv;
 noperspective out vec3 g_edge_px;
 flat out int g_face;
 void main() {
@@ -53,6 +63,8 @@ void main() {
     g_view_pos = v_view_pos[i];
     g_view_normal = v_view_normal[i];
     g_distance = v_distance[i];
+    g_color = v_color[i];
+    g_uv = v_uv[i];
     g_edge_px = vec3(i == 0 ? heights.x : 0.0, i == 1 ? heights.y : 0.0, i == 2 ? heights.z : 0.0);
     g_face = gl_PrimitiveIDIn;
     gl_Position = gl_in[i].gl_Position;
@@ -66,6 +78,8 @@ inline constexpr const char* kFragment = R"(#version 330 core
 in vec3 g_view_pos;
 in vec3 g_view_normal;
 in float g_distance;
+in vec4 g_color;
+in vec2 g_uv;
 noperspective in vec3 g_edge_px;
 flat in int g_face;
 uniform int u_coloring;
@@ -73,6 +87,13 @@ uniform int u_wireframe;
 uniform float u_wire_width;
 uniform float u_distance_max;
 uniform usamplerBuffer u_face_kind;
+// The surface's own look (ColorMode 0): per-vertex (or per-corner) base
+// colour times the base colour texture, lit (u_surface 0), unlit without
+// the texture (1: base colour), or the texture alone, unlit (2).
+uniform int u_has_color;
+uniform int u_has_texture;
+uniform int u_surface;
+uniform sampler2D u_base_texture;
 out vec4 frag_color;
 
 // Blue (0) - cyan - green - yellow - red (1).
@@ -88,7 +109,20 @@ vec3 ramp(float t) {
 
 void main() {
   vec3 base = vec3(0.78, 0.76, 0.72);
-  if (u_coloring == 1) {
+  bool lit = true;
+  if (u_coloring == 0 && (u_has_color != 0 || u_has_texture != 0)) {
+    vec3 albedo = u_has_color != 0 ? g_color.rgb : vec3(1.0);
+    vec3 texel = u_has_texture != 0 ? texture(u_base_texture, g_uv).rgb : vec3(1.0);
+    if (u_surface == 1) {
+      base = u_has_color != 0 ? albedo : base;
+      lit = false;
+    } else if (u_surface == 2) {
+      base = u_has_texture != 0 ? texel : base;
+      lit = false;
+    } else {
+      base = albedo * texel;
+    }
+  } else if (u_coloring == 1) {
     uint kind = texelFetch(u_face_kind, g_face).r;
     base = kind == 1u ? vec3(0.95, 0.55, 0.15) : (kind == 2u ? vec3(0.35, 0.80, 0.35)
                                                              : vec3(0.55, 0.62, 0.75));
@@ -104,7 +138,8 @@ void main() {
   float diffuse = max(dot(n, key), 0.0);
   float fill_light = max(dot(n, fill), 0.0);
   float specular = pow(max(dot(n, normalize(key + v)), 0.0), 48.0);
-  vec3 color = base * (0.20 + 0.70 * diffuse + 0.30 * fill_light) + vec3(0.22) * specular;
+  vec3 color = lit ? base * (0.20 + 0.70 * diffuse + 0.30 * fill_light) + vec3(0.22) * specular
+                  : base;
   if (u_wireframe != 0) {
     float d = min(g_edge_px.x, min(g_edge_px.y, g_edge_px.z));
     float coverage = 1.0 - smoothstep(u_wire_width * 0.5, u_wire_width * 0.5 + 1.0, d);

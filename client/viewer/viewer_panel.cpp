@@ -95,6 +95,12 @@ PanelActions draw_panel(PanelState& state, const DisplayFrame& latest, const Dis
     if (ImGui::Combo("colour", &coloring, "shaded\0what ASA did\0distance to final\0")) {
       state.coloring = static_cast<ColorMode>(coloring);
     }
+    if (state.coloring == ColorMode::kShaded && state.mesh_has_surface) {
+      int surface = static_cast<int>(state.surface);
+      if (ImGui::Combo("surface", &surface, "lit\0base colour\0texture\0")) {
+        state.surface = static_cast<SurfaceMode>(surface);
+      }
+    }
     if (state.coloring == ColorMode::kAsaKinds) {
       ImGui::TextColored(ImVec4(0.55f, 0.62f, 0.75f, 1), "untouched");
       ImGui::SameLine();

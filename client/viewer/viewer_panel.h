@@ -15,6 +15,10 @@ namespace meshstream::client {
 struct PanelState {
   // display
   ColorMode coloring = ColorMode::kShaded;
+  // Shaded mode on a mesh with colours or a texture: lit base colour x
+  // texture, the base colour alone, or the texture alone.
+  SurfaceMode surface = SurfaceMode::kLit;
+  bool mesh_has_surface = false;  // the shown mesh has colours or a texture
   bool wireframe = false;
   bool distance_auto = true;  // ramp maximum = 98th percentile of the distances
   float distance_p98 = 0;

@@ -416,6 +416,8 @@ class ViewerLoop {
   // the last frame (options.exit_after_frames / exit_after_records).
   bool draw_model(const FrameGeometry& g) {
     style_.coloring = panel_.coloring;
+    style_.surface = panel_.surface;
+    panel_.mesh_has_surface = renderer_.has_colors() || renderer_.has_texture();
     style_.wireframe = panel_.wireframe;
     style_.distance_max = panel_.distance_auto ? std::max(panel_.distance_p98, 1e-12f)
                                                : panel_.distance_max_percent / 100.0f *

@@ -26,6 +26,10 @@ struct SplitInput {
   // Adaptive split with want_topology: the level's unit face normals; the
   // output then gets its own (out.normals, out.fresh). Null: none written.
   const Vec3f* normals = nullptr;
+  // Per vertex id: the two vertices a new vertex was made between, at
+  // 2 id and 2 id + 1 (for corner attributes, corner_attributes.h); sized
+  // by the caller for every new vertex; null: not recorded.
+  uint32_t* parents = nullptr;
 };
 
 struct SplitScratch {
@@ -59,6 +63,10 @@ inline void start_vertex_attributes(const SplitInput& in, uint32_t V, uint32_t E
 // (linear, so colours stay in range and texture coordinates on their chart).
 inline void average_vertex_attributes(const SplitInput& in, uint32_t a, uint32_t b, uint32_t id,
                                       LevelMesh& out) {
+  if (in.parents) {
+    in.parents[2 * size_t(id)] = a;
+    in.parents[2 * size_t(id) + 1] = b;
+  }
   if (in.colors) {
     const Vec4f ca = in.colors[a], cb = in.colors[b];
     out.colors[id] = {(ca.x + cb.x) * 0.5f, (ca.y + cb.y) * 0.5f, (ca.z + cb.z) * 0.5f,

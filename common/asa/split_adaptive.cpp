@@ -166,7 +166,7 @@ void place_vertices(const SplitInput& in, uint32_t E, SplitScratch& s, LevelMesh
   start_vertex_attributes(in, V, E, out);
   compute_edge_points(m, s.edge_vertex.data(), V, E, *in.weights, in.placement,
                       out.positions.data(), s.points, &s.naming);
-  if (in.colors == nullptr && in.texcoords == nullptr) return;
+  if (in.colors == nullptr && in.texcoords == nullptr && in.parents == nullptr) return;
   for (uint32_t k = 0; k < E; ++k) {
     const uint32_t c = s.naming[k];
     average_vertex_attributes(in, cv[next_corner(c)], cv[prev_corner(c)], V + k, out);

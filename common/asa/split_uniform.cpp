@@ -36,7 +36,7 @@ void name_edges(const SplitInput& in, uint32_t* edge_of, LevelMesh& out) {
   const uint32_t corners = 3 * m.face_count;
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
-  const bool attributes = in.colors != nullptr || in.texcoords != nullptr;
+  const bool attributes = in.colors != nullptr || in.texcoords != nullptr || in.parents;
   const bool topology = in.want_topology;
   uint32_t next_id = m.vertex_count;
   const uint8_t* parent_feature = m.feature_edge;

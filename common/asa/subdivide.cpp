@@ -10,6 +10,7 @@
 
 #include "common/asa/butterfly_stencils.h"
 #include "common/asa/closure.h"
+#include "common/asa/corner_attributes.h"
 #include "common/asa/corner_table.h"
 #include "common/asa/flatness.h"
 #include "common/asa/level_mesh.h"
@@ -28,6 +29,7 @@ struct AsaWorkspace::Buffers {
   std::vector<uint8_t> target;
   std::vector<uint8_t> fresh;      // per face of the current level: made by the last split
   std::vector<uint32_t> identity;  // level-0 source faces
+  std::vector<uint32_t> parents;   // per vertex id: its two parents (corner_attributes.h)
   AsaStats stats;
 };
 
@@ -230,6 +232,12 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     result.mesh.triangles = mesh.triangles;
     result.mesh.colors = mesh.colors;
     result.mesh.texcoords = mesh.texcoords;
+    result.mesh.corner_normals = mesh.corner_normals;
+    result.mesh.corner_colors = mesh.corner_colors;
+    result.mesh.corner_texcoords = mesh.corner_texcoords;
+    result.mesh.face_materials = mesh.face_materials;
+    result.mesh.materials = mesh.materials;
+    result.mesh.textures = mesh.textures;
     result.mesh.normals.clear();
     if (!mesh.normals.empty()) result.mesh.normals = compute_vertex_normals(result.mesh);
     result.face_kind.assign(F, FaceKind::kUntouched);
@@ -247,7 +255,10 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   in.weights = &ws.weights;
   in.placement = options.rule == ButterflyRule::kProjection ? asa::EdgePlacement::kProjection
                                                             : asa::EdgePlacement::kZorin;
-  if (options.track_source_faces) {
+  // Per-corner attributes and face materials need every output face's
+  // source and every new vertex's parents (corner_attributes.h).
+  const bool corner_data = asa::has_corner_data(mesh);
+  if (options.track_source_faces || corner_data) {
     ws.identity.resize(F);
     for (uint32_t f = 0; f < F; ++f) ws.identity[f] = f;
     in.source = ws.identity.data();
@@ -263,11 +274,32 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
   }
 
   const bool normals = !mesh.normals.empty();
+  // Carries the corner data onto the result (and drops the source faces
+  // when only they needed them).
+  auto finish = [&]() {
+    // Mesh-wide: the materials and the images they use.
+    result.mesh.materials = mesh.materials;
+    result.mesh.textures = mesh.textures;
+    if (!corner_data) {  // nothing of an earlier call's result stays
+      result.mesh.corner_normals = {};
+      result.mesh.corner_colors = {};
+      result.mesh.corner_texcoords = {};
+      result.mesh.face_materials.clear();
+      return;
+    }
+    asa::carry_corner_attributes(mesh, result.source_face, ws.parents, result.mesh);
+    if (!options.track_source_faces) result.source_face.clear();
+  };
   for (int level = 0; level < options.levels; ++level) {
     const bool last = level + 1 == options.levels;
     asa::LevelMesh& out = ws.levels[level % 2];
     in.want_topology = !last;
     in.normals = nullptr;
+    if (corner_data) {
+      // Every edge may get a vertex: at most 3 per face.
+      ws.parents.resize(2 * (size_t(in.mesh.vertex_count) + 3 * size_t(in.mesh.face_count)));
+      in.parents = ws.parents.data();
+    }
     std::vector<FaceKind>* kinds = last ? &result.face_kind : nullptr;
     if (options.uniform) {
       asa::split_uniform(in, ws.scratch, out, kinds);
@@ -283,6 +315,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
         ws.stats.targets.push_back(0);
         ws.stats.split_edges.push_back(0);
       }
+      finish();
       return {};
     }
     if (!last)
@@ -290,6 +323,7 @@ Status subdivide_into(const Mesh& mesh, const AsaOptions& options, AsaWorkspace&
     else
       take_last_level(out, in.source != nullptr, normals, result);
   }
+  finish();
   return {};
 }
 

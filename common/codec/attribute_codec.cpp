@@ -1044,7 +1044,7 @@ void AttributeDecoder::write_face(const EditableMesh& m, uint32_t f, Mesh& out) 
   }
 }
 
-void AttributeDecoder::write_mesh(const EditableMesh& m, Mesh& out) const {
+void AttributeDecoder::write_materials(Mesh& out) const {
   if (!active_) return;
   out.materials = layout_.materials;
   const int32_t textures = int32_t(out.textures.size());
@@ -1053,6 +1053,11 @@ void AttributeDecoder::write_mesh(const EditableMesh& m, Mesh& out) const {
                        &m.occlusion_texture, &m.emissive_texture})
       if (*t >= textures || *t < -1) *t = -1;
   }
+}
+
+void AttributeDecoder::write_mesh(const EditableMesh& m, Mesh& out) const {
+  if (!active_) return;
+  write_materials(out);
   write_vertex_values(0, out);
   const uint32_t faces = m.face_slot_count();
   for (const AttributeChannel& c : layout_.channels) {

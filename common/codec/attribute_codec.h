@@ -32,12 +32,13 @@
 #include "common/base/result.h"
 #include "common/codec/attribute_quantize.h"
 #include "common/codec/editable_mesh.h"
+#include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
 
 namespace meshstream {
 
-// First payload byte of an attribute record (stream_format.h's record flags).
-inline constexpr uint8_t kRecordAttributes = 4;
+// An attribute record's first payload byte is kRecordAttributes
+// (stream_format.h); its second says which part it is.
 inline constexpr uint8_t kAttributePartBase = 0;   // record 1
 inline constexpr uint8_t kAttributePartFinal = 1;  // the last record
 // Wedge key of the wedge the boundary ends; kNone (editable_mesh.h): the
@@ -136,6 +137,9 @@ class AttributeDecoder {
   // Writes every attribute array of `out` for `m` (whose vertices all have
   // values: call preview first).
   void write_mesh(const EditableMesh& m, Mesh& out) const;
+  // The material table alone, for the textures `out` holds now (a texture
+  // record made more of them valid).
+  void write_materials(Mesh& out) const;
   // The material table as the stream has it, texture indices included
   // (write_mesh drops the indices of textures `out` does not hold, so the
   // mesh stays valid until the images arrive).

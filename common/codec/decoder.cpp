@@ -13,6 +13,7 @@
 #include "common/codec/quantize.h"
 #include "common/codec/refinement_codec.h"
 #include "common/codec/stream_format.h"
+#include "common/codec/texture_record.h"
 
 namespace meshstream {
 
@@ -52,6 +53,11 @@ struct IncrementalDecoder::State {
   // that failed its checksum before being applied): fetching the bytes again
   // may succeed, so resume_at clears it.
   bool error_recoverable = false;
+  // Texture records (texture_record.h): the textures so far, the level of
+  // each and whether it is the original (nothing may follow it).
+  std::vector<Texture> textures;
+  std::vector<uint32_t> texture_level;
+  std::vector<bool> texture_original;
 
   uint64_t consumed_end() const {
     if (!index) return 0;
@@ -116,26 +122,81 @@ struct IncrementalDecoder::State {
   }
 
   uint32_t known_attribute_vertices = 0;  // kEveryRecord: vertices whose values mesh has
+  uint32_t geometry_records = 0;          // structure and plane records applied
+  bool attributes_final = false;          // the final attribute record came
 
-  // Record 1 (the base's attributes) or the last record (everything else).
-  Status apply_attribute_record(uint32_t i, std::span<const uint8_t> payload) {
+  // The base's attributes, before any geometry record (only texture records
+  // may come between it and the base), or the inserted vertices' values,
+  // after every geometry record (only texture records may follow).
+  Status apply_attribute_record(std::span<const uint8_t> payload) {
     const StreamHeader& h = index->header;
     if (payload.size() >= 2 && payload[1] == kAttributePartBase) {
-      if (i != 1) return make_error(ErrorCode::kParse, "base attribute record is not record 1");
+      if (geometry_records > 0)
+        return make_error(ErrorCode::kParse, "base attribute record after a geometry record");
       if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
     } else {
-      if (i + 1 != index->records.size())
-        return make_error(ErrorCode::kParse, "final attribute record is not the last record");
+      if (attributes_final) return make_error(ErrorCode::kParse, "a second final attribute record");
       if (refine->mesh.vertex_count() != h.vertex_count ||
           refine->mesh.face_slot_count() != h.face_count)
         return make_error(ErrorCode::kParse, "final attribute record before the mesh is complete");
       if (auto s = attributes.read_final(payload, refine->mesh); !s) return s;
+      attributes_final = true;
     }
     if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
       attributes.preview(refine->mesh);
       attributes.write_mesh(refine->mesh, mesh);
       known_attribute_vertices = refine->mesh.vertex_count();
     }
+    return {};
+  }
+
+  // A texture record: checked (texture_record.h), then its image replaces
+  // the texture's smaller level. Levels of a texture only grow, textures
+  // are numbered in order of arrival, and the record adds nothing else.
+  Status apply_texture_record(uint32_t i, std::span<const uint8_t> payload, RecordDelta& delta) {
+    const RecordEntry& rec = index->records[i];
+    const RecordEntry& before = index->records[i - 1];
+    if (rec.vertices != before.vertices || rec.faces != before.faces) {
+      return make_error(ErrorCode::kParse, "texture record where the index says the mesh grows");
+    }
+    auto level = read_texture_record(payload);
+    if (!level) return tl::unexpected(level.error());
+    const uint32_t t = level->texture;
+    const std::string what = "texture " + std::to_string(t) + " (\"" + level->name + "\") level " +
+                             std::to_string(level->level);
+    if (t > textures.size()) {
+      return make_error(ErrorCode::kParse, what + ": textures " + std::to_string(textures.size()) +
+                                               ".." + std::to_string(t - 1) +
+                                               " have not come yet (textures come in order)");
+    }
+    if (t < textures.size()) {
+      if (texture_original[t]) {
+        return make_error(ErrorCode::kParse, what + ": comes after the original image");
+      }
+      if (level->level <= texture_level[t]) {
+        return make_error(ErrorCode::kParse,
+                          what + ": level " + std::to_string(texture_level[t]) + " came already");
+      }
+      if (level->name != textures[t].name) {
+        return make_error(ErrorCode::kParse,
+                          what + ": an earlier level is named \"" + textures[t].name + "\"");
+      }
+    } else {
+      textures.emplace_back();
+      texture_level.push_back(0);
+      texture_original.push_back(false);
+    }
+    textures[t].name = level->name;
+    textures[t].mime_type = mime_type_of(level->format);
+    textures[t].bytes = std::move(level->bytes);
+    texture_level[t] = level->level;
+    texture_original[t] = level->original;
+    if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+      mesh.textures = textures;
+      // The materials' indices of textures that had not come are valid now.
+      attributes.write_materials(mesh);
+    }
+    delta.textures_changed = true;
     return {};
   }
 
@@ -188,9 +249,15 @@ struct IncrementalDecoder::State {
         for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
       }
     } else if (!payload.empty() && payload[0] == kRecordAttributes) {
-      if (auto s = apply_attribute_record(i, payload); !s) return where(s.error());
+      if (auto s = apply_attribute_record(payload); !s) return where(s.error());
       delta.full_rebuild = true;
+    } else if (!payload.empty() && payload[0] == kRecordTexture) {
+      if (auto st = apply_texture_record(i, payload, delta); !st) return where(st.error());
     } else {
+      if (attributes_final) {
+        return where({ErrorCode::kParse, "a geometry record after the final attribute record"});
+      }
+      ++geometry_records;
       AppliedRecord applied;
       // Without an output mesh nobody follows the changes: the lists would
       // only grow (a whole stream fed at once keeps every record's delta).
@@ -332,6 +399,8 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
     out.positions.resize(q.size());
     const Dequantizer dequantize(s.grid);
     for (size_t v = 0; v < q.size(); ++v) out.positions[v] = dequantize(q[v]);
+    // Before the attributes: the materials keep the indices of textures held.
+    out.textures = std::move(s.textures);
     // Attributes need the faces still in the decoder's table.
     s.attributes.preview(s.refine->mesh);
     s.attributes.write_mesh(s.refine->mesh, out);
@@ -345,6 +414,9 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
   return out;
 }
 const std::vector<RecordDelta>& IncrementalDecoder::last_deltas() const { return state_->deltas; }
+const std::vector<bool>& IncrementalDecoder::textures_original() const {
+  return state_->texture_original;
+}
 
 bool IncrementalDecoder::error_is_recoverable() const {
   return state_->error && state_->error_recoverable;

@@ -33,6 +33,9 @@ struct RecordDelta {
   // moved vertices and no added vertices as a position update of exactly
   // those vertices (no face changes its corners).
   std::vector<uint32_t> moved_vertices;
+  // A texture record: mesh().textures changed (a texture arrived, or a
+  // larger level of it replaced the one shown). No vertex or face changed.
+  bool textures_changed = false;
 };
 
 // What the decoder keeps of the decoded mesh as records arrive.
@@ -73,7 +76,9 @@ class IncrementalDecoder {
   bool finished() const;
 
   // The current mesh: dequantized positions and triangles (kEveryRecord;
-  // empty with kOnRelease).
+  // empty with kOnRelease), and the textures received so far (each the
+  // largest level of it that arrived: a small preview first, the original
+  // image at last; texture_record.h).
   const Mesh& mesh() const;
   // The mesh after the last applied record, moved out of the decoder, which
   // is spent afterwards (further feeds fail). kTruncated before the base
@@ -85,6 +90,9 @@ class IncrementalDecoder {
   // What each record the last feed() applied changed, in order: one delta a
   // record, empty when that call completed none (feed clears them first).
   const std::vector<RecordDelta>& last_deltas() const;
+  // Per texture of mesh().textures: whether the level shown is the
+  // original image (else a smaller level of the pyramid).
+  const std::vector<bool>& textures_original() const;
 
   // True after an error that left the decoded state untouched: a record
   // that failed its checksum (checked before it is applied) or a damaged

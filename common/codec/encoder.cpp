@@ -19,6 +19,7 @@
 #include "common/codec/quantize.h"
 #include "common/codec/rd_measure.h"
 #include "common/codec/record_schedule.h"
+#include "common/codec/texture_stream.h"
 #include "common/metrics/bvh.h"
 
 namespace meshstream {
@@ -294,13 +295,13 @@ Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std:
 }  // namespace
 
 std::vector<std::string> encode_warnings(const Mesh& mesh) {
-  std::vector<std::string> warnings;
-  if (!mesh.textures.empty()) {
-    warnings.push_back(std::to_string(mesh.textures.size()) +
-                       " texture image(s) are not carried by the stream (the material table "
-                       "keeps their indices)");
-  }
-  return warnings;
+  // Everything a Mesh holds travels now: positions, faces, attributes with
+  // their seams, materials and extra attributes (attribute records) and the
+  // images (texture records). What import could not put into the Mesh is
+  // import's warning (CleanReport::notes). A field added to Mesh that the
+  // stream does not carry must be named here.
+  (void)mesh;
+  return {};
 }
 
 namespace {
@@ -398,6 +399,15 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   const RecordSizing sizing(mesh.vertex_count(), options);
   const bool parallel =
       measuring && options.threads != 1 && std::thread::hardware_concurrency() > 1;
+  // The chosen geometry stream with the attribute and texture records added.
+  auto finish = [&](EncodedStream& stream) -> Result<std::vector<uint8_t>> {
+    auto out = with_attributes(*plan, mesh, q, stream, report);
+    if (report) report->warnings = encode_warnings(mesh);
+    progress.stage("done", 1.0, 1.0);
+    if (!out) return out;
+    // Textures go in last: the record order and sizes above are the geometry's.
+    return add_texture_records(std::move(*out), mesh.textures);
+  };
   if (on_prefixes) {
     // The first candidate whole (it settles the record size, as before),
     // the others only as far as the measurement decodes them, at that record
@@ -428,32 +438,23 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
     auto best =
         measured_best(mesh, *grid, q, streams, sizing, false, progress, true, options.threads);
     if (!best) return tl::unexpected(best.error());
-    if (*best == 0) {
-      progress.stage("done", 1.0, 1.0);
-      return std::move(streams[0].bytes);
-    }
+    if (*best == 0) return finish(streams[0]);
     progress.stage("coding the winner", measured_at, 1.0);
     if (uses_surface(orderings[*best])) surface = grid_surface(mesh, q);
     EncodeReport winner_report;
     auto winner = encode_candidate(*best, first->record_bytes, report ? &winner_report : nullptr,
                                    progress.within_function());
     if (!winner) return tl::unexpected(winner.error());
-    progress.stage("done", 1.0, 1.0);
     if (sizing.automatic && sizing.granular(streams[0]) && !sizing.granular(*winner))
-      return std::move(streams[0].bytes);
+      return finish(streams[0]);
     if (report) *report = std::move(winner_report);
-    return std::move(winner->bytes);
+    return finish(*winner);
   }
 
   auto candidates = encode_candidates(encode_candidate, orderings.size(), sizing, parallel, report,
                                       progress.within_function());
   if (!candidates) return tl::unexpected(candidates.error());
-  if (!measuring) {
-    auto out = with_attributes(*plan, mesh, q, candidates->streams[0], report);
-    if (report) report->warnings = encode_warnings(mesh);
-    progress.stage("done", 1.0, 1.0);
-    return out;
-  }
+  if (!measuring) return finish(candidates->streams[0]);
   // The peer (EncodeOptions::measure_whole_candidates). What the
   // measurement does not need goes before it builds its own hierarchy over
   // the original: the peak is then one such hierarchy.
@@ -465,10 +466,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel, progress);
   if (!best) return tl::unexpected(best.error());
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
-  auto out = with_attributes(*plan, mesh, q, candidates->streams[*best], report);
-  if (report) report->warnings = encode_warnings(mesh);
-  progress.stage("done", 1.0, 1.0);
-  return out;
+  return finish(candidates->streams[*best]);
 }
 
 }  // namespace meshstream

@@ -99,5 +99,11 @@ inline constexpr uint32_t kMaxInsertedValence = 16;
 // has 0 or kRecordStartsLayer, a plane record exactly kRecordPlane.
 inline constexpr uint8_t kRecordStartsLayer = 1;
 inline constexpr uint8_t kRecordPlane = 2;
+// Records beside the geometry, told apart by this first byte too: the
+// attribute records (attribute_codec.h: record 1 the base's values, the last
+// geometry-bearing record the inserted vertices') and the texture records
+// (texture_record.h: pyramid levels of Mesh::textures).
+inline constexpr uint8_t kRecordAttributes = 4;
+inline constexpr uint8_t kRecordTexture = 8;
 
 }  // namespace meshstream

@@ -21,6 +21,7 @@
 #include "common/codec/encoder.h"
 #include "common/codec/quantize.h"
 #include "common/mesh/import.h"
+#include "common/mesh/textured_sphere.h"
 #include "tests/codec/attribute_test_util.h"
 #include "tests/test_meshes.h"
 
@@ -90,9 +91,9 @@ Mesh faceted_cube(int n) {
     mat.base_color_texture = k == 1 ? 0 : -1;
     m.materials.push_back(mat);
   }
-  // check_attribute_counts wants a texture for index 0: materials refer to
-  // textures by index, which the stream keeps (h18-tex carries the images).
-  m.textures.push_back(Texture{"t.png", "image/png", {1, 2, 3}});
+  // Materials refer to textures by index: a real (small) PNG for index 0,
+  // carried by the texture records.
+  m.textures.push_back(Texture{"t.png", "image/png", make_checker_png(16, 2)});
   for (const Vec3f& p : m.positions) {
     auto byte = [](float x) { return float(std::lround((x + 0.5f) * 255)) / 255.0f; };
     m.colors.push_back({byte(p.x), byte(p.y), byte(p.z), 1.0f});
@@ -190,15 +191,15 @@ TEST(AttributeCodec, FacetedCubeRoundTripsExactlyWithSeamsMaterialsAndExtras) {
   EXPECT_GT(report.attribute_locked_vertices, 0u);
   EXPECT_GT(report.attribute_bytes["seams"], 0u);
   EXPECT_GT(report.attribute_bytes["extra"], 0u);
-  ASSERT_FALSE(report.warnings.empty());  // the texture image is not carried here
+  EXPECT_TRUE(report.warnings.empty());  // everything travels, the image too
   auto decoded = decode_hcs(*stream);
   ASSERT_TRUE(decoded) << decoded.error().message;
   ASSERT_TRUE(check_attribute_counts(*decoded)) << check_attribute_counts(*decoded).error().message;
   Mesh expected = expected_mesh(cube, o);
-  // The images are not in the stream (yet: texture records), so the decoded
-  // table names no texture; the stream keeps the index (AttributeDecoder::materials).
-  expected.textures.clear();
-  for (Material& m : expected.materials) m.base_color_texture = -1;
+  // The image travels in texture records: the decoded table keeps its index.
+  ASSERT_EQ(decoded->textures.size(), cube.textures.size());
+  EXPECT_TRUE(decoded->textures[0].bytes == cube.textures[0].bytes);
+  expected.textures = cube.textures;
   EXPECT_TRUE(faces_of(*decoded) == faces_of(expected));
   expect_materials_equal(*decoded, expected);
   EXPECT_EQ(decoded->corner_normals.corners.size(), 3 * decoded->triangles.size());
@@ -300,11 +301,11 @@ TEST(AttributeCodec, DamagedAttributeRecordsAreRefused) {
   ASSERT_TRUE(get_varint(*stream, pos, layout_length));
   const uint64_t layout_at = pos;
   const Damage damages[] = {
-      {first.offset + 1, 1, "not the last record"},             // base part claims to be the final
+      {first.offset + 1, 1, "before the mesh is complete"},     // base part claims to be the final
       {first.offset + 3, 0xFF, "attribute record"},             // layout length past the record
       {layout_at + 1, 9, "unknown attribute kind"},             // first channel's kind
       {layout_at + 3, 40, "quantization bits"},                 // first channel's bits
-      {last.offset + 1, 0, "not record 1"},                     // final part claims to be the base
+      {last.offset + 1, 0, "after a geometry record"},          // final part claims to be the base
       {last.offset + last.size - 6, 0xFF, "attribute record"},  // the zstd frame's end
   };
   for (const Damage& d : damages) {

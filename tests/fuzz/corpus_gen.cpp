@@ -23,6 +23,7 @@
 #include "common/codec/record_index_coder.h"
 #include "common/mesh/export.h"
 #include "common/mesh/procedural.h"
+#include "common/mesh/textured_sphere.h"
 #include "proto/framing.h"
 
 namespace fs = std::filesystem;
@@ -164,6 +165,23 @@ int main(int argc, char** argv) {
       fixing.push_back(1);
       write(out / "hcs_decoder" / (m.name + (draco ? "_draco" : "_own") + "_fixcrc.hcs"), fixing);
     }
+  }
+  // Texture records (texture_record.h): a small textured sphere, so the
+  // fuzzer starts from streams with a preview and an original image.
+  {
+    EncodeOptions options;
+    options.target_base_vertices = 24;
+    options.record_bytes = 256;
+    options.plane_calibration = 1.0;
+    auto stream = encode_hcs(make_textured_uv_sphere(6, 10, 24), options);
+    if (!stream) {
+      std::cerr << "textured sphere: " << stream.error().message << "\n";
+      return 1;
+    }
+    write(out / "hcs_decoder" / "textured_sphere.hcs", with_trailer(*stream, 3));
+    std::vector<uint8_t> fixing = with_trailer(*stream, 3);
+    fixing.push_back(1);
+    write(out / "hcs_decoder" / "textured_sphere_fixcrc.hcs", fixing);
   }
   auto index = read_stream_index(sample_stream);
   if (!index) {

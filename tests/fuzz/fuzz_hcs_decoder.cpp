@@ -8,8 +8,10 @@
 // IncrementalDecoder fed piece by piece never crash, never read out of
 // bounds (ASan) and never hit undefined behaviour (UBSan); once the decoder
 // reports an error it stays in error and keeps its last good (valid) mesh, its
-// attribute arrays included (check_attribute_counts); a resume
-// at the decoder's own resume offset is accepted.
+// attribute arrays included (check_attribute_counts); a resume at the
+// decoder's own resume offset is accepted; every texture the decoder shows is
+// a whole PNG or JPEG image (texture records are checked before they are
+// shown), one original flag per texture.
 //
 // The container's CRC-32s would stop almost every mutation at the index or
 // at a record's checksum, so the payload decoders (base mesh, refinement
@@ -27,6 +29,7 @@
 #include "common/codec/container.h"
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
+#include "common/codec/texture_record.h"
 #include "common/mesh/mesh.h"
 
 namespace {
@@ -90,6 +93,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(validate_arrays(mesh).has_value());  // every index names a vertex
     // Attribute arrays as long as the vertex and corner arrays, indices in range.
     check(check_attribute_counts(mesh).has_value());
+  }
+  if (decoder.records_decoded() > 0) {
+    const Mesh& mesh = decoder.mesh();
+    check(mesh.textures.size() == decoder.textures_original().size());
+    for (const Texture& t : mesh.textures) check(check_image(t.bytes, t.name).has_value());
   }
   return 0;
 }
