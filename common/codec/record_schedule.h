@@ -23,7 +23,7 @@ struct EncodedStream {
   std::vector<uint8_t> bytes;
   size_t largest_refinement = 0;
   size_t records = 0;
-  uint64_t payload_offset = 0;  // bytes of magic, header and index
+  uint64_t payload_offset = 0;       // bytes of magic, header and index
   std::vector<uint32_t> to_decoder;  // input vertex id -> the decoder's id
 };
 

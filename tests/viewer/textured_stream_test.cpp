@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "client/viewer/rgba_image.h"
-#include "common/codec/decoder.h"
 #include "common/codec/container.h"
+#include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/codec/texture_record.h"
 #include "common/mesh/textured_sphere.h"
