@@ -53,7 +53,7 @@ struct Material {
   int32_t metallic_roughness_texture = -1;
   int32_t occlusion_texture = -1;
   int32_t emissive_texture = -1;
-  float metallic = 1.0f, roughness = 1.0f;   // glTF defaults
+  float metallic = 1.0f, roughness = 1.0f;  // glTF defaults
   bool double_sided = false;
 };
 
@@ -61,9 +61,7 @@ struct Material {
 // and weights, custom ones): carried byte for byte, one element per corner,
 // so it survives welding and every vertex split without being understood.
 struct ExtraAttribute {
-  enum class ComponentType : uint8_t {
-    kInt8, kUint8, kInt16, kUint16, kUint32, kFloat32
-  };
+  enum class ComponentType : uint8_t { kInt8, kUint8, kInt16, kUint16, kUint32, kFloat32 };
   std::string name;  // glTF semantic ("TANGENT", "TEXCOORD_1", "JOINTS_0") or PLY property
   ComponentType component_type = ComponentType::kFloat32;
   uint8_t components = 1;      // 1..4
@@ -75,11 +73,14 @@ struct ExtraAttribute {
 inline uint32_t component_size(ExtraAttribute::ComponentType type) {
   switch (type) {
     case ExtraAttribute::ComponentType::kInt8:
-    case ExtraAttribute::ComponentType::kUint8: return 1;
+    case ExtraAttribute::ComponentType::kUint8:
+      return 1;
     case ExtraAttribute::ComponentType::kInt16:
-    case ExtraAttribute::ComponentType::kUint16: return 2;
+    case ExtraAttribute::ComponentType::kUint16:
+      return 2;
     case ExtraAttribute::ComponentType::kUint32:
-    case ExtraAttribute::ComponentType::kFloat32: return 4;
+    case ExtraAttribute::ComponentType::kFloat32:
+      return 4;
   }
   return 4;
 }

@@ -70,13 +70,12 @@ Status check_attribute_counts(const Mesh& mesh) {
                            " vertices");
   }
   const size_t corners = 3 * mesh.triangles.size();
-  if (auto ok = check_corner_attribute(mesh.corner_normals, corners, mesh.normals.size(),
-                                       "normals");
+  if (auto ok =
+          check_corner_attribute(mesh.corner_normals, corners, mesh.normals.size(), "normals");
       !ok) {
     return ok;
   }
-  if (auto ok =
-          check_corner_attribute(mesh.corner_colors, corners, mesh.colors.size(), "colours");
+  if (auto ok = check_corner_attribute(mesh.corner_colors, corners, mesh.colors.size(), "colours");
       !ok) {
     return ok;
   }
@@ -113,9 +112,8 @@ Status check_attribute_counts(const Mesh& mesh) {
   for (size_t m = 0; m < mesh.materials.size(); ++m) {
     const Material& material = mesh.materials[m];
     for (int32_t texture :
-         {material.base_color_texture, material.normal_texture,
-          material.metallic_roughness_texture, material.occlusion_texture,
-          material.emissive_texture}) {
+         {material.base_color_texture, material.normal_texture, material.metallic_roughness_texture,
+          material.occlusion_texture, material.emissive_texture}) {
       if (auto ok = check_texture_index(texture, mesh.textures.size(), m); !ok) return ok;
     }
   }

@@ -32,8 +32,8 @@ struct Mesh {
   CornerAttribute<Vec2f> corner_texcoords;
 
   std::vector<Material> materials;
-  std::vector<uint32_t> face_materials;  // optional, per triangle: index into materials
-  std::vector<Texture> textures;         // images the materials use
+  std::vector<uint32_t> face_materials;          // optional, per triangle: index into materials
+  std::vector<Texture> textures;                 // images the materials use
   std::vector<ExtraAttribute> extra_attributes;  // carried, not modelled (attributes.h)
 
   uint32_t vertex_count() const { return static_cast<uint32_t>(positions.size()); }
