@@ -20,6 +20,8 @@ MESHSTREAM_PACKAGES=(
   clang-format  # scripts/check-format, run by scripts/test
   nginx  # tests/http: the HTTP stream path against a real web server
   haproxy curl  # deploy tests: servers behind a real HAProxy; scraping --metrics
+  libeigen3-dev  # glTF import: Draco's scene headers (node transforms) use Eigen
+  nodejs npm  # tests: the Khronos glTF validator (npm gltf-validator) on our glTF output
 )
 
 ms_install_packages() {

@@ -81,6 +81,18 @@ void apply_material_libraries(const std::string& obj_path, RawMesh& raw);
 // material files (they are looked up beside a path).
 Result<RawMesh> parse_obj_text(std::string_view text);
 
+// glTF 2.0: .gltf (external or embedded buffers and images) and .glb,
+// through Draco's scene reader (gltf_reader.cpp): every mesh instance of the
+// default scene with its node transform, one face material per primitive,
+// normals/texture coordinates/colours per corner (set 0; clean_mesh makes
+// them per vertex where they have no seam), other attributes (TANGENT,
+// TEXCOORD_1, JOINTS_0, ...) as extra attributes, images with their
+// original bytes. What is not carried (animations, skins, cameras, morph
+// targets, texture transforms, unknown extensions) is named in the notes.
+// A file Draco refuses, a truncated GLB or a missing buffer/image file is
+// an error naming the reason.
+Result<RawMesh> read_gltf(const std::string& path);
+
 // Binary STL and .drc through Draco's io (an .obj path goes to read_obj).
 // Positions are read per face corner through the point-to-value mapping, so
 // Draco's own de-duplication does not hide what the file holds. Normals,
