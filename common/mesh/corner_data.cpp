@@ -131,3 +131,87 @@ void settle_attribute_forms(Mesh& mesh) {
 }
 
 }  // namespace meshstream
+
+namespace meshstream {
+
+SplitMesh split_seams(const Mesh& mesh) {
+  SplitMesh out;
+  Mesh& m = out.mesh;
+  m.triangles = mesh.triangles;
+  m.materials = mesh.materials;
+  m.face_materials = mesh.face_materials;
+  m.textures = mesh.textures;
+  m.positions = mesh.positions;
+  m.normals = mesh.normals;
+  m.colors = mesh.colors;
+  m.texcoords = mesh.texcoords;
+  const bool cn = !mesh.corner_normals.empty(), cc = !mesh.corner_colors.empty(),
+             ct = !mesh.corner_texcoords.empty();
+  const uint32_t n = mesh.vertex_count();
+  if (cn) m.normals.assign(n, Vec3f{0, 0, 0});
+  if (cc) m.colors.assign(n, Vec4f{1, 1, 1, 1});
+  if (ct) m.texcoords.assign(n, Vec2f{0, 0});
+  out.vertex_extras.resize(mesh.extra_attributes.size());
+  for (size_t e = 0; e < mesh.extra_attributes.size(); ++e)
+    out.vertex_extras[e].assign(static_cast<size_t>(n) * element_size(mesh.extra_attributes[e]), 0);
+  if (!cn && !cc && !ct && mesh.extra_attributes.empty()) return out;
+
+  // The key of a corner: its per-corner values' bytes.
+  std::string key;
+  auto corner_key = [&](size_t c) {
+    key.clear();
+    auto add = [&key](const void* p, size_t size) {
+      key.append(static_cast<const char*>(p), size);
+    };
+    if (cn) add(&mesh.corner_normals.at_corner(c), sizeof(Vec3f));
+    if (cc) add(&mesh.corner_colors.at_corner(c), sizeof(Vec4f));
+    if (ct) add(&mesh.corner_texcoords.at_corner(c), sizeof(Vec2f));
+    for (const ExtraAttribute& e : mesh.extra_attributes) {
+      const size_t size = element_size(e);
+      add(e.bytes.data() + c * size, size);
+    }
+  };
+  std::vector<std::string> first_key(n);
+  std::vector<uint8_t> seen(n, 0);
+  std::unordered_map<std::string, uint32_t> copies;  // vertex bytes + key -> copy
+  auto assign = [&](uint32_t v, size_t c) {
+    if (cn) m.normals[v] = mesh.corner_normals.at_corner(c);
+    if (cc) m.colors[v] = mesh.corner_colors.at_corner(c);
+    if (ct) m.texcoords[v] = mesh.corner_texcoords.at_corner(c);
+    for (size_t e = 0; e < mesh.extra_attributes.size(); ++e) {
+      const size_t size = element_size(mesh.extra_attributes[e]);
+      std::memcpy(out.vertex_extras[e].data() + static_cast<size_t>(v) * size,
+                  mesh.extra_attributes[e].bytes.data() + c * size, size);
+    }
+  };
+  for (size_t c = 0; c < 3 * mesh.triangles.size(); ++c) {
+    uint32_t& v = m.triangles[c / 3][c % 3];
+    corner_key(c);
+    if (!seen[v]) {
+      seen[v] = 1;
+      first_key[v] = key;
+      assign(v, c);
+      continue;
+    }
+    if (first_key[v] == key) continue;
+    std::string full(reinterpret_cast<const char*>(&v), sizeof v);
+    full += key;
+    auto [it, added] = copies.try_emplace(full, m.vertex_count());
+    if (added) {
+      const uint32_t original = v;
+      m.positions.push_back(mesh.positions[original]);
+      if (!m.normals.empty()) m.normals.push_back(m.normals[original]);
+      if (!m.colors.empty()) m.colors.push_back(m.colors[original]);
+      if (!m.texcoords.empty()) m.texcoords.push_back(m.texcoords[original]);
+      for (size_t e = 0; e < mesh.extra_attributes.size(); ++e)
+        out.vertex_extras[e].resize(out.vertex_extras[e].size() +
+                                    element_size(mesh.extra_attributes[e]));
+      assign(it->second, c);
+      ++out.split_copies;
+    }
+    v = it->second;
+  }
+  return out;
+}
+
+}  // namespace meshstream

@@ -103,3 +103,21 @@ extern template void compact_corner_values(CornerAttribute<Vec3f>&);
 extern template void compact_corner_values(CornerAttribute<Vec4f>&);
 
 }  // namespace meshstream
+
+namespace meshstream {
+
+// The mesh with every attribute per vertex, for formats that have no
+// corners (PLY, OFF, glTF): a vertex whose corners use different values is
+// split into one copy per distinct combination (position, normal, texture
+// coordinate, colour, extra attributes' bytes). Original vertices keep their
+// index (the first combination met); copies are appended. Extra attributes
+// become per-vertex bytes in `vertex_extras` (one element per vertex, same
+// order as mesh.extra_attributes). `split_copies` counts the copies made.
+struct SplitMesh {
+  Mesh mesh;  // per-vertex attributes only; extra_attributes left empty
+  std::vector<std::vector<uint8_t>> vertex_extras;
+  uint32_t split_copies = 0;
+};
+SplitMesh split_seams(const Mesh& mesh);
+
+}  // namespace meshstream

@@ -504,8 +504,6 @@ Status SceneFlattener::run() {
   raw_.contents.normals.count = mesh_.corner_normals.values.size();
   raw_.contents.texcoords.count = mesh_.corner_texcoords.values.size();
   raw_.contents.colors.count = mesh_.corner_colors.values.size();
-  for (const ExtraAttribute& extra : mesh_.extra_attributes)
-    raw_.contents.extra_properties.push_back(extra.name);
   return {};
 }
 
