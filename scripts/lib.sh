@@ -61,3 +61,27 @@ ms_find_meshes() {
   local candidate="$MESHSTREAM_ROOT/../shared/meshes"
   if [ -d "$candidate" ]; then (cd "$candidate" && pwd); fi
 }
+
+# The Khronos glTF validator (npm gltf-validator, a JS library) for the glTF
+# export tests: installed into DIR/node_modules when missing. Prints DIR/
+# node_modules on success; on failure (no npm, registry unreachable) prints
+# nothing and says why on stderr, so the tests skip visibly.
+MESHSTREAM_GLTF_VALIDATOR_VERSION=2.0.0-dev.3.10
+ms_gltf_validator() {
+  local dir="$1"
+  if [ -f "$dir/node_modules/gltf-validator/package.json" ]; then
+    echo "$dir/node_modules"
+    return 0
+  fi
+  if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
+    echo "gltf-validator: node/npm not installed (Debian nodejs, npm)" >&2
+    return 0
+  fi
+  mkdir -p "$dir"
+  if npm install --no-audit --no-fund --silent --prefix "$dir" \
+    "gltf-validator@$MESHSTREAM_GLTF_VALIDATOR_VERSION" >&2; then
+    echo "$dir/node_modules"
+  else
+    echo "gltf-validator: npm install failed (registry unreachable?)" >&2
+  fi
+}
