@@ -69,9 +69,9 @@ inline std::string gltf_validator_modules() {
                       "../shared/meshes beside the repository)";                       \
   } while (0)
 
-#define MESHSTREAM_REQUIRE_TEST_MODELS()                                              \
-  do {                                                                                \
-    if (::meshstream::testing::test_model_dir().empty())                              \
-      GTEST_SKIP() << "test models not found (set MESHSTREAM_TEST_MODELS or put "     \
-                      "../shared/models beside the repository)";                      \
+#define MESHSTREAM_REQUIRE_TEST_MODELS()                                          \
+  do {                                                                            \
+    if (::meshstream::testing::test_model_dir().empty())                          \
+      GTEST_SKIP() << "test models not found (set MESHSTREAM_TEST_MODELS or put " \
+                      "../shared/models beside the repository)";                  \
   } while (0)

@@ -5,6 +5,10 @@
 // its linear part; a mirroring transform reverses the winding, as glTF
 // says), every primitive's material as a face material.
 //
+// Texture coordinates: Draco turns glTF's v (down the image) into OBJ's
+// (up: 1 - v), the Mesh's convention (mesh.h); the writer turns it back.
+// Both flips are exact on values that came from a flip.
+//
 // Draco splits nothing further and merges equal attribute values, so a
 // point (glTF vertex) maps to a position value and to a value of each other
 // attribute: the positions become our vertices, the other attributes
@@ -195,8 +199,10 @@ std::string semantic_of(draco::GeometryAttribute::Type type, int set) {
 
 class SceneFlattener {
  public:
-  SceneFlattener(const draco::Scene& scene, const std::filesystem::path& folder, RawMesh& raw)
-      : scene_(scene), folder_(folder), raw_(raw), mesh_(raw.mesh) {}
+  // `file_has_materials`: the JSON has a materials array (Draco adds a
+  // default material to a file without one; we do not).
+  SceneFlattener(const draco::Scene& scene, bool file_has_materials, RawMesh& raw)
+      : scene_(scene), file_has_materials_(file_has_materials), raw_(raw), mesh_(raw.mesh) {}
 
   Status run();
 
@@ -208,7 +214,7 @@ class SceneFlattener {
                  const draco::Mesh& dm, const Eigen::Matrix3d& linear, bool reverse);
 
   const draco::Scene& scene_;
-  std::filesystem::path folder_;
+  bool file_has_materials_;
   RawMesh& raw_;
   Mesh& mesh_;
   std::unordered_map<const draco::Texture*, int32_t> texture_index_;
@@ -348,7 +354,9 @@ void SceneFlattener::add_extra(const std::string& name, const draco::PointAttrib
   }
   extra.bytes.resize(faces_before * size);
   const bool tangent =
-      name == "TANGENT" && type == ExtraAttribute::ComponentType::kFloat32 && extra.components >= 3;
+      name == "TANGENT" && type == ExtraAttribute::ComponentType::kFloat32 &&
+      extra.components >= 3 &&
+      linear != Eigen::Matrix3d::Identity();  // untouched bits when not transformed
   for (uint32_t f = 0; f < dm.num_faces(); ++f) {
     const auto& face = dm.face(draco::FaceIndex(f));
     for (int k = 0; k < 3; ++k) {
@@ -397,14 +405,17 @@ Status SceneFlattener::add_instance(const draco::Mesh& dm, const Matrix4& transf
   }
   raw_.vertices_in_file += dm.num_points();
 
-  if (material < 0) {
+  if (!file_has_materials_) {
+    // No materials in the file at all: none in the mesh either.
+  } else if (material < 0) {
     if (default_material_ < 0) {
       default_material_ = static_cast<int32_t>(mesh_.materials.size());
       mesh_.materials.push_back({.name = "(default material)"});
     }
     material = default_material_;
   }
-  mesh_.face_materials.resize(mesh_.triangles.size(), static_cast<uint32_t>(material));
+  if (material >= 0)
+    mesh_.face_materials.resize(mesh_.triangles.size(), static_cast<uint32_t>(material));
 
   // Corner attributes: the first of each kind; the rest are extra attributes.
   auto corners = [&](auto& target, const draco::PointAttribute& attribute, int n, float fill,
@@ -487,7 +498,7 @@ Status SceneFlattener::add_instance(const draco::Mesh& dm, const Matrix4& transf
 
 Status SceneFlattener::run() {
   if (auto s = add_textures(); !s) return s;
-  add_materials();
+  if (file_has_materials_) add_materials();
   const auto instances = draco::SceneUtils::ComputeAllInstances(scene_);
   if (instances.size() == 0) return make_error(ErrorCode::kInvalidMesh, "the scene has no mesh");
   for (auto i = draco::MeshInstanceIndex(0); i < instances.size(); ++i) {
@@ -546,7 +557,7 @@ Result<RawMesh> read_gltf(const std::string& path) {
   } catch (const std::exception& e) {
     return make_error(ErrorCode::kParse, std::string("Draco could not read it: ") + e.what());
   }
-  SceneFlattener flattener(*scene, std::filesystem::path(path).parent_path(), raw);
+  SceneFlattener flattener(*scene, array_size(*json, "materials") > 0, raw);
   if (auto s = flattener.run(); !s) return tl::unexpected(s.error());
   gltf_inventory(*json, raw.notes);
   return raw;

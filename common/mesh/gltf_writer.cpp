@@ -174,7 +174,7 @@ void GltfBuilder::add_primitive(uint32_t material, const std::vector<uint32_t>& 
       // glTF requires unit normals: values that are not (zeros a file
       // left, sloppy lengths) are normalized, zeros become +z.
       const float len = length(v);
-      if (!(std::fabs(len - 1.0f) <= 1e-4f))
+      if (!(std::fabs(len - 1.0f) <= 5e-4f))
         v = len > 0 && std::isfinite(len) ? v / len : Vec3f{0, 0, 1};
       values[i] = v;
     }
@@ -187,6 +187,7 @@ void GltfBuilder::add_primitive(uint32_t material, const std::vector<uint32_t>& 
       const uint32_t c = corner_of_vertex[i];
       values[i] =
           m.corner_texcoords.empty() ? m.texcoords[vertex_of(c)] : m.corner_texcoords.at_corner(c);
+      values[i].y = 1.0f - values[i].y;  // glTF's v runs down the image (mesh.h)
     }
     attributes["TEXCOORD_0"] =
         add_accessor(add_view(values.data(), n * sizeof(Vec2f), kArrayBuffer), kFloat, n, "VEC2");
