@@ -150,8 +150,10 @@ TEST(FileContents, RealFilesReportWhatTheyHold) {
   const ImportedMesh cube = import_ok(testing::test_mesh("cube_att.obj"));
   EXPECT_EQ(cube.contents.normals.count, 6u);
   EXPECT_EQ(cube.contents.texcoords.count, 4u);
-  EXPECT_FALSE(cube.contents.normals.dropped.empty());
-  EXPECT_FALSE(cube.contents.texcoords.dropped.empty());
+  // Per-face values are seams, kept per corner (issue 18).
+  EXPECT_TRUE(cube.contents.normals.dropped.empty());
+  EXPECT_TRUE(cube.contents.texcoords.dropped.empty());
+  EXPECT_FALSE(cube.mesh.corner_normals.empty());
 
   const ImportedMesh bunny = import_ok(testing::test_mesh("bun_zipper.ply"));
   EXPECT_TRUE(contains(bunny.contents.extra_properties, "vertex confidence (float)"));
@@ -164,7 +166,8 @@ TEST(FileContents, UsbModelTextureCoordinatesAndMaterial) {
     GTEST_SKIP() << "../shared/models/usb/usb.obj not found";
   const ImportedMesh m = import_ok(usb);
   EXPECT_EQ(m.contents.texcoords.count, 601u);
-  EXPECT_FALSE(m.contents.texcoords.dropped.empty());
+  EXPECT_TRUE(m.contents.texcoords.dropped.empty());  // kept per corner (issue 18)
+  EXPECT_FALSE(m.mesh.corner_texcoords.empty());
   ASSERT_EQ(m.contents.material_libraries.size(), 1u);
   const MaterialLibrary library = read_material_library(usb, m.contents.material_libraries[0].name);
   EXPECT_TRUE(library.found);
