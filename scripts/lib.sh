@@ -21,6 +21,8 @@ MESHSTREAM_PACKAGES=(
   clang-format  # scripts/check-format, run by scripts/test
   nginx  # tests/http: the HTTP stream path against a real web server
   haproxy curl  # deploy tests: servers behind a real HAProxy; scraping --metrics
+  libeigen3-dev  # glTF import: Draco's scene headers (node transforms) use Eigen
+  nodejs npm  # tests: the Khronos glTF validator (npm gltf-validator) on our glTF output
 )
 
 ms_install_packages() {
@@ -59,4 +61,28 @@ ms_find_meshes() {
   if [ -n "${MESHSTREAM_TEST_MESHES:-}" ]; then echo "$MESHSTREAM_TEST_MESHES"; return; fi
   local candidate="$MESHSTREAM_ROOT/../shared/meshes"
   if [ -d "$candidate" ]; then (cd "$candidate" && pwd); fi
+}
+
+# The Khronos glTF validator (npm gltf-validator, a JS library) for the glTF
+# export tests: installed into DIR/node_modules when missing. Prints DIR/
+# node_modules on success; on failure (no npm, registry unreachable) prints
+# nothing and says why on stderr, so the tests skip visibly.
+MESHSTREAM_GLTF_VALIDATOR_VERSION=2.0.0-dev.3.10
+ms_gltf_validator() {
+  local dir="$1"
+  if [ -f "$dir/node_modules/gltf-validator/package.json" ]; then
+    echo "$dir/node_modules"
+    return 0
+  fi
+  if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
+    echo "gltf-validator: node/npm not installed (Debian nodejs, npm)" >&2
+    return 0
+  fi
+  mkdir -p "$dir"
+  if npm install --no-audit --no-fund --silent --prefix "$dir" \
+    "gltf-validator@$MESHSTREAM_GLTF_VALIDATOR_VERSION" >&2; then
+    echo "$dir/node_modules"
+  else
+    echo "gltf-validator: npm install failed (registry unreachable?)" >&2
+  fi
 }

@@ -1,6 +1,8 @@
 // Mesh files imported and encoded by the encoder pool, cached by content
 // hash and encoder version (encode_cache.h) so a second start maps the
 // cache instead of encoding again.
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -55,6 +57,9 @@ EncodeTask mesh_file_task(const ModelFile& file, const std::string& cache_dir) {
     const EncodeJob job{file.name, "mesh", origin, *key, [origin]() -> Result<Mesh> {
                           auto imported = import_mesh(origin);
                           if (!imported) return tl::unexpected(imported.error());
+                          // What import could not carry, in the server log.
+                          for (const std::string& note : imported->report.notes)
+                            spdlog::warn("import {}: {}", origin, note);
                           return std::move(imported->mesh);
                         }};
     EncodeOutcome outcome = encode_cached(job, cache_dir, progress);

@@ -16,7 +16,8 @@ std::string lower(std::string s) {
 }
 
 bool is_mesh_extension(const std::string& ext) {
-  return ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".drc" || ext == ".off";
+  return ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".drc" || ext == ".off" ||
+         ext == ".gltf" || ext == ".glb";
 }
 
 // Why an entry that is neither .hcs nor a mesh file is skipped.
@@ -33,7 +34,7 @@ std::string skip_reason(const fs::directory_entry& entry, std::error_code& ec) {
 
 }  // namespace
 
-const char* served_extensions() { return ".hcs, .ply, .obj, .stl, .off, .drc"; }
+const char* served_extensions() { return ".hcs, .ply, .obj, .stl, .off, .drc, .gltf, .glb"; }
 
 Result<FolderScan> scan_models_folder(const std::string& dir) {
   std::error_code ec;

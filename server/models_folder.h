@@ -36,11 +36,11 @@ struct FolderScan {
   std::vector<NameClash> clashes;
 };
 
-// The extensions the server reads, for messages: ".hcs, .ply, .obj, .stl, .off, .drc".
+// The extensions the server reads, for messages: ".hcs, .ply, .obj, .stl, .off, .drc, .gltf, .glb".
 const char* served_extensions();
 
 // Lists `dir` (not its subfolders). Naming rule: `.hcs` files first, then
-// mesh files (.ply .obj .stl .off .drc, any case), each group in byte order
+// mesh files (.ply .obj .stl .off .drc .gltf .glb, any case), each group in byte order
 // of file name; a file is served under its name without extension unless an
 // earlier file took that name, then under its whole file name. Everything
 // else (other extensions, no extension, subfolders, special files) is

@@ -98,7 +98,8 @@ void add_compare_command(CLI::App& app, int& exit_code) {
       "compare",
       "Symmetric Hausdorff and RMS surface distance between two meshes, absolute and relative "
       "to A's bounding-box diagonal");
-  cmd->add_option("A", args->a, "first mesh (OBJ, PLY, STL, OFF, DRC); its diagonal is the scale")
+  cmd->add_option("A", args->a,
+                  "first mesh (OBJ, PLY, STL, OFF, DRC, glTF, GLB); its diagonal is the scale")
       ->required();
   cmd->add_option("B", args->b, "second mesh")->required();
   cmd->add_flag("--json", args->json, "one JSON object on stdout");

@@ -1,4 +1,4 @@
-// `meshstream decode IN.hcs -o OUT.ply|.obj|.stl|.off [--bytes N | --vertices
+// `meshstream decode IN.hcs -o OUT.ply|.obj|.stl|.off|.glb|.gltf [--bytes N | --vertices
 // N | --percent P | --percent-bytes P | --ratio CR]`: decode the whole
 // stream or the prefix a budget selects (HCS's decoder controls; --ratio 20
 // = 1/20 of the stream) and write the mesh.
@@ -82,7 +82,8 @@ void add_decode_command(CLI::App& app, int& exit_code) {
                          "short decodes up to its last complete record, with a warning)");
   auto args = std::make_shared<DecodeArgs>();
   cmd->add_option("input", args->input, ".hcs stream")->required();
-  cmd->add_option("-o,--output", args->output, "mesh to write (.ply, .obj, .stl or .off)")
+  cmd->add_option("-o,--output", args->output,
+                  "mesh to write (.ply, .obj, .stl, .off, .glb or .gltf)")
       ->required()
       ->check(mesh_output_validator());
   // The budget rule of every program: common/cli/budget_options.h.

@@ -43,6 +43,9 @@ int run_encode(const EncodeArgs& args) {
     bar.finish();
     return report_failure(imported.error());
   }
+  // What import could not carry (or changed), never dropped in silence.
+  for (const std::string& note : imported->report.notes)
+    std::fprintf(stderr, "meshstream encode: %s: warning: %s\n", args.input.c_str(), note.c_str());
   EncodeOptions options;
   options.quant_bits = args.quant_bits;
   options.target_base_vertices = args.base_vertices;

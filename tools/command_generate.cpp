@@ -44,7 +44,8 @@ void add_generate_command(CLI::App& app, int& exit_code) {
                   "(open, one boundary), components (several closed parts), torus (genus 1)")
       ->required()
       ->check(CLI::IsMember({"demo", "icosahedron", "icosphere", "grid", "components", "torus"}));
-  cmd->add_option("-o,--output", args->output, "output file (.ply, .obj, .off or .stl)")
+  cmd->add_option("-o,--output", args->output,
+                  "output file (.ply, .obj, .off, .stl, .glb or .gltf)")
       ->required()
       ->check(mesh_output_validator());
   cmd->add_option("--size", args->size,

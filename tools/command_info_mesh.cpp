@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/mesh/corner_data.h"
 #include "common/mesh/import.h"
 #include "common/mesh/topology.h"
 #include "tools/commands.h"
@@ -72,10 +73,13 @@ struct AttributeRow {
 
 std::vector<AttributeRow> attribute_rows(const ImportedMesh& m, bool obj) {
   const FileContents& c = m.contents;
-  return {{"normals", "normals", obj ? "'vn' lines" : "values", c.normals, !m.mesh.normals.empty()},
+  const Mesh& mesh = m.mesh;
+  return {{"normals", "normals", obj ? "'vn' lines" : "values", c.normals,
+           !mesh.normals.empty() || !mesh.corner_normals.empty()},
           {"texture coordinates", "texcoords", obj ? "'vt' lines" : "values", c.texcoords,
-           !m.mesh.texcoords.empty()},
-          {"colours", "colors", "vertices", c.colors, !m.mesh.colors.empty()}};
+           !mesh.texcoords.empty() || !mesh.corner_texcoords.empty()},
+          {"colours", "colors", "vertices", c.colors,
+           !mesh.colors.empty() || !mesh.corner_colors.empty()}};
 }
 
 // "kept by import and subdivide; not carried: ..." or "not kept by import:
@@ -134,14 +138,15 @@ void print_contents(const ImportedMesh& m, bool obj) {
                   l.name.c_str());
       continue;
     }
-    std::printf("  %-21s %s: %zu material%s (%s)%s%s; not read\n", "material library",
+    std::printf("  %-21s %s: %zu material%s (%s)%s%s; Kd and map_Kd kept\n", "material library",
                 l.name.c_str(), l.materials.size(), l.materials.size() == 1 ? "" : "s",
                 joined(l.materials).c_str(), l.textures.empty() ? "" : ", textures ",
                 joined(l.textures).c_str());
   }
   if (!c.materials_used.empty()) {
     any = true;
-    std::printf("  %-21s %s (not read)\n", "materials used", joined(c.materials_used).c_str());
+    std::printf("  %-21s %s (kept as face materials)\n", "materials used",
+                joined(c.materials_used).c_str());
   }
   if (!c.extra_properties.empty()) {
     any = true;
@@ -161,10 +166,143 @@ std::string attributes_of(const Mesh& m) {
     if (!a.empty()) a += ", ";
     a += name;
   };
-  add(!m.normals.empty(), "normals");
-  add(!m.colors.empty(), "colors");
-  add(!m.texcoords.empty(), "texture coordinates");
+  add(!m.normals.empty() || !m.corner_normals.empty(), "normals");
+  add(!m.colors.empty() || !m.corner_colors.empty(), "colors");
+  add(!m.texcoords.empty() || !m.corner_texcoords.empty(), "texture coordinates");
   return a.empty() ? "none" : a;
+}
+
+// How the mesh holds one attribute kind: per vertex, or per corner with
+// its value count and the vertices on a seam.
+struct AttributeForm {
+  const char* name;
+  const char* key;
+  std::string form;  // "", "vertex", "corner"
+  size_t values = 0;
+  uint32_t seam_vertices = 0;
+};
+
+template <typename T>
+AttributeForm form_of(const Mesh& m, const char* name, const char* key,
+                      const std::vector<T>& per_vertex, const CornerAttribute<T>& corner) {
+  AttributeForm f{name, key, "", 0, 0};
+  if (!per_vertex.empty()) {
+    f.form = "vertex";
+    f.values = per_vertex.size();
+  } else if (!corner.empty()) {
+    f.form = "corner";
+    f.values = corner.values.size();
+    f.seam_vertices = count_seam_vertices(m, corner);
+  }
+  return f;
+}
+
+std::vector<AttributeForm> attribute_forms(const Mesh& m) {
+  return {form_of(m, "normals", "normals", m.normals, m.corner_normals),
+          form_of(m, "texcoords", "texcoords", m.texcoords, m.corner_texcoords),
+          form_of(m, "colours", "colors", m.colors, m.corner_colors)};
+}
+
+const char* component_name(ExtraAttribute::ComponentType type) {
+  switch (type) {
+    case ExtraAttribute::ComponentType::kInt8:
+      return "int8";
+    case ExtraAttribute::ComponentType::kUint8:
+      return "uint8";
+    case ExtraAttribute::ComponentType::kInt16:
+      return "int16";
+    case ExtraAttribute::ComponentType::kUint16:
+      return "uint16";
+    case ExtraAttribute::ComponentType::kUint32:
+      return "uint32";
+    case ExtraAttribute::ComponentType::kFloat32:
+      return "float32";
+  }
+  return "?";
+}
+
+std::string texture_name(const Mesh& m, int32_t index) {
+  if (index < 0 || static_cast<size_t>(index) >= m.textures.size()) return "";
+  return m.textures[index].name;
+}
+
+nlohmann::json mesh_attributes_json(const Mesh& m) {
+  nlohmann::json forms = nlohmann::json::object();
+  for (const AttributeForm& f : attribute_forms(m)) {
+    if (f.form.empty()) continue;
+    forms[f.key] = {{"per", f.form}, {"values", f.values}, {"seam_vertices", f.seam_vertices}};
+  }
+  nlohmann::json materials = nlohmann::json::array();
+  std::vector<size_t> faces_of(m.materials.size(), 0);
+  for (uint32_t id : m.face_materials) {
+    if (id < faces_of.size()) ++faces_of[id];
+  }
+  for (size_t i = 0; i < m.materials.size(); ++i) {
+    const Material& mat = m.materials[i];
+    materials.push_back(
+        {{"name", mat.name},
+         {"base_color", {mat.base_color.x, mat.base_color.y, mat.base_color.z, mat.base_color.w}},
+         {"base_color_texture", mat.base_color_texture},
+         {"normal_texture", mat.normal_texture},
+         {"metallic_roughness_texture", mat.metallic_roughness_texture},
+         {"occlusion_texture", mat.occlusion_texture},
+         {"emissive_texture", mat.emissive_texture},
+         {"faces", faces_of[i]}});
+  }
+  nlohmann::json textures = nlohmann::json::array();
+  for (const Texture& t : m.textures)
+    textures.push_back({{"name", t.name}, {"mime_type", t.mime_type}, {"bytes", t.bytes.size()}});
+  nlohmann::json extras = nlohmann::json::array();
+  for (const ExtraAttribute& e : m.extra_attributes) {
+    extras.push_back({{"name", e.name},
+                      {"component_type", component_name(e.component_type)},
+                      {"components", e.components},
+                      {"normalized", e.normalized},
+                      {"bytes", e.bytes.size()}});
+  }
+  return {{"attribute_forms", forms},
+          {"materials", materials},
+          {"textures", textures},
+          {"extra_attributes", extras}};
+}
+
+void print_mesh_attributes(const Mesh& m) {
+  for (const AttributeForm& f : attribute_forms(m)) {
+    if (f.form == "vertex") {
+      std::printf("  %-15s per vertex (%zu values)\n", f.name, f.values);
+    } else if (f.form == "corner") {
+      std::printf("  %-15s per corner (%zu values, %u seam vertices)\n", f.name, f.values,
+                  f.seam_vertices);
+    }
+  }
+  for (const ExtraAttribute& e : m.extra_attributes) {
+    std::printf("  %-15s %s x%u%s per corner, %zu bytes (carried, not modelled)\n", e.name.c_str(),
+                component_name(e.component_type), e.components, e.normalized ? " normalized" : "",
+                e.bytes.size());
+  }
+  std::vector<size_t> faces_of(m.materials.size(), 0);
+  for (uint32_t id : m.face_materials) {
+    if (id < faces_of.size()) ++faces_of[id];
+  }
+  for (size_t i = 0; i < m.materials.size(); ++i) {
+    const Material& mat = m.materials[i];
+    std::printf("  material %zu     %s: base colour (%.4g, %.4g, %.4g, %.4g)", i, mat.name.c_str(),
+                mat.base_color.x, mat.base_color.y, mat.base_color.z, mat.base_color.w);
+    auto map = [&](const char* what, int32_t index) {
+      if (index >= 0) std::printf(", %s %s", what, texture_name(m, index).c_str());
+    };
+    map("texture", mat.base_color_texture);
+    map("normal map", mat.normal_texture);
+    map("metallic-roughness", mat.metallic_roughness_texture);
+    map("occlusion", mat.occlusion_texture);
+    map("emissive", mat.emissive_texture);
+    std::printf(", %zu faces\n", faces_of[i]);
+  }
+  for (size_t i = 0; i < m.textures.size(); ++i) {
+    const Texture& t = m.textures[i];
+    std::printf("  texture %zu      %s (%s, %zu bytes)\n", i, t.name.c_str(), t.mime_type.c_str(),
+                t.bytes.size());
+  }
 }
 
 void print_stats(const MeshStats& s) {
@@ -221,7 +359,9 @@ int run_info_mesh(const std::string& path, bool json) {
                            {{"normals", !imported->mesh.normals.empty()},
                             {"colors", !imported->mesh.colors.empty()},
                             {"texcoords", !imported->mesh.texcoords.empty()}}},
-                          {"contents", contents_json(*imported, obj)}};
+                          {"contents", contents_json(*imported, obj)},
+                          {"warnings", r.notes}};
+    out.update(mesh_attributes_json(imported->mesh));
     std::cout << out.dump() << "\n";
     return 0;
   }
@@ -253,6 +393,7 @@ int run_info_mesh(const std::string& path, bool json) {
   std::printf("  attributes      %s%s\n", kept.c_str(),
               kept == "none" ? " kept (see \"file holds\" for what the file has)"
                              : (std::string(" (") + kEncodeDrops + ")").c_str());
+  print_mesh_attributes(imported->mesh);
   return 0;
 }
 

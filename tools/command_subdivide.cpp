@@ -101,8 +101,9 @@ void add_subdivide_command(CLI::App& app, int& exit_code) {
       "subdivide",
       "Adaptive modified-Butterfly subdivision (ASA): refine where neighbouring triangles bend, "
       "or everywhere with --uniform. Old vertices never move.");
-  cmd->add_option("IN", args->input, "input mesh (OBJ, PLY, STL, OFF, DRC)")->required();
-  cmd->add_option("-o,--output", args->output, "output mesh (.ply, .obj, .off or .stl)")
+  cmd->add_option("IN", args->input, "input mesh (OBJ, PLY, STL, OFF, DRC, glTF, GLB)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "output mesh (.ply, .obj, .off, .stl, .glb or .gltf)")
       ->required()
       ->check(mesh_output_validator());
   cmd->add_option("--levels", args->options.levels,

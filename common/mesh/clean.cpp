@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "common/mesh/adjacency.h"
+#include "common/mesh/corner_data.h"
 #include "common/mesh/edge_groups.h"
 #include "common/mesh/import.h"
 #include "common/mesh/manifold_repair.h"
@@ -80,7 +81,7 @@ bool consistent_after_merge(const std::vector<T>& values,
 // apart, as the manifest counts them); each keeps the lowest index of its
 // group. An open-addressing table of the 96-bit keys: O(V), 8-16 bytes per
 // vertex besides the result.
-uint32_t weld(Mesh& mesh, std::vector<std::string>& notes) {
+uint32_t weld(Mesh& mesh) {
   const uint32_t n = mesh.vertex_count();
   size_t table_size = 16;
   while (table_size < 2 * static_cast<size_t>(n)) table_size *= 2;
@@ -110,16 +111,17 @@ uint32_t weld(Mesh& mesh, std::vector<std::string>& notes) {
   table = {};
   if (merged == 0) return 0;
 
-  auto check = [&](auto& values, const char* name) {
+  // Values that differ between welded vertices are seams: kept per corner
+  // (the corners still index the file's vertices, which are the values).
+  auto check = [&](auto& values, auto& corner) {
     if (!consistent_after_merge(values, representative)) {
+      corner = to_corner_attribute(mesh, values);
       values.clear();
-      notes.push_back(std::string(name) +
-                      " dropped: welded vertices carried different values (per-face values)");
     }
   };
-  check(mesh.normals, "normals");
-  check(mesh.colors, "colors");
-  check(mesh.texcoords, "texture coordinates");
+  check(mesh.normals, mesh.corner_normals);
+  check(mesh.colors, mesh.corner_colors);
+  check(mesh.texcoords, mesh.corner_texcoords);
 
   std::vector<uint32_t> new_index(n, kNone);
   uint32_t count = 0;
@@ -140,7 +142,13 @@ uint32_t count_degenerate(const Mesh& mesh) {
 
 uint32_t drop_degenerate(Mesh& mesh) {
   const size_t before = mesh.triangles.size();
-  std::erase_if(mesh.triangles, repeats_a_vertex);
+  if (!has_corner_data(mesh)) {
+    std::erase_if(mesh.triangles, repeats_a_vertex);
+  } else {
+    std::vector<uint8_t> keep(before);
+    for (size_t f = 0; f < before; ++f) keep[f] = !repeats_a_vertex(mesh.triangles[f]);
+    keep_faces(mesh, keep);
+  }
   return static_cast<uint32_t>(before - mesh.triangles.size());
 }
 
@@ -163,15 +171,13 @@ uint32_t drop_duplicates(Mesh& mesh, std::vector<uint8_t>& had_twin) {
     state[first[f]] = 1;
   }
   first = {};
-  std::vector<Triangle> kept;
-  kept.reserve(f_count - dups);
+  std::vector<uint8_t> keep(f_count);
   had_twin.reserve(f_count - dups);
   for (uint32_t f = 0; f < f_count; ++f) {
-    if (state[f] == 2) continue;
-    kept.push_back(mesh.triangles[f]);
-    had_twin.push_back(state[f]);
+    keep[f] = state[f] != 2;
+    if (keep[f]) had_twin.push_back(state[f]);
   }
-  mesh.triangles.swap(kept);
+  keep_faces(mesh, keep);
   return dups;
 }
 
@@ -189,14 +195,11 @@ uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin) {
     for (uint32_t k = groups.begin[e]; k < groups.begin[e + 1]; ++k)
       shared_edges[groups.uses[k].face] = 1;
   }
-  std::vector<Triangle> kept;
-  kept.reserve(mesh.triangles.size());
-  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
-    if (!had_twin[f] || shared_edges[f]) kept.push_back(mesh.triangles[f]);
-  }
-  const uint32_t dropped = mesh.face_count() - static_cast<uint32_t>(kept.size());
-  mesh.triangles.swap(kept);
-  return dropped;
+  const uint32_t before = mesh.face_count();
+  std::vector<uint8_t> keep(before);
+  for (uint32_t f = 0; f < before; ++f) keep[f] = !had_twin[f] || shared_edges[f];
+  keep_faces(mesh, keep);
+  return before - mesh.face_count();
 }
 
 uint32_t drop_unreferenced(Mesh& mesh) {
@@ -222,7 +225,9 @@ bool CleanReport::changed() const {
          split_vertices || detached_faces || flipped_faces || double_sided_flaps || !notes.empty();
 }
 
-Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
+namespace {
+
+Result<CleanReport> clean_faces(Mesh& mesh, const ImportOptions& options) {
   CleanReport report;
   report.vertices_in_file = mesh.vertex_count();
   report.faces_in_file = mesh.face_count();
@@ -246,7 +251,7 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
     }
   }
 
-  if (options.weld) report.welded_vertices = weld(mesh, report.notes);
+  if (options.weld) report.welded_vertices = weld(mesh);
   if (options.keep_degenerate_faces && options.keep_nonmanifold) {
     report.degenerate_faces = count_degenerate(mesh);
   } else {
@@ -308,6 +313,17 @@ Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
                         "no usable triangle: every face is a double-sided flap");
     }
   }
+  return report;
+}
+
+}  // namespace
+
+Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options) {
+  auto report = clean_faces(mesh, options);
+  if (!report) return report;
+  // Welding and repair decide where the seams are: an attribute left
+  // without one is per vertex, the rest per corner with its values merged.
+  settle_attribute_forms(mesh);
   return report;
 }
 

@@ -94,8 +94,9 @@ Result<std::unique_ptr<draco::Mesh>> decode(const std::string& path, const std::
     if (!result.ok()) return fail(result.status());
     return std::move(result).value();
   }
-  return make_error(ErrorCode::kParse,
-                    "unknown mesh format '." + ext + "' (expected .obj, .ply, .stl, .off or .drc)");
+  return make_error(
+      ErrorCode::kParse,
+      "unknown mesh format '." + ext + "' (expected .obj, .ply, .stl, .off, .drc, .gltf or .glb)");
 }
 
 // Gathers one attribute per vertex from the corners. Returns false when two

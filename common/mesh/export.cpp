@@ -14,8 +14,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
+
+#include "common/mesh/corner_data.h"
+#include "common/mesh/texture_files.h"
 
 namespace meshstream {
 namespace {
@@ -115,10 +120,122 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+// A name usable as a file name and an MTL/usemtl token: no blanks, no
+// folders. Materials keep their names where they are already safe.
+std::string safe_name(const std::string& name, const std::string& fallback) {
+  std::string out;
+  for (char c : name) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    out += (std::isalnum(u) || c == '_' || c == '-' || c == '.') ? c : '_';
+  }
+  if (out.empty() || out == "." || out == "..") out = fallback;
+  return out;
+}
+
+}  // namespace
+
+std::string material_file_name(const Mesh& mesh, uint32_t m) {
+  if (m >= mesh.materials.size()) return "material" + std::to_string(m);
+  std::string name = safe_name(mesh.materials[m].name, "material" + std::to_string(m));
+  // Unique: a later material with the same safe name gets its index.
+  for (uint32_t k = 0; k < m; ++k) {
+    if (safe_name(mesh.materials[k].name, "material" + std::to_string(k)) == name)
+      return name + "_" + std::to_string(m);
+  }
+  return name;
+}
+
+std::vector<std::string> texture_file_names(const Mesh& mesh, const std::string& prefix) {
+  std::vector<std::string> names;
+  for (size_t t = 0; t < mesh.textures.size(); ++t) {
+    const Texture& texture = mesh.textures[t];
+    std::string stem = safe_name(std::filesystem::path(texture.name).stem().string(),
+                                 "texture" + std::to_string(t));
+    std::string name = prefix + stem + texture_extension(texture);
+    if (std::find(names.begin(), names.end(), name) != names.end())
+      name = prefix + stem + "_" + std::to_string(t) + texture_extension(texture);
+    names.push_back(name);
+  }
+  return names;
+}
+
+Status write_file_bytes(const std::string& path, const void* data, size_t size) {
+  File file;
+  if (auto status = open_for_writing(path, file); !status) return status;
+  if (size > 0 && std::fwrite(data, 1, size, file.get()) != size)
+    return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
+  if (std::fflush(file.get()) != 0) return make_error(ErrorCode::kIo, path + ": write failed");
+  return {};
+}
+
+Result<std::string> write_material_files(const Mesh& mesh, const std::string& obj_path) {
+  const std::filesystem::path obj(obj_path);
+  const std::string stem = obj.stem().string();
+  const std::string library = safe_name(stem, "mesh") + ".mtl";
+  const std::filesystem::path folder = obj.parent_path();
+  const std::vector<std::string> images = texture_file_names(mesh, safe_name(stem, "mesh") + "_");
+  for (size_t t = 0; t < mesh.textures.size(); ++t) {
+    const Texture& texture = mesh.textures[t];
+    if (auto s = write_file_bytes((folder / images[t]).string(), texture.bytes.data(),
+                                  texture.bytes.size());
+        !s) {
+      return tl::unexpected(s.error());
+    }
+  }
+  std::string mtl = "# written by meshstream: base colour (Kd, d) and its texture (map_Kd)\n";
+  for (uint32_t m = 0; m < mesh.materials.size(); ++m) {
+    const Material& material = mesh.materials[m];
+    char line[160];
+    std::snprintf(line, sizeof line, "Kd %.9g %.9g %.9g\nd %.9g\n", material.base_color.x,
+                  material.base_color.y, material.base_color.z, material.base_color.w);
+    mtl += "\nnewmtl " + material_file_name(mesh, m) + "\n" + line;
+    const int32_t t = material.base_color_texture;
+    if (t >= 0 && static_cast<size_t>(t) < images.size()) mtl += "map_Kd " + images[t] + "\n";
+    if (material.normal_texture >= 0 &&
+        static_cast<size_t>(material.normal_texture) < images.size())
+      mtl += "norm " + images[material.normal_texture] + "\n";
+  }
+  if (auto s = write_file_bytes((folder / library).string(), mtl.data(), mtl.size()); !s)
+    return tl::unexpected(s.error());
+  return library;
+}
+
+namespace {
+
+// What a per-vertex format loses of `mesh`, for its header comment: the
+// seam splits and what it cannot store at all.
+std::string per_vertex_comment(const Mesh& original, const SplitMesh* split) {
+  std::string c;
+  if (split != nullptr && split->split_copies > 0)
+    c += "comment " + std::to_string(split->split_copies) +
+         " vertices added: per-corner attributes (seams) split into per-vertex copies\n";
+  if (!original.extra_attributes.empty()) {
+    c += "comment not stored (PLY has no such property):";
+    for (const ExtraAttribute& e : original.extra_attributes) c += " " + e.name;
+    c += "\n";
+  }
+  if (!original.materials.empty())
+    c += "comment materials and textures not stored (use OBJ or glTF)\n";
+  return c;
+}
+
+Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding encoding,
+                          const std::string& comment);
+
 }  // namespace
 
 Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding) {
   if (auto status = check_writable(mesh, path); !status) return status;
+  if (!has_corner_data(mesh))
+    return write_ply_vertices(mesh, path, encoding, per_vertex_comment(mesh, nullptr));
+  const SplitMesh split = split_seams(mesh);
+  return write_ply_vertices(split.mesh, path, encoding, per_vertex_comment(mesh, &split));
+}
+
+namespace {
+
+Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding encoding,
+                          const std::string& comment) {
   File file;
   if (auto status = open_for_writing(path, file); !status) return status;
   Writer out(file.get());
@@ -128,6 +245,7 @@ Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding
   const bool texcoords = !mesh.texcoords.empty();
   out.text(std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
            " 1.0\ncomment written by meshstream\n");
+  out.text(comment);
   out.text("element vertex " + std::to_string(mesh.vertex_count()) + "\n");
   out.text("property float x\nproperty float y\nproperty float z\n");
   if (normals) out.text("property float nx\nproperty float ny\nproperty float nz\n");
@@ -177,51 +295,78 @@ Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding
   return {};
 }
 
+}  // namespace
+
 Status write_obj(const Mesh& mesh, const std::string& path) {
   if (auto status = check_writable(mesh, path); !status) return status;
+  // Materials first: the MTL file and the images beside the OBJ.
+  std::string library;
+  if (!mesh.materials.empty()) {
+    auto written = write_material_files(mesh, path);
+    if (!written) return tl::unexpected(written.error());
+    library = *written;
+  }
   File file;
   if (auto status = open_for_writing(path, file); !status) return status;
   Writer out(file.get());
-  const bool normals = !mesh.normals.empty();
-  const bool texcoords = !mesh.texcoords.empty();
-  // OBJ has no standard per-vertex colour; the common extension "v x y z r g b"
-  // is not read back by every tool, so colours are written only with a note.
+  // vt / vn values: the per-vertex arrays (index = vertex) or a corner
+  // attribute's values (index per corner), so seams stay seams.
+  const bool corner_texcoords = !mesh.corner_texcoords.empty();
+  const bool corner_normals = !mesh.corner_normals.empty();
+  const bool texcoords = corner_texcoords || !mesh.texcoords.empty();
+  const bool normals = corner_normals || !mesh.normals.empty();
   out.text("# written by meshstream: " + std::to_string(mesh.vertex_count()) + " vertices, " +
            std::to_string(mesh.face_count()) + " triangles\n");
-  if (!mesh.colors.empty()) out.text("# per-vertex colours are not stored in OBJ\n");
+  if (!mesh.colors.empty() || !mesh.corner_colors.empty())
+    out.text("# vertex colours are not stored in OBJ\n");
+  for (const ExtraAttribute& e : mesh.extra_attributes)
+    out.text("# not stored (OBJ has no such attribute): " + e.name + "\n");
+  if (!library.empty()) out.text("mtllib " + library + "\n");
   for (const Vec3f& p : mesh.positions) {
     out.text("v "), out.numbers(p), out.put('\n');
   }
-  if (texcoords) {
-    for (const Vec2f& t : mesh.texcoords) {
-      out.text("vt "), out.numbers(t), out.put('\n');
-    }
+  for (const Vec2f& t : corner_texcoords ? mesh.corner_texcoords.values : mesh.texcoords) {
+    out.text("vt "), out.numbers(t), out.put('\n');
   }
-  if (normals) {
-    for (const Vec3f& n : mesh.normals) {
-      out.text("vn "), out.numbers(n), out.put('\n');
-    }
+  for (const Vec3f& n : corner_normals ? mesh.corner_normals.values : mesh.normals) {
+    out.text("vn "), out.numbers(n), out.put('\n');
   }
-  for (const Triangle& t : mesh.triangles) {
+  const bool materials = !mesh.materials.empty();
+  uint32_t current = 0xFFFFFFFFu;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    if (materials) {
+      const uint32_t m = mesh.face_materials.empty() ? 0 : mesh.face_materials[f];
+      if (m != current) {
+        out.text("usemtl " + material_file_name(mesh, m) + "\n");
+        current = m;
+      }
+    }
     out.text("f");
-    for (uint32_t i : t) {
-      const uint32_t k = i + 1;  // OBJ counts from 1
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t c = 3 * f + k;
+      const uint32_t v = mesh.triangles[f][k];
       out.put(' ');
-      out.number(k);
+      out.number(v + 1);  // OBJ counts from 1
       if (texcoords || normals) {
         out.put('/');
-        if (texcoords) out.number(k);
-        if (normals) out.put('/'), out.number(k);
+        if (texcoords) out.number((corner_texcoords ? mesh.corner_texcoords.corners[c] : v) + 1);
+        if (normals)
+          out.put('/'), out.number((corner_normals ? mesh.corner_normals.corners[c] : v) + 1);
       }
     }
     out.put('\n');
+    out.maybe_flush();
   }
   if (!out.finish()) return make_error(ErrorCode::kIo, path + ": write failed (disk full?)");
   return {};
 }
 
-Status write_off(const Mesh& mesh, const std::string& path) {
-  if (auto status = check_writable(mesh, path); !status) return status;
+Status write_off(const Mesh& input, const std::string& path) {
+  if (auto status = check_writable(input, path); !status) return status;
+  // OFF is per vertex: seams are split (copies appended).
+  SplitMesh split;
+  if (has_corner_data(input)) split = split_seams(input);
+  const Mesh& mesh = has_corner_data(input) ? split.mesh : input;
   File file;
   if (auto status = open_for_writing(path, file); !status) return status;
   Writer out(file.get());
@@ -290,9 +435,11 @@ Status write_stl(const Mesh& mesh, const std::string& path) {
 
 Status check_mesh_output_path(const std::string& path) {
   const std::string ext = lower_extension(path);
-  if (ext == "ply" || ext == "obj" || ext == "off" || ext == "stl") return {};
-  return make_error(ErrorCode::kInvalidArgument,
-                    path + ": cannot write '." + ext + "' files (use .ply, .obj, .off or .stl)");
+  if (ext == "ply" || ext == "obj" || ext == "off" || ext == "stl" || ext == "glb" || ext == "gltf")
+    return {};
+  return make_error(
+      ErrorCode::kInvalidArgument,
+      path + ": cannot write '." + ext + "' files (use .ply, .obj, .off, .stl, .glb or .gltf)");
 }
 
 Status write_mesh(const Mesh& mesh, const std::string& path) {
@@ -301,6 +448,7 @@ Status write_mesh(const Mesh& mesh, const std::string& path) {
   if (ext == "ply") return write_ply(mesh, path, PlyEncoding::kBinary);
   if (ext == "obj") return write_obj(mesh, path);
   if (ext == "off") return write_off(mesh, path);
+  if (ext == "glb" || ext == "gltf") return write_gltf(mesh, path);
   return write_stl(mesh, path);
 }
 

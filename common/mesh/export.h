@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "common/base/result.h"
 #include "common/mesh/mesh.h"
@@ -14,6 +15,11 @@ namespace meshstream {
 
 enum class PlyEncoding { kBinary, kAscii };
 
+// Per-vertex formats (PLY, OFF) split seam vertices (per-corner values)
+// into copies and say so in the header comment; PLY also names what it
+// cannot store (extra attributes, materials). OBJ keeps seams (vt/vn per
+// corner), writes usemtl groups and, beside the OBJ, STEM.mtl (Kd, d,
+// map_Kd) and the texture images (STEM_NAME.png/.jpg, original bytes).
 Status write_ply(const Mesh& mesh, const std::string& path,
                  PlyEncoding encoding = PlyEncoding::kBinary);
 Status write_obj(const Mesh& mesh, const std::string& path);
@@ -24,7 +30,25 @@ Status write_off(const Mesh& mesh, const std::string& path);
 // zero when degenerate), the corners' floats as they are. Attributes are
 // not written, and vertices no face uses are lost.
 Status write_stl(const Mesh& mesh, const std::string& path);
-// By extension (any case): .ply (binary), .obj, .off, .stl (binary).
+// glTF 2.0: .glb (one file) or .gltf with STEM.bin and the images beside
+// it (gltf_writer.cpp). One primitive per material, seams split into
+// glTF vertices, positions/normals/UVs/colours as floats, extra attributes
+// under their glTF semantic when glTF allows it (TANGENT, TEXCOORD_n,
+// COLOR_n, JOINTS_n, WEIGHTS_n) and as "_NAME" otherwise; materials as
+// pbrMetallicRoughness with the images' original bytes.
+Status write_gltf(const Mesh& mesh, const std::string& path);
+
+// Helpers the OBJ and glTF writers share: the name a material gets in a
+// file (safe, unique), the file names of the textures written beside a
+// file (PREFIX + the texture's safe name + its type's extension, unique),
+// and writing the MTL file and images beside `obj_path` (returns the MTL's
+// file name).
+std::string material_file_name(const Mesh& mesh, uint32_t material);
+std::vector<std::string> texture_file_names(const Mesh& mesh, const std::string& prefix);
+Status write_file_bytes(const std::string& path, const void* data, size_t size);
+Result<std::string> write_material_files(const Mesh& mesh, const std::string& obj_path);
+
+// By extension (any case): .ply (binary), .obj, .off, .stl (binary), .glb, .gltf.
 // kInvalidArgument for anything else (the same error as
 // check_mesh_output_path).
 Status write_mesh(const Mesh& mesh, const std::string& path);

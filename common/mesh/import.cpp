@@ -30,6 +30,7 @@ Result<RawMesh> read_by_format(const std::string& path) {
   if (has_extension(path, ".ply")) return read_ply(path);
   // Never Draco's ObjDecoder: it corrupts the heap on malformed face tokens.
   if (has_extension(path, ".obj")) return read_obj(path);
+  if (has_extension(path, ".gltf") || has_extension(path, ".glb")) return read_gltf(path);
   return read_with_draco(path);
 }
 

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common/mesh/adjacency.h"
+#include "common/mesh/corner_data.h"
 #include "common/mesh/edge_groups.h"
 #include "common/mesh/union_find.h"
 
@@ -200,7 +201,7 @@ Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups, std::vector<Join>&
   for (uint32_t f = 0; f < f_count; ++f) {
     const bool invert = 2 * flipped_in[root[f]] > size_of[root[f]];
     if ((flip[f] != 0) != invert) {
-      std::swap(mesh.triangles[f][1], mesh.triangles[f][2]);
+      reverse_face(mesh, f);  // its corner data follows
       ++flipped;
     }
   }

@@ -24,7 +24,7 @@ struct Mesh {
   std::vector<Triangle> triangles;
   std::vector<Vec3f> normals;    // optional, per vertex
   std::vector<Vec4f> colors;     // optional, per vertex, RGBA in [0, 1]
-  std::vector<Vec2f> texcoords;  // optional, per vertex
+  std::vector<Vec2f> texcoords;  // optional, per vertex; v up (OBJ's way; glTF's v is 1 - v)
 
   // With seams: used instead of the per-vertex array of the same kind.
   CornerAttribute<Vec3f> corner_normals;

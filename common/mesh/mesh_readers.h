@@ -60,8 +60,10 @@ Result<RawMesh> read_ascii_stl(const std::string& path);
 // elements so far; positive ones may point forward), polygons
 // fan-triangulated (c0, c(k-1), ck). One vertex per `v` line; normals and
 // texture coordinates are kept per vertex when all corners of a vertex agree,
-// else dropped with a note (as the Draco path did). `#` comments, CRLF, `\`
-// continuation; o/g/s/usemtl/mtllib and free-form lines are ignored, `l`/`p`
+// else per corner (seams); dropped with a note only when some corners have
+// none. `usemtl` gives face_materials, `mtllib` the materials' colours and
+// textures (apply_material_libraries). `#` comments, CRLF, `\`
+// continuation; o/g/s and free-form lines are ignored, `l`/`p`
 // elements skipped and counted in a note. Strict: malformed numbers or
 // corner tokens (kParse), NaN/Inf positions and indices out of range
 // (kInvalidMesh) are errors naming the line and the token. Never hands the
@@ -69,8 +71,27 @@ Result<RawMesh> read_ascii_stl(const std::string& path);
 // O(file size), one read, no allocation per token.
 Result<RawMesh> read_obj(const std::string& path);
 
-// read_obj on text already in memory (tests, fuzzing). Same rules.
+// The materials of an OBJ read by parse_obj_text: its mtllib files beside
+// `obj_path` give each used material its Kd colour (and d/Tr opacity) and
+// map_Kd texture (the image file's bytes). Missing MTL or image files, maps
+// other than map_Kd and materials no MTL defines are notes, never errors.
+void apply_material_libraries(const std::string& obj_path, RawMesh& raw);
+
+// read_obj on text already in memory (tests, fuzzing). Same rules, no
+// material files (they are looked up beside a path).
 Result<RawMesh> parse_obj_text(std::string_view text);
+
+// glTF 2.0: .gltf (external or embedded buffers and images) and .glb,
+// through Draco's scene reader (gltf_reader.cpp): every mesh instance of the
+// default scene with its node transform, one face material per primitive,
+// normals/texture coordinates/colours per corner (set 0; clean_mesh makes
+// them per vertex where they have no seam), other attributes (TANGENT,
+// TEXCOORD_1, JOINTS_0, ...) as extra attributes, images with their
+// original bytes. What is not carried (animations, skins, cameras, morph
+// targets, texture transforms, unknown extensions) is named in the notes.
+// A file Draco refuses, a truncated GLB or a missing buffer/image file is
+// an error naming the reason.
+Result<RawMesh> read_gltf(const std::string& path);
 
 // Binary STL and .drc through Draco's io (an .obj path goes to read_obj).
 // Positions are read per face corner through the point-to-value mapping, so

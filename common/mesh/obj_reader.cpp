@@ -8,8 +8,9 @@
 // real OBJ files in tests/mesh/obj_reader_test.cpp): one vertex per `v` line,
 // polygons fan-triangulated as (c0, c(k-1), ck), and normals / texture
 // coordinates kept per vertex when every face corner of a vertex carries the
-// same value, dropped with a note otherwise (per-face values, as in a cube
-// with sharp edges). In addition: per-vertex colours of the common
+// same value, per corner otherwise (seams: per-face values, as in a cube
+// with sharp edges; the Draco path dropped them). In addition: usemtl
+// groups as face materials, and per-vertex colours of the common
 // `v x y z r g b` extension, relative (negative) indices, `\` line
 // continuation, and strict errors: every index is range-checked, malformed
 // numbers and corner tokens are refused with the line and the token.
@@ -187,6 +188,11 @@ class ObjParser {
   uint32_t line_elements_ = 0, point_elements_ = 0, unknown_lines_ = 0;
   std::string first_unknown_;
   std::vector<std::string> material_libraries_, materials_used_;  // mtllib and usemtl names
+  // Once a usemtl line came: every triangle's index into materials_used_
+  // (kAbsent before the first usemtl).
+  std::vector<uint32_t> face_materials_;
+  uint32_t current_material_ = kAbsent;
+  bool any_usemtl_ = false;
   std::string joined_;  // a logical line made of continued physical lines
 };
 
@@ -388,6 +394,7 @@ void ObjParser::add_triangle(const Corner& a, const Corner& b, const Corner& c) 
   attribute(corner_vt_, &Corner::vt);
   attribute(corner_vn_, &Corner::vn);
   triangles_.push_back({a.v, b.v, c.v});
+  if (any_usemtl_) face_materials_.push_back(current_material_);
 }
 
 Status ObjParser::parse_face(std::string_view rest) {
@@ -426,9 +433,13 @@ Status ObjParser::parse_line(std::string_view line) {
       material_libraries_.emplace_back(name);
   } else if (keyword == "usemtl") {
     const std::string name(next_token(rest));
-    if (!name.empty() &&
-        std::find(materials_used_.begin(), materials_used_.end(), name) == materials_used_.end())
-      materials_used_.push_back(name);
+    if (!name.empty()) {
+      auto it = std::find(materials_used_.begin(), materials_used_.end(), name);
+      current_material_ = static_cast<uint32_t>(it - materials_used_.begin());
+      if (it == materials_used_.end()) materials_used_.push_back(name);
+      if (!any_usemtl_) face_materials_.assign(triangles_.size(), kAbsent);
+      any_usemtl_ = true;
+    }
   } else if (keyword == "l") {
     ++line_elements_;
   } else if (keyword == "p") {
@@ -479,8 +490,8 @@ void ObjParser::gather_attributes(RawMesh& raw) {
   Mesh& mesh = raw.mesh;
   const uint32_t n = mesh.vertex_count();
   auto attribute = [&](auto& values, const std::vector<uint32_t>& corner_index, auto& target,
-                       AttributeInFile& contents, const char* name, const char* keyword,
-                       uint32_t bad_line) {
+                       auto& corner, AttributeInFile& contents, const char* name,
+                       const char* keyword, uint32_t bad_line) {
     contents.count = values.size();
     if (values.empty()) return;
     if (corner_index.empty()) {
@@ -495,15 +506,19 @@ void ObjParser::gather_attributes(RawMesh& raw) {
     bool some_missing = false;
     if (!gather(mesh.triangles, corner_index, values, n, target, some_missing)) {
       target.clear();
-      note_dropped(raw, contents, name,
-                   some_missing ? "some face corners have none"
-                                : "they differ between corners of one vertex (per-face values)");
+      if (some_missing) {
+        note_dropped(raw, contents, name, "some face corners have none");
+      } else {
+        // Seams (per-face normals, UV island borders): kept per corner.
+        corner.values = values;
+        corner.corners = corner_index;
+      }
     }
   };
-  attribute(normals_, corner_vn_, mesh.normals, raw.contents.normals, "normals", "vn",
-            first_bad_normal_line_);
-  attribute(texcoords_, corner_vt_, mesh.texcoords, raw.contents.texcoords, "texture coordinates",
-            "vt", first_bad_texcoord_line_);
+  attribute(normals_, corner_vn_, mesh.normals, mesh.corner_normals, raw.contents.normals,
+            "normals", "vn", first_bad_normal_line_);
+  attribute(texcoords_, corner_vt_, mesh.texcoords, mesh.corner_texcoords, raw.contents.texcoords,
+            "texture coordinates", "vt", first_bad_texcoord_line_);
   raw.contents.colors.count = vertices_with_color_;
 
   if (vertices_with_color_ == n && n > 0) {
@@ -608,7 +623,22 @@ Result<RawMesh> ObjParser::parse(std::string_view text) {
   raw.contents.format = "OBJ";
   for (const std::string& name : material_libraries_)
     raw.contents.material_libraries.push_back({.name = name});
-  raw.contents.materials_used = std::move(materials_used_);
+  raw.contents.materials_used = materials_used_;
+  if (any_usemtl_ && !raw.mesh.triangles.empty()) {
+    // Materials by usemtl name (read_obj fills them from the MTL files);
+    // faces before the first usemtl get a default material of their own.
+    for (const std::string& name : materials_used_) raw.mesh.materials.push_back({.name = name});
+    const uint32_t none = static_cast<uint32_t>(raw.mesh.materials.size());
+    bool any_none = false;
+    for (uint32_t& m : face_materials_) {
+      if (m == kAbsent) {
+        m = none;
+        any_none = true;
+      }
+    }
+    if (any_none) raw.mesh.materials.push_back({.name = "(no usemtl)"});
+    raw.mesh.face_materials = std::move(face_materials_);
+  }
   if (line_elements_ + point_elements_ > 0) {
     raw.notes.push_back(std::to_string(line_elements_) + " line elements ('l') and " +
                         std::to_string(point_elements_) +
@@ -628,7 +658,9 @@ Result<RawMesh> parse_obj_text(std::string_view text) { return ObjParser().parse
 Result<RawMesh> read_obj(const std::string& path) {
   auto text = read_file_bytes(path);
   if (!text) return tl::unexpected(text.error());
-  return parse_obj_text(*text);
+  auto raw = parse_obj_text(*text);
+  if (raw) apply_material_libraries(path, *raw);
+  return raw;
 }
 
 }  // namespace meshstream

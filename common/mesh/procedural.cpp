@@ -1,6 +1,7 @@
 #include "common/mesh/procedural.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -10,6 +11,7 @@ namespace meshstream {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+constexpr uint32_t kNoValue = 0xFFFFFFFFu;
 
 // ---- Gradient noise (Perlin, "Improving noise", SIGGRAPH 2002), with an
 // integer hash instead of a permutation table so it needs no state.
@@ -240,6 +242,125 @@ Mesh make_torus(uint32_t major, uint32_t minor) {
     }
   }
   add_quad_grid_faces(m, major, minor, true, true);
+  return m;
+}
+
+Mesh make_faceted_cube(uint32_t segments) {
+  const uint32_t n = std::clamp<uint32_t>(segments, 1, 4096);
+  Mesh m;
+  // Grid points on the cube's surface, keyed by their integer coordinates in
+  // [0, n]^3, so the faces share the points on the cube's edges.
+  std::map<std::array<uint32_t, 3>, uint32_t> index_of;
+  auto vertex = [&](std::array<uint32_t, 3> g) {
+    auto [it, added] = index_of.try_emplace(g, m.vertex_count());
+    if (added) {
+      const Vec3d p{2.0 * g[0] / n - 1.0, 2.0 * g[1] / n - 1.0, 2.0 * g[2] / n - 1.0};
+      m.positions.push_back(to_float(p));
+      m.colors.push_back({static_cast<float>(g[0]) / n, static_cast<float>(g[1]) / n,
+                          static_cast<float>(g[2]) / n, 1.0f});
+    }
+    return it->second;
+  };
+  // Each face: the axis it faces along, its sign, and two in-plane axes
+  // (u, v) with u x v pointing outwards.
+  struct Side {
+    int axis, u, v;
+    bool positive;
+  };
+  const Side sides[6] = {{0, 1, 2, true},  {0, 2, 1, false}, {1, 2, 0, true},
+                         {1, 0, 2, false}, {2, 0, 1, true},  {2, 1, 0, false}};
+  for (uint32_t side_index = 0; side_index < 6; ++side_index) {
+    const Side& side = sides[side_index];
+    Vec3f normal{0, 0, 0};
+    (&normal.x)[side.axis] = side.positive ? 1.0f : -1.0f;
+    const uint32_t value_base = static_cast<uint32_t>(m.corner_texcoords.values.size());
+    std::vector<uint32_t> grid((n + 1) * (n + 1));
+    for (uint32_t j = 0; j <= n; ++j) {
+      for (uint32_t i = 0; i <= n; ++i) {
+        std::array<uint32_t, 3> g{};
+        g[side.axis] = side.positive ? n : 0;
+        g[side.u] = i;
+        g[side.v] = j;
+        grid[j * (n + 1) + i] = vertex(g);
+        // Face `side_index` in cell (side_index % 3, side_index / 3) of a
+        // 3 x 2 atlas, inset so no two faces share a value.
+        const double cell_u = side_index % 3, cell_v = side_index / 3;
+        m.corner_texcoords.values.push_back(
+            {static_cast<float>((cell_u + 0.05 + 0.9 * i / n) / 3),
+             static_cast<float>((cell_v + 0.05 + 0.9 * j / n) / 2)});
+        m.corner_normals.values.push_back(normal);
+      }
+    }
+    for (uint32_t j = 0; j < n; ++j) {
+      for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+        for (const std::array<uint32_t, 3>& t :
+             {std::array<uint32_t, 3>{a, b, d}, std::array<uint32_t, 3>{a, d, c}}) {
+          m.triangles.push_back({grid[t[0]], grid[t[1]], grid[t[2]]});
+          for (uint32_t k : t) {
+            m.corner_texcoords.corners.push_back(value_base + k);
+            m.corner_normals.corners.push_back(value_base + k);
+          }
+        }
+      }
+    }
+  }
+  return m;
+}
+
+Mesh make_uv_sphere(uint32_t segments, uint32_t rings) {
+  const uint32_t s = std::clamp<uint32_t>(segments, 3, 1u << 14);
+  const uint32_t r = std::clamp<uint32_t>(rings, 2, 1u << 14);
+  Mesh m;
+  auto point = [](double longitude, double latitude) {
+    return to_float(Vec3d{std::sin(latitude) * std::cos(longitude),
+                          std::sin(latitude) * std::sin(longitude), std::cos(latitude)});
+  };
+  // Vertices: north pole, rings 1..r-1 of s vertices each, south pole.
+  m.positions.push_back({0, 0, 1});
+  for (uint32_t k = 1; k < r; ++k) {
+    for (uint32_t i = 0; i < s; ++i) m.positions.push_back(point(2 * kPi * i / s, kPi * k / r));
+  }
+  m.positions.push_back({0, 0, -1});
+  m.normals = m.positions;
+  const uint32_t south = m.vertex_count() - 1;
+  auto ring_vertex = [s](uint32_t k, uint32_t i) { return 1 + (k - 1) * s + i % s; };
+
+  // Texture coordinates: a (s + 1) x (r + 1) grid (column s repeats column
+  // 0's vertices with u = 1: the seam); the poles use the row's values at
+  // the middle of each segment.
+  CornerAttribute<Vec2f>& uv = m.corner_texcoords;
+  auto uv_value = [&](double u, double v) {
+    uv.values.push_back({static_cast<float>(u), static_cast<float>(v)});
+    return static_cast<uint32_t>(uv.values.size() - 1);
+  };
+  std::vector<uint32_t> grid_value((s + 1) * (r + 1), kNoValue);
+  auto grid_uv = [&](uint32_t k, uint32_t i) {
+    uint32_t& value = grid_value[k * (s + 1) + i];
+    if (value == kNoValue) value = uv_value(static_cast<double>(i) / s, static_cast<double>(k) / r);
+    return value;
+  };
+  auto face = [&](std::array<uint32_t, 3> v, std::array<uint32_t, 3> t) {
+    m.triangles.push_back(v);
+    uv.corners.insert(uv.corners.end(), t.begin(), t.end());
+  };
+  for (uint32_t i = 0; i < s; ++i) {
+    const uint32_t pole = uv_value((i + 0.5) / s, 0.0);
+    face({0, ring_vertex(1, i), ring_vertex(1, i + 1)}, {pole, grid_uv(1, i), grid_uv(1, i + 1)});
+  }
+  for (uint32_t k = 1; k + 1 < r; ++k) {
+    for (uint32_t i = 0; i < s; ++i) {
+      const uint32_t a = ring_vertex(k, i), b = ring_vertex(k, i + 1);
+      const uint32_t c = ring_vertex(k + 1, i), d = ring_vertex(k + 1, i + 1);
+      face({a, c, d}, {grid_uv(k, i), grid_uv(k + 1, i), grid_uv(k + 1, i + 1)});
+      face({a, d, b}, {grid_uv(k, i), grid_uv(k + 1, i + 1), grid_uv(k, i + 1)});
+    }
+  }
+  for (uint32_t i = 0; i < s; ++i) {
+    const uint32_t pole = uv_value((i + 0.5) / s, 1.0);
+    face({south, ring_vertex(r - 1, i + 1), ring_vertex(r - 1, i)},
+         {pole, grid_uv(r - 1, i + 1), grid_uv(r - 1, i)});
+  }
   return m;
 }
 

@@ -37,4 +37,26 @@ Mesh make_multi_component(uint32_t count);
 // (both >= 3), radii 1 and 0.35: closed, genus 1, 2 * major * minor faces.
 Mesh make_torus(uint32_t major = 48, uint32_t minor = 24);
 
+// Meshes with seams (attributes.h), for the attribute work's tests.
+//
+// The cube [-1, 1]^3 with `segments` x `segments` quads per face (>= 1),
+// positions welded along the cube's edges: closed, genus 0,
+// 12 * segments^2 triangles, 6 * segments^2 + 2 vertices. Per-face normals as
+// corner normals (each cube face's (segments + 1)^2 grid points have their
+// own value, so 24 values at segments = 1: the cube's edges are normal
+// seams), per-face texture coordinates (each face in its own cell of a
+// 3 x 2 atlas: corner texcoords, the same value layout, no value shared
+// between faces) and per-vertex colours (the
+// position mapped from [-1, 1] to [0, 1], alpha 1).
+Mesh make_faceted_cube(uint32_t segments = 1);
+
+// Latitude-longitude unit sphere: `segments` meridians (>= 3) and `rings`
+// latitude bands (>= 2), one vertex at each pole: closed, genus 0,
+// 2 * segments * (rings - 1) triangles, segments * (rings - 1) + 2 vertices.
+// Smooth per-vertex normals (the position). Texture coordinates per corner:
+// u = longitude / 2pi, v = latitude band / rings, so the meridian u = 0 / 1
+// is a seam (two values on each of its vertices), and each pole has one
+// value per touching triangle (u at the middle of its segment).
+Mesh make_uv_sphere(uint32_t segments = 32, uint32_t rings = 16);
+
 }  // namespace meshstream

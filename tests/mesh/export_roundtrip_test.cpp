@@ -259,7 +259,8 @@ TEST(Export, RefusesInvalidMeshesAndUnknownExtensions) {
   auto unknown = write_mesh(awkward_octahedron(), temp_path("mesh.xyz"));
   ASSERT_FALSE(unknown);
   EXPECT_EQ(unknown.error().code, ErrorCode::kInvalidArgument);
-  EXPECT_NE(unknown.error().message.find(".ply, .obj, .off or .stl"), std::string::npos);
+  EXPECT_NE(unknown.error().message.find(".ply, .obj, .off, .stl, .glb or .gltf"),
+            std::string::npos);
   EXPECT_FALSE(write_stl(bad, temp_path("bad.stl")));
   EXPECT_FALSE(write_off(bad, temp_path("bad.off")));
   EXPECT_EQ(write_mesh(awkward_octahedron(), "/nonexistent/dir/x.ply").error().code,

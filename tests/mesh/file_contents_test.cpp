@@ -53,9 +53,20 @@ TEST(FileContents, ObjCountsAttributesAndNamesMaterials) {
   EXPECT_TRUE(c.texcoords.dropped.empty());
   EXPECT_EQ(m.mesh.texcoords.size(), 4u);  // consistent per vertex: kept
   EXPECT_EQ(c.normals.count, 3u);
-  EXPECT_NE(c.normals.dropped.find("differ between corners"), std::string::npos)
-      << c.normals.dropped;
-  EXPECT_TRUE(m.mesh.normals.empty());
+  EXPECT_TRUE(c.normals.dropped.empty()) << c.normals.dropped;
+  EXPECT_TRUE(m.mesh.normals.empty());  // a seam at vertices 1 and 3: per corner
+  EXPECT_EQ(m.mesh.corner_normals.values.size(), 3u);
+  EXPECT_EQ(m.mesh.corner_normals.corners.size(), 6u);
+  // usemtl groups: face 0 red, face 1 blue, Kd from the library; the
+  // textures' files are absent, so named in notes.
+  ASSERT_EQ(m.mesh.materials.size(), 2u);
+  EXPECT_EQ(m.mesh.face_materials, (std::vector<uint32_t>{0, 1}));
+  EXPECT_EQ(m.mesh.materials[0].base_color.x, 1.0f);
+  EXPECT_EQ(m.mesh.materials[0].base_color.y, 0.0f);
+  EXPECT_EQ(m.mesh.materials[0].base_color_texture, -1);
+  bool named = false;
+  for (const std::string& note : m.report.notes) named |= note.find("red.png") != std::string::npos;
+  EXPECT_TRUE(named) << "the missing texture file is named in a note";
   EXPECT_EQ(c.colors.count, 0u);
   ASSERT_EQ(c.material_libraries.size(), 1u);
   EXPECT_EQ(c.material_libraries[0].name, library);
@@ -139,8 +150,10 @@ TEST(FileContents, RealFilesReportWhatTheyHold) {
   const ImportedMesh cube = import_ok(testing::test_mesh("cube_att.obj"));
   EXPECT_EQ(cube.contents.normals.count, 6u);
   EXPECT_EQ(cube.contents.texcoords.count, 4u);
-  EXPECT_FALSE(cube.contents.normals.dropped.empty());
-  EXPECT_FALSE(cube.contents.texcoords.dropped.empty());
+  // Per-face values are seams, kept per corner (issue 18).
+  EXPECT_TRUE(cube.contents.normals.dropped.empty());
+  EXPECT_TRUE(cube.contents.texcoords.dropped.empty());
+  EXPECT_FALSE(cube.mesh.corner_normals.empty());
 
   const ImportedMesh bunny = import_ok(testing::test_mesh("bun_zipper.ply"));
   EXPECT_TRUE(contains(bunny.contents.extra_properties, "vertex confidence (float)"));
@@ -153,7 +166,8 @@ TEST(FileContents, UsbModelTextureCoordinatesAndMaterial) {
     GTEST_SKIP() << "../shared/models/usb/usb.obj not found";
   const ImportedMesh m = import_ok(usb);
   EXPECT_EQ(m.contents.texcoords.count, 601u);
-  EXPECT_FALSE(m.contents.texcoords.dropped.empty());
+  EXPECT_TRUE(m.contents.texcoords.dropped.empty());  // kept per corner (issue 18)
+  EXPECT_FALSE(m.mesh.corner_texcoords.empty());
   ASSERT_EQ(m.contents.material_libraries.size(), 1u);
   const MaterialLibrary library = read_material_library(usb, m.contents.material_libraries[0].name);
   EXPECT_TRUE(library.found);

@@ -111,10 +111,12 @@ TEST(MeshCommands, InfoReportsWhatTheFileHoldsEvenWhatImportDrops) {
   std::filesystem::remove(path);
   ASSERT_EQ(text.exit_code, 0) << text.out;
   EXPECT_NE(text.out.find("file holds (OBJ"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("texture coordinates   3 'vt' lines (not kept by import: they differ"),
-            std::string::npos)
+  // Per-face values are seams now: kept per corner (issue 18).
+  EXPECT_NE(text.out.find("texture coordinates   3 'vt' lines (kept by import"), std::string::npos)
       << text.out;
-  EXPECT_NE(text.out.find("normals               2 'vn' lines (not kept by import"),
+  EXPECT_NE(text.out.find("normals               2 'vn' lines (kept by import"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("texcoords       per corner (3 values, 1 seam vertices)"),
             std::string::npos)
       << text.out;
   EXPECT_NE(text.out.find("material library      nowhere.mtl (not found"), std::string::npos)
@@ -126,7 +128,11 @@ TEST(MeshCommands, InfoReportsWhatTheFileHoldsEvenWhatImportDrops) {
   const auto& contents = json["contents"];
   EXPECT_EQ(contents["format"], "OBJ");
   EXPECT_EQ(contents["texcoords"]["count"], 3);
-  EXPECT_EQ(contents["texcoords"]["kept_by_import"], false);
+  EXPECT_EQ(contents["texcoords"]["kept_by_import"], true);
+  EXPECT_EQ(json["attribute_forms"]["texcoords"]["per"], "corner");
+  EXPECT_EQ(json["attribute_forms"]["texcoords"]["seam_vertices"], 1);
+  EXPECT_EQ(json["materials"][0]["name"], "shiny");
+  EXPECT_TRUE(json["warnings"].is_array());
   EXPECT_EQ(contents["normals"]["count"], 2);
   EXPECT_EQ(contents["colors"]["count"], 0);
   EXPECT_EQ(contents["material_libraries"][0]["name"], "nowhere.mtl");

@@ -226,15 +226,18 @@ TEST(ObjReader, VertexColoursWhenEveryVertexHasOne) {
   EXPECT_THAT(some->notes[0], HasSubstr("only 2 of 3 vertices"));
 }
 
-TEST(ObjReader, PerFaceAttributesAreDroppedWithANote) {
-  // Two triangles sharing vertices 1 and 3, with different normals there.
+TEST(ObjReader, PerFaceAttributesAreKeptPerCornerAndMissingOnesDroppedWithANote) {
+  // Two triangles sharing vertices 2 and 3, with different normals there.
   auto raw = parse(
       "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvn 0 0 1\nvn 0 1 0\n"
       "f 1//1 2//1 3//1\nf 2//2 4//2 3//2\n");
   ASSERT_TRUE(raw) << raw.error().message;
   EXPECT_TRUE(raw->mesh.normals.empty());
-  ASSERT_EQ(raw->notes.size(), 1u);
-  EXPECT_THAT(raw->notes[0], HasSubstr("normals dropped: they differ between corners"));
+  EXPECT_TRUE(raw->notes.empty());
+  ASSERT_TRUE(check_attribute_counts(raw->mesh));
+  ASSERT_EQ(raw->mesh.corner_normals.corners.size(), 6u);
+  EXPECT_EQ(raw->mesh.corner_normals.at_corner(1).z, 1.0f);  // face 0 at vertex 2
+  EXPECT_EQ(raw->mesh.corner_normals.at_corner(3).y, 1.0f);  // face 1 at vertex 2
   auto partial = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvn 0 0 1\nf 1//1 2//1 3//1\nf 2 4 3\n");
   ASSERT_TRUE(partial) << partial.error().message;
   EXPECT_TRUE(partial->mesh.normals.empty());

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/mesh/corner_data.h"
 #include "common/mesh/topology.h"
 #include "tests/mesh/mesh_invariants.h"
 
@@ -109,6 +110,52 @@ TEST(Procedural, DemoMeshHasNoSliversOrSpikes) {
   const BoundingBox box = bounding_box(m);
   EXPECT_GT(box.diagonal(), 2.0f);
   EXPECT_LT(box.diagonal(), 5.0f);
+}
+
+TEST(Procedural, FacetedCubeHasNormalSeamsOnItsEdges) {
+  for (uint32_t n : {1u, 3u}) {
+    const Mesh m = make_faceted_cube(n);
+    EXPECT_EQ(m.face_count(), 12 * n * n);
+    EXPECT_EQ(m.vertex_count(), 6 * n * n + 2);
+    expect_topology(m, {1, 0, 0, 0}, "faceted cube");
+    ASSERT_TRUE(check_attribute_counts(m));
+    EXPECT_GT(testing::signed_volume(m), 0);
+    EXPECT_TRUE(m.normals.empty());
+    EXPECT_EQ(m.colors.size(), m.vertex_count());
+    EXPECT_EQ(m.corner_normals.values.size(), 6 * (n + 1) * (n + 1));
+    // Every corner's normal is its face's normal (flat shading).
+    for (uint32_t f = 0; f < m.face_count(); ++f) {
+      for (uint32_t k = 0; k < 3; ++k) {
+        const Vec3f normal = m.corner_normals.at_corner(3 * f + k);
+        EXPECT_GT(dot(normal, face_normal(m, f)), 0.999f);
+      }
+    }
+    // The seams are the cube's 12 edges: 12 * (n - 1) edge points and 8 corners.
+    EXPECT_EQ(count_seam_vertices(m, m.corner_normals), 12 * (n - 1) + 8);
+    EXPECT_EQ(count_seam_vertices(m, m.corner_texcoords), 12 * (n - 1) + 8);
+  }
+}
+
+TEST(Procedural, UvSphereHasOneMeridianSeamAndPoles) {
+  const uint32_t s = 16, r = 8;
+  const Mesh m = make_uv_sphere(s, r);
+  EXPECT_EQ(m.face_count(), 2 * s * (r - 1));
+  EXPECT_EQ(m.vertex_count(), s * (r - 1) + 2);
+  expect_topology(m, {1, 0, 0, 0}, "uv sphere");
+  ASSERT_TRUE(check_attribute_counts(m));
+  EXPECT_GT(testing::signed_volume(m), 0);
+  EXPECT_EQ(m.normals.size(), m.vertex_count());
+  ASSERT_FALSE(m.corner_texcoords.empty());
+  // The meridian's r - 1 ring vertices and the two poles.
+  EXPECT_EQ(count_seam_vertices(m, m.corner_texcoords), (r - 1) + 2);
+  for (uint32_t c = 0; c < 3 * m.face_count(); ++c) {
+    const Vec2f uv = m.corner_texcoords.at_corner(c);
+    EXPECT_GE(uv.x, 0.0f);
+    EXPECT_LE(uv.x, 1.0f);
+    // v follows the latitude: z = cos(pi v).
+    const Vec3f p = m.positions[m.triangles[c / 3][c % 3]];
+    EXPECT_NEAR(p.z, std::cos(3.14159265358979 * uv.y), 1e-5);
+  }
 }
 
 }  // namespace

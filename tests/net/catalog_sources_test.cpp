@@ -3,6 +3,8 @@
 // --demo models served with no folder.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "server/catalog.h"
 #include "tests/net/greeted_client.h"
 #include "tests/net/net_harness.h"
@@ -83,6 +85,39 @@ TEST(NetCatalog, MeshFilesAreEncodedCachedAndBadOnesSkipped) {
       EXPECT_NE(log.find("from cache " + models + "/fandisk.off"), std::string::npos) << log;
     }
   }
+  std::error_code ec;
+  fs::remove_all(fs::path(models).parent_path(), ec);
+}
+
+// Issue 18: glTF files are served; a truncated GLB is listed as failed
+// with its reason, the rest served, and the import warnings are logged.
+TEST(NetCatalog, GltfFilesAreServedAndABrokenOneFails) {
+  MESHSTREAM_REQUIRE_TEST_MODELS();
+  if (!server::mesh_encoding_available()) GTEST_SKIP() << "this build has no encoder";
+  const std::string models = fresh_dir("gltf_models");
+  const std::string cache = fresh_dir("gltf_cache");
+  fs::copy_file(testing::test_model("Duck/Duck.glb"), models + "/duck.glb");
+  const std::vector<uint8_t> bytes = read_file(testing::test_model("Duck/Duck.glb"));
+  std::ofstream(models + "/broken.glb", std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size() / 2));
+  ServerProcess server;
+  ASSERT_TRUE(server.start({"--models", models, "--cache", cache, "--threads", "2"},
+                           models + "/../log.txt"))
+      << server.log();
+  const v1::ModelList list = list_models(server.port());
+  ASSERT_EQ(list.models_size(), 2) << list.DebugString() << server.log();
+  EXPECT_EQ(list.models(0).name(), "broken");
+  EXPECT_EQ(list.models(0).state(), v1::ModelInfo::FAILED);
+  EXPECT_NE(list.models(0).reason().find(models + "/broken.glb: "), std::string::npos)
+      << list.models(0).reason();
+  EXPECT_NE(list.models(0).reason().find("truncated"), std::string::npos)
+      << list.models(0).reason();
+  EXPECT_EQ(list.models(1).name(), "duck");
+  EXPECT_EQ(list.models(1).state(), v1::ModelInfo::READY);
+  EXPECT_EQ(list.models(1).vertices(), 2108u);
+  const std::string log = server.log();
+  EXPECT_NE(log.find("camera(s) not carried"), std::string::npos) << log;
   std::error_code ec;
   fs::remove_all(fs::path(models).parent_path(), ec);
 }

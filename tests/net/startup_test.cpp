@@ -207,7 +207,7 @@ TEST(ServerStartup, AHostNameIsResolvedAndABadOneNamed) {
 TEST(ModelsFolderScan, NamesHcsFirstThenMeshesInFileOrderAndSaysWhyItSkips) {
   const std::string dir = fresh_dir("scan");
   for (const char* name :
-       {"bunny.stl", "bunny.off", "bunny.hcs", "Dragon.PLY", "notes.txt", "README", "scene.glb"}) {
+       {"bunny.stl", "bunny.off", "bunny.hcs", "Dragon.PLY", "notes.txt", "README", "scene.fbx"}) {
     write_text(dir + "/" + name, "x");
   }
   fs::create_directories(dir + "/old");
@@ -231,8 +231,8 @@ TEST(ModelsFolderScan, NamesHcsFirstThenMeshesInFileOrderAndSaysWhyItSkips) {
   EXPECT_NE(scan->skipped[1].reason.find("'.txt' is not a model format"), std::string::npos);
   EXPECT_EQ(scan->skipped[2].path, dir + "/old");
   EXPECT_NE(scan->skipped[2].reason.find("a folder"), std::string::npos);
-  EXPECT_EQ(scan->skipped[3].path, dir + "/scene.glb");
-  EXPECT_NE(scan->skipped[3].reason.find("'.glb' is not a model format"), std::string::npos);
+  EXPECT_EQ(scan->skipped[3].path, dir + "/scene.fbx");
+  EXPECT_NE(scan->skipped[3].reason.find("'.fbx' is not a model format"), std::string::npos);
 }
 
 TEST(ModelsFolderScan, AFolderThatCannotBeListedIsAnError) {
@@ -249,7 +249,7 @@ TEST(ServerStartup, WarnsOnceAboutAClashAndOncePerSkippedFile) {
   write_tetra_stl(models + "/bunny.stl");
   write_text(models + "/notes.txt", "my models\n");
   write_text(models + "/README", "read me\n");
-  write_text(models + "/scene.glb", "glTF");
+  write_text(models + "/scene.fbx", "Kaydara FBX");
   ServerProcess server;
   ASSERT_TRUE(server.start({"--models", models, "--cache", "none"}, work + "/log.txt"))
       << server.log();
@@ -268,7 +268,7 @@ TEST(ServerStartup, WarnsOnceAboutAClashAndOncePerSkippedFile) {
                           "/bunny.off as 'bunny', " + models + "/bunny.stl as 'bunny.stl'"),
             std::string::npos)
       << clash[0];
-  for (const char* skipped : {"/notes.txt", "/README", "/scene.glb"}) {
+  for (const char* skipped : {"/notes.txt", "/README", "/scene.fbx"}) {
     const auto lines = lines_with(log, models + skipped);
     ASSERT_EQ(lines.size(), 1u) << skipped << "\n" << log;
     EXPECT_NE(lines[0].find(" warning catalog: skipped " + models + skipped + ": "),

@@ -359,7 +359,8 @@ TEST_F(ToolCli, DecodeAndGenerateWriteStlAndOff) {
       run_program({tool_bin(), "decode", stream(), "-o", scratch_ / "d.xyz"}, scratch_);
   // A usage error, found before the stream is read: exit 2, nothing written.
   EXPECT_EQ(unknown.status, 2);
-  EXPECT_NE(unknown.err.find("(use .ply, .obj, .off or .stl)"), std::string::npos) << unknown.err;
+  EXPECT_NE(unknown.err.find("(use .ply, .obj, .off, .stl, .glb or .gltf)"), std::string::npos)
+      << unknown.err;
   EXPECT_FALSE(fs::exists(scratch_ / "d.xyz"));
   const Ran unknown_of_missing = run_program(
       {tool_bin(), "decode", scratch_ / "no-such.hcs", "-o", scratch_ / "d.xyz"}, scratch_);
