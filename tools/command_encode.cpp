@@ -24,6 +24,7 @@ struct EncodeArgs {
   uint32_t record_bytes = EncodeOptions{}.record_bytes;
   std::optional<int> base_shift;  // empty: automatic
   bool no_bit_planes = false;
+  bool no_asa_guidance = false;
   bool old_flag = false;  // --issue1-order, the old name of --no-bit-planes
   uint32_t threads = EncodeOptions{}.threads;
   bool progress = false, no_progress = false;  // neither: a bar when stderr is a terminal
@@ -47,6 +48,7 @@ int run_encode(const EncodeArgs& args) {
   options.base_shift = args.base_shift;
   options.embedded = !(args.no_bit_planes || args.old_flag);
   options.threads = args.threads;
+  options.asa_guidance = !args.no_asa_guidance;
   options.progress = [&bar](const EncodeProgress& p) { bar.update(p.stage, p.fraction); };
   auto bytes = encode_hcs(imported->mesh, options);
   bar.finish();
@@ -95,6 +97,10 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--no-bit-planes", args->no_bit_planes,
                 "every position exact when its vertex arrives: no plane records, structure "
                 "records in decimation order (the peer benchmarks compare against)");
+  cmd->add_flag("--no-asa-guidance", args->no_asa_guidance,
+                "write no ASA guidance (by default the encoder measures which ASA setting, or "
+                "none, brings each part of the stream closest to the original; the client's "
+                "--asa auto follows it and shows a stream without it as decoded)");
   cmd->add_option("--threads", args->threads,
                   "threads for decimation, the candidate streams and their measurement (0: one "
                   "per core); the stream is the same for every count")

@@ -11,6 +11,7 @@
 #include <string>
 #include <thread>
 
+#include "common/codec/asa_guidance.h"
 #include "common/codec/decimate.h"
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/editable_mesh.h"
@@ -277,6 +278,17 @@ Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std:
 
 }  // namespace
 
+namespace {
+// The stream with its ASA guidance (asa_guidance.h), when asked for.
+Result<std::vector<uint8_t>> guided(const Mesh& mesh, std::vector<uint8_t> stream,
+                                    const EncodeOptions& options) {
+  if (!options.asa_guidance) return stream;
+  auto guidance = measure_asa_guidance(mesh, stream);
+  if (!guidance) return tl::unexpected(guidance.error());
+  return with_asa_guidance(stream, *guidance);
+}
+}  // namespace
+
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
   return encode_hcs(mesh, options, nullptr);
 }
@@ -330,7 +342,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (!candidates) return tl::unexpected(candidates.error());
   if (!measuring) {
     progress.stage("done", 1.0, 1.0);
-    return std::move(candidates->streams[0].bytes);
+    return guided(mesh, std::move(candidates->streams[0].bytes), options);
   }
   // What the measurement does not need goes before it builds its own
   // hierarchy over the original: the peak is then one such hierarchy.
@@ -343,7 +355,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (!best) return tl::unexpected(best.error());
   progress.stage("done", 1.0, 1.0);
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
-  return std::move(candidates->streams[*best].bytes);
+  return guided(mesh, std::move(candidates->streams[*best].bytes), options);
 }
 
 }  // namespace meshstream
