@@ -19,9 +19,11 @@
 //
 // Writes bench/report/fidelity.md (or DIR/fidelity.md with --report-dir DIR).
 // Usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply]
-//                       [--margin M] [--groups-per-octave G]
+//                       [--margin M] [--groups-per-octave G] [--guidance-samples N]
+//                       [--guidance-only]
 //   --margin, --groups-per-octave: the guidance's AsaGuidanceOptions (the
 //   encoder's defaults otherwise), to measure what they change.
+//   --guidance-only: no pictures, only the guidance's choices and its cost.
 //   --quick: fandisk, casting and hemisphere only (about 40 s of CPU).
 // MESHSTREAM_FIDELITY_PNG_DIR=DIR also writes the default-view pictures there.
 #include <algorithm>
@@ -183,6 +185,7 @@ int main(int argc, char** argv) {
   bool quick = false;
   std::vector<std::string> names;
   AsaGuidanceOptions guidance_options;  // the encoder's defaults unless asked otherwise
+  bool guidance_only = false;           // no pictures: the guidance's choices and cost
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--report-dir" && i + 1 < argc) {
@@ -191,6 +194,10 @@ int main(int argc, char** argv) {
       guidance_options.margin = std::atof(argv[++i]);
     } else if (a == "--groups-per-octave" && i + 1 < argc) {
       guidance_options.groups_per_octave = std::atoi(argv[++i]);
+    } else if (a == "--guidance-samples" && i + 1 < argc) {
+      guidance_options.samples = uint32_t(std::atoi(argv[++i]));
+    } else if (a == "--guidance-only") {
+      guidance_only = true;
     } else if (a == "--quick") {
       quick = true;
     } else if (a == "--meshes" && i + 1 < argc) {
@@ -198,7 +205,7 @@ int main(int argc, char** argv) {
     } else if (a == "--help" || a == "-h") {
       std::printf(
           "usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply] "
-          "[--margin M] [--groups-per-octave G]\n");
+          "[--margin M] [--groups-per-octave G] [--guidance-samples N] [--guidance-only]\n");
       return 0;
     } else {
       std::fprintf(stderr, "fidelity_bench: unknown argument %s\n", a.c_str());
@@ -251,8 +258,8 @@ int main(int argc, char** argv) {
     auto measured = plain_stream ? measure_asa_guidance(original, *plain_stream, guidance_options,
                                                         &guidance_report)
                                  : tl::unexpected(plain_stream.error());
-    auto stream = measured ? with_asa_guidance(*plain_stream, *measured)
-                           : tl::unexpected(measured.error());
+    auto stream =
+        measured ? with_asa_guidance(*plain_stream, *measured) : tl::unexpected(measured.error());
     const double t_done = now_s();
     for (const AsaGuidanceReport::Group& g : guidance_report.groups) {
       std::printf("%s guidance group from record %u (measured at ratio %.1f): %s; RMS / off:",
@@ -288,7 +295,11 @@ int main(int argc, char** argv) {
         c.choices += std::to_string(g.first_record) + ": " + asa_choice_label(g.choice);
       }
       costs.push_back(c);
+      std::printf("%s: encode %.2f s, with guidance %.2f s; %s\n", name.c_str(), c.seconds_plain,
+                  c.seconds_guided, c.choices.c_str());
+      std::fflush(stdout);
     }
+    if (guidance_only) continue;
     auto reference = pictures(*full, *full);
     if (!reference) {
       std::fprintf(stderr, "fidelity_bench: %s: %s\n", name.c_str(),

@@ -55,10 +55,11 @@ Result<std::optional<BlockSpan>> find_block(const std::vector<uint8_t>& extra) {
 
 std::vector<uint8_t> AsaGuidanceOptions::default_candidates() {
   // L1 t0.85 (the old fixed default), with creases at 45 and 60 degrees (the
-  // bench's best fixed variant and a gentler one), t0.95 with creases, and
-  // two levels with creases.
+  // bench's best fixed variant and a gentler one), and t0.95 with creases.
+  // Two levels (t0.85, crease 45) were tried too and never chosen on the 12
+  // real meshes (bench/REPORT.md, fidelity), at the highest cost.
   return {make_choice(1, 0, 0, false), make_choice(1, 0, 2, false), make_choice(1, 0, 3, false),
-          make_choice(1, 2, 2, false), make_choice(2, 0, 2, false)};
+          make_choice(1, 2, 2, false)};
 }
 
 Result<std::optional<AsaOptions>> asa_choice_options(uint8_t choice) {
@@ -217,7 +218,15 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
   AsaWorkspace workspace;
   AsaResult out;
   uint64_t fed = 0;
+  double report_last_ratio = 0;  // of the last group measured
   for (const Planned& p : planned) {
+    // ASA's gain shrinks as the prefix fills in: once a group as fine as
+    // stop_below_ratio chose none, the finer ones are not measured (none
+    // of the bench's meshes chose ASA finer than such a group, and the
+    // finest groups cost the most).
+    if (!guidance.groups.empty() && guidance.groups.back().choice == kAsaChoiceOff &&
+        report_last_ratio > 0 && report_last_ratio < options.stop_below_ratio)
+      break;
     const uint64_t end = records[p.measured].offset + records[p.measured].size;
     auto applied = decoder.feed(stream.subspan(fed, end - fed));
     if (!applied) return tl::unexpected(applied.error());
@@ -243,6 +252,7 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
       }
     }
     row.choice = choice;
+    report_last_ratio = row.ratio;
     if (guidance.groups.empty() || guidance.groups.back().choice != choice)
       guidance.groups.push_back({p.first, choice});
     if (report) report->groups.push_back(std::move(row));

@@ -86,6 +86,9 @@ struct AsaGuidanceOptions {
   // ASA must lower the measured RMS distance by this share to be chosen
   // over no ASA (a margin for what the distance does not see).
   double margin = 0.02;
+  // Once a group measured at a ratio below this chose no ASA, the finer
+  // groups get none without being measured (0: measure every group).
+  double stop_below_ratio = 16;
   // Area samples on the original (RdMeasure): noise well below the margin.
   uint32_t samples = 16000;
   // The settings tried, as choice bytes; off is always tried.
@@ -106,7 +109,8 @@ struct AsaGuidanceReport {
 };
 
 // Measures the guidance of an encoded `stream` of `original`: decodes the
-// stream once, record by record, and at each group's measured prefix
+// stream once, record by record (up to where stop_below_ratio ends it), and
+// at each group's measured prefix
 // applies every candidate and measures the symmetric RMS surface distance
 // to the original (RdMeasure). The complete stream gets no ASA (nothing is
 // missing). Groups with equal choices are merged. Fails with the decoder's
