@@ -4,82 +4,23 @@
 
 namespace meshstream::client {
 
-using Clock = std::chrono::steady_clock;
-
-Connection::Connection() : socket_(io_), buffer_(256 * 1024) {}
-Connection::~Connection() {
-  boost::system::error_code ignored;
-  socket_.shutdown(tcp::socket::shutdown_both, ignored);
-  socket_.close(ignored);
-}
-
-bool Connection::run_until(const bool& done, Clock::time_point deadline,
-                           const std::atomic<bool>* cancel) {
-  io_.restart();
-  while (!done) {
-    const auto now = Clock::now();
-    if (now >= deadline || (cancel && cancel->load())) {
-      boost::system::error_code ignored;
-      socket_.cancel(ignored);
-      // Let the cancelled handler run so no operation outlives this call.
-      io_.restart();
-      while (!done && io_.run_one_for(Millis(200)) > 0) {
-      }
-      return false;
-    }
-    io_.run_one_for(std::min<Clock::duration>(deadline - now, Millis(20)));
-  }
-  return true;
-}
+Connection::Connection(std::unique_ptr<TcpLink> link)
+    : link_(std::move(link)), buffer_(256 * 1024) {}
 
 Result<std::unique_ptr<Connection>> Connection::open(const std::string& host, uint16_t port,
                                                      Millis timeout,
                                                      const std::atomic<bool>* cancel) {
-  std::unique_ptr<Connection> c(new Connection());
-  const std::string where = host + ":" + std::to_string(port);
-  c->peer_ = where;
-  boost::system::error_code ec;
-  tcp::resolver resolver(c->io_);
-  auto endpoints = resolver.resolve(host, std::to_string(port), ec);
-  if (ec) return make_error(ErrorCode::kIo, "cannot resolve " + where + ": " + ec.message());
-  bool done = false;
-  boost::system::error_code result = asio::error::timed_out;
-  asio::async_connect(c->socket_, endpoints,
-                      [&](const boost::system::error_code& e, const tcp::endpoint&) {
-                        result = e;
-                        done = true;
-                      });
-  if (!c->run_until(done, Clock::now() + timeout, cancel)) {
-    result = cancel && cancel->load() ? asio::error::operation_aborted : asio::error::timed_out;
-  }
-  if (result)
-    return make_error(ErrorCode::kIo, "cannot connect to " + where + ": " + result.message());
-  c->socket_.set_option(tcp::no_delay(true), ec);
-  return c;
+  auto link = TcpLink::open(host, port, host + ":" + std::to_string(port), timeout, cancel);
+  if (!link) return tl::unexpected(link.error());
+  return std::unique_ptr<Connection>(new Connection(std::move(*link)));
 }
-
-namespace {
-
-// End of file, or a reset because the peer closed with our bytes unread.
-bool closed_by_peer(const boost::system::error_code& e) {
-  return e == asio::error::eof || e == asio::error::connection_reset ||
-         e == asio::error::broken_pipe;
-}
-
-}  // namespace
 
 Status Connection::send(const v1::ClientMessage& message, Millis timeout) {
   const std::vector<uint8_t> frame = proto::encode_frame(message);
-  bool done = false;
-  boost::system::error_code result = asio::error::timed_out;
-  asio::async_write(socket_, asio::buffer(frame), [&](const boost::system::error_code& e, size_t) {
-    result = e;
-    done = true;
-  });
-  if (!run_until(done, Clock::now() + timeout, nullptr)) result = asio::error::timed_out;
+  const boost::system::error_code result = link_->write_all(frame, timeout);
   peer_closed_ |= closed_by_peer(result);
   if (result)
-    return make_error(ErrorCode::kIo, "sending to " + peer_ + " failed: " + result.message());
+    return make_error(ErrorCode::kIo, "sending to " + peer() + " failed: " + result.message());
   return {};
 }
 
@@ -88,21 +29,10 @@ Result<v1::ServerMessage> Connection::receive(Millis timeout, const std::atomic<
     auto next = reader_.next();
     if (!next) {
       return make_error(next.error().code,
-                        "server " + peer_ + " sent a bad frame: " + next.error().message);
+                        "server " + peer() + " sent a bad frame: " + next.error().message);
     }
     if (*next) return std::move(**next);
-    bool done = false;
-    size_t got = 0;
-    boost::system::error_code result = asio::error::timed_out;
-    socket_.async_read_some(asio::buffer(buffer_),
-                            [&](const boost::system::error_code& e, size_t n) {
-                              result = e;
-                              got = n;
-                              done = true;
-                            });
-    if (!run_until(done, Clock::now() + timeout, cancel)) {
-      result = (cancel && cancel->load()) ? asio::error::operation_aborted : asio::error::timed_out;
-    }
+    const auto [got, result] = link_->read_some(buffer_, timeout, cancel);
     if (got > 0) {
       bytes_read_ += got;
       reader_.feed(std::span<const uint8_t>(buffer_.data(), got));
@@ -110,11 +40,11 @@ Result<v1::ServerMessage> Connection::receive(Millis timeout, const std::atomic<
     if (result) {
       if (got > 0) continue;  // parse what arrived first
       peer_closed_ |= closed_by_peer(result);
-      const std::string why = result == asio::error::eof ? "closed the connection"
-                              : result == asio::error::timed_out
+      const std::string why = result == net::asio::error::eof ? "closed the connection"
+                              : result == net::asio::error::timed_out
                                   ? "sent nothing for " + std::to_string(timeout.count()) + " ms"
                                   : "broke the connection: " + result.message();
-      return make_error(ErrorCode::kIo, "server " + peer_ + " " + why);
+      return make_error(ErrorCode::kIo, "server " + peer() + " " + why);
     }
   }
 }

@@ -1,7 +1,7 @@
 // One TCP connection to a meshstream server, speaking framed protobuf
 // messages (proto/meshstream.proto, proto/framing.h). Blocking calls with
-// deadlines, run on the caller's thread over a private Asio io_context, so
-// the streaming loop reads like the conversation it implements.
+// deadlines on the caller's thread (client/tcp_link.h), so the streaming
+// loop reads like the conversation it implements.
 #pragma once
 
 #include <atomic>
@@ -11,15 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "client/tcp_link.h"
 #include "common/base/result.h"
-#include "common/net/asio.h"
 #include "proto/framing.h"
 
 namespace meshstream::client {
 
 namespace v1 = ::meshstream::v1;
-namespace asio = net::asio;
-using tcp = net::tcp;
 using Millis = std::chrono::milliseconds;
 
 class Connection {
@@ -30,7 +28,6 @@ class Connection {
                                                   Millis timeout,
                                                   const std::atomic<bool>* cancel = nullptr);
 
-  ~Connection();
   Connection(const Connection&) = delete;
   Connection& operator=(const Connection&) = delete;
 
@@ -47,22 +44,16 @@ class Connection {
   // The peer closed the connection (end of file, or a reset or broken pipe
   // because it closed with our bytes unread).
   bool peer_closed() const { return peer_closed_; }
-  std::string peer() const { return peer_; }
+  std::string peer() const { return link_->peer(); }
 
  private:
-  Connection();
-  // Runs the io_context until `done`, the deadline or a cancel; closes the
-  // pending operation on timeout. True when the operation completed.
-  bool run_until(const bool& done, std::chrono::steady_clock::time_point deadline,
-                 const std::atomic<bool>* cancel);
+  explicit Connection(std::unique_ptr<TcpLink> link);
 
-  asio::io_context io_;
-  tcp::socket socket_;
+  std::unique_ptr<TcpLink> link_;
   proto::ServerFrameReader reader_{proto::kMaxServerFrameBytes};
   std::vector<uint8_t> buffer_;
   uint64_t bytes_read_ = 0;
   bool peer_closed_ = false;
-  std::string peer_;
 };
 
 // Splits "HOST:PORT" ("[::1]:7878" for IPv6). kInvalidArgument otherwise.

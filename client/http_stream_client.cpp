@@ -3,13 +3,37 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "client/http_link.h"
+#include "client/tcp_link.h"
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
 
 namespace meshstream::client {
 
 namespace {
+
+// HOST:PORT as a URL writes it ("[::1]:8080" for IPv6), for messages.
+std::string url_peer(const std::string& host, uint16_t port) {
+  return (host.find(':') != std::string::npos ? "[" + host + "]" : host) + ":" +
+         std::to_string(port);
+}
+
+// Reads some body bytes: 0 when the server closed the connection; kIo
+// when nothing came for `timeout`, the connection broke, or a stop.
+Result<size_t> read_some(TcpLink& link, std::span<uint8_t> into, Millis timeout,
+                         const std::atomic<bool>* stop) {
+  const auto [got, error] = link.read_some(into, timeout, stop);
+  if (got > 0) return got;
+  if (error == net::asio::error::eof) return size_t{0};
+  if (error == net::asio::error::timed_out) {
+    return make_error(ErrorCode::kIo, "server " + link.peer() + " sent nothing for " +
+                                          std::to_string(timeout.count()) + " ms");
+  }
+  if (error) {
+    return make_error(ErrorCode::kIo,
+                      "server " + link.peer() + " broke the connection: " + error.message());
+  }
+  return got;
+}
 
 // The first bytes of a body that is not a stream, for the message.
 std::string describe_start(std::span<const uint8_t> bytes) {
@@ -193,10 +217,11 @@ HttpStreamClient::Attempt HttpStreamClient::exchange(
   // A server known to ignore Range gets a plain GET (its answer is the whole file).
   const uint64_t first = next_;
   const std::optional<uint64_t> last = range_ignored_ ? std::nullopt : request_end();
-  if (auto s = link_->write(range_request(target_.url, range_ignored_ ? 0 : first, last),
-                            policy.connect_timeout);
-      !s) {
-    error = s.error();
+  const std::string request = range_request(target_.url, range_ignored_ ? 0 : first, last);
+  if (const auto e = link_->write_all(
+          std::span(reinterpret_cast<const uint8_t*>(request.data()), request.size()),
+          policy.connect_timeout)) {
+    error = Error{ErrorCode::kIo, "sending to " + link_->peer() + " failed: " + e.message()};
     return Attempt::kRetry;
   }
   ++requests_;
@@ -263,7 +288,7 @@ HttpStreamClient::Attempt HttpStreamClient::exchange(
   while (true) {
     if (paused_ && !wait_while_paused()) return Attempt::kDone;
     if (stop_) return Attempt::kDone;
-    auto got = link_->read_some(buffer_, policy.read_timeout, &stop_);
+    auto got = read_some(*link_, buffer_, policy.read_timeout, &stop_);
     if (stop_) return Attempt::kDone;
     if (!got) {
       refusal_ = Attempt::kRetry;
@@ -308,8 +333,9 @@ HttpStreamClient::Attempt HttpStreamClient::attempt(
     }
     if (!link_) {
       leftover_.clear();
-      auto link =
-          HttpLink::open(target_.url.host, target_.url.port, policy.connect_timeout, &stop_);
+      auto link = TcpLink::open(target_.url.host, target_.url.port,
+                                url_peer(target_.url.host, target_.url.port),
+                                policy.connect_timeout, &stop_);
       if (!link) {
         error = Error{link.error().code, target_.url.text + ": " + link.error().message};
         // Nothing to resume: a first connection that cannot be made is the URL's fault.

@@ -31,7 +31,7 @@
 
 namespace meshstream::client {
 
-class HttpLink;
+class TcpLink;
 
 inline constexpr uint64_t kHttpPrefixProbeBytes = 64 * 1024;
 inline constexpr uint64_t kHttpDefaultRangeBytes = 256 * 1024;
@@ -96,7 +96,7 @@ class HttpStreamClient {
   std::atomic<uint64_t> requests_{0};
   // Why accept() refused bytes: a retry (a record's checksum) or final.
   std::optional<Attempt> refusal_;
-  std::unique_ptr<HttpLink> link_;
+  std::unique_ptr<TcpLink> link_;
   uint64_t link_requests_ = 0;  // requests sent on link_
   bool stale_link_ = false;     // link_ was closed by the server while idle
   std::vector<uint8_t> buffer_;
