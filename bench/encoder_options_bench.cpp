@@ -82,6 +82,10 @@ std::vector<Variant> all_variants() {
       "displacement estimate, balance 1 or 3 by measurement (the encoder before the surface "
       "estimate)",
       [](EncodeOptions& o) { o.distortion_estimate = DistortionEstimate::kDisplacement; });
+  add("measure-whole",
+      "the automatic ordering chosen on whole candidate streams (the encoder before it chose on "
+      "prefixes)",
+      [](EncodeOptions& o) { o.measure_whole_candidates = true; });
   add("issue-1-order", "no bit planes: every position exact at insertion",
       [](EncodeOptions& o) { o.embedded = false; });
   return v;

@@ -24,7 +24,8 @@
 //                    [--max-triangles N]
 // --quick: up to 1M triangles; --max-triangles (or MESHSTREAM_SCALE_MAX_TRIANGLES)
 // picks the sizes up to N. The meshes, streams and Draco files go to WORK
-// (default BUILD/bench-scale), made afresh by every run.
+// (default BUILD/bench-scale), made afresh by every run. --make-only: write
+// the synthetic meshes to WORK and stop (for profiling by hand).
 #include <draco/compression/decode.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -501,6 +502,7 @@ int main(int argc, char** argv) {
   std::string report_dir = std::string(MESHSTREAM_SOURCE_DIR) + "/bench/report";
   std::string work = std::string(MESHSTREAM_BINARY_DIR) + "/bench-scale";
   uint64_t max_triangles = 20000000;
+  bool make_only = false;
   if (const char* env = std::getenv("MESHSTREAM_SCALE_MAX_TRIANGLES"))
     max_triangles = std::strtoull(env, nullptr, 10);
   for (int i = 1; i < argc; ++i) {
@@ -510,6 +512,8 @@ int main(int argc, char** argv) {
       report_dir = argv[++i];
     } else if (a == "--work-dir" && i + 1 < argc) {
       work = argv[++i];
+    } else if (a == "--make-only") {
+      make_only = true;
     } else if (a == "--quick") {
       max_triangles = std::min<uint64_t>(max_triangles, 1000000);
     } else if (a == "--max-triangles" && i + 1 < argc) {
@@ -517,7 +521,7 @@ int main(int argc, char** argv) {
     } else if (a == "-h" || a == "--help") {
       std::printf(
           "usage: scale_bench [--report-dir DIR] [--work-dir DIR] [--quick] "
-          "[--max-triangles N]\n");
+          "[--max-triangles N] [--make-only]\n");
       return 0;
     } else {
       std::fprintf(stderr, "scale_bench: unknown argument '%s'\n", argv[i]);
@@ -571,6 +575,7 @@ int main(int argc, char** argv) {
       sizes.push_back(next);
     }
   }
+  if (make_only) return 0;
 
   std::vector<Row> rows;
   for (Size& s : sizes) {

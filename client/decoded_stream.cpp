@@ -178,6 +178,7 @@ TakenUpdate DecodedStream::take(Mesh& mirror, MeshChanges& changes) {
       for (uint32_t v : pending_.moved) mirror.positions[v] = m.positions[v];
       for (uint32_t f : pending_.faces) mirror.triangles[f] = m.triangles[f];
     }
+    copy_attributes(m, mirror);
     u = hand_over_pending(changes);
   }
   changed_.notify_all();  // releases a network thread waiting at the barrier

@@ -93,9 +93,11 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
     plain_full = true;
   }
   if (plain_full && options.view.enabled && path_ != AsaPath::kFull) {
-    // A camera bounds the work: the incremental subdivider's full update
-    // subdivides only the region the screen may refine (incremental.h).
-    if (s.incremental) s.incremental->reset();
+    // A camera bounds the work: the incremental subdivider redoes the
+    // region the change and the screen ask for, and where that is most of
+    // the mesh its own full update subdivides only the region the screen
+    // may refine (incremental.h).
+    if (s.incremental && changes.full) s.incremental->reset();
     plain_full = false;
   }
   report.pixel_tolerance = options.view.enabled ? options.view.pixel_tolerance : 0;
@@ -141,7 +143,16 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   } else {
     s.incremental->set_view(options.view);  // nothing when it is the same
   }
-  if (auto st = s.incremental->update(mesh); !st) return tl::unexpected(st.error());
+  // The decoder's report of what changed spares the subdivider a
+  // comparison of the whole mesh (valid only against the previous call's
+  // input, which the subdivider saw unless it was just made or reset).
+  InputChanges reported;
+  reported.vertices = changes.vertices;
+  reported.moved = changes.moved;
+  reported.faces = changes.faces;
+  const bool use_report = changes_exact_ && !changes.full && !options_changed;
+  if (auto st = s.incremental->update(mesh, use_report ? &reported : nullptr); !st)
+    return tl::unexpected(st.error());
   const IncrementalStats& stats = s.incremental->last_update();
   const AsaResult& result = s.incremental->result();
   if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();

@@ -45,6 +45,11 @@ class DisplayBuilder {
   void set_path(AsaPath path) { path_ = path; }
   // The display budget (--max-display-faces; 0 = none), see display_budget.h.
   void set_max_faces(uint64_t max_faces) { max_faces_ = max_faces; }
+  // The `changes` given to build() are exact (the pipeline's, from the
+  // decoder's record deltas): the incremental path then takes them instead
+  // of comparing the whole mesh with the previous one. Off by default, so a
+  // caller that passes no or partial changes still gets a correct display.
+  void set_changes_exact(bool exact) { changes_exact_ = exact; }
 
   // The display mesh of `decoded`, which differs from the previous call's
   // input by `changes` (ignored when `options_changed` or on the first
@@ -60,6 +65,7 @@ class DisplayBuilder {
   std::unique_ptr<State> state_;
   AsaPath path_ = AsaPath::kAuto;
   uint64_t max_faces_ = 0;
+  bool changes_exact_ = false;
 };
 
 }  // namespace meshstream::client

@@ -13,11 +13,14 @@ namespace {
 // The camera and tolerance of this update into the ASA options. The
 // snapshot camera is fitted on this very mesh, so the display of a record
 // does not depend on which updates were merged before it (--out files are
-// the same on any link). O(V + F): the fit and the facing sign.
+// the same on any link); it is snapped (fit_camera) so that records that
+// barely move the framing do not move the camera. O(V + F): the fit and
+// the facing sign.
 AsaOptions options_with_view(const PipelineSettings& settings, const Mesh& decoded,
                              std::optional<AsaCamera>& camera) {
-  camera = settings.view.camera ? *settings.view.camera
-                                : fit_camera(decoded, settings.view.width, settings.view.height);
+  camera = settings.view.camera
+               ? *settings.view.camera
+               : fit_camera(decoded, settings.view.width, settings.view.height, /*snap=*/true);
   AsaOptions options = settings.asa;
   options.view.enabled = settings.view.dependent;
   options.view.camera = *camera;
@@ -47,6 +50,7 @@ DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamSource* client,
       settings_(std::move(settings)) {
   builder_.set_path(settings_.path);
   builder_.set_max_faces(settings_.view.max_display_faces);
+  builder_.set_changes_exact(true);  // decoded_stream's changes come from the record deltas
 }
 
 DisplayPipeline::~DisplayPipeline() { stop(); }

@@ -4,6 +4,19 @@
 
 namespace meshstream::client {
 
+void copy_attributes(const Mesh& from, Mesh& to) {
+  to.normals = from.normals;
+  to.colors = from.colors;
+  to.texcoords = from.texcoords;
+  to.corner_normals = from.corner_normals;
+  to.corner_colors = from.corner_colors;
+  to.corner_texcoords = from.corner_texcoords;
+  to.materials = from.materials;
+  to.face_materials = from.face_materials;
+  to.textures = from.textures;
+  to.extra_attributes = from.extra_attributes;
+}
+
 namespace {
 
 // Adds `changes` to what a kept mesh lacks; past one entry per vertex and
@@ -31,6 +44,7 @@ void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror) {
   if (behind.full) {
     mesh.positions.assign(mirror.positions.begin(), mirror.positions.end());
     mesh.triangles.assign(mirror.triangles.begin(), mirror.triangles.end());
+    copy_attributes(mirror, mesh);
     return;
   }
   // The mirror only grows between full changes: added vertices and faces are
@@ -40,6 +54,7 @@ void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror) {
   for (uint32_t v : behind.vertices) mesh.positions[v] = mirror.positions[v];
   for (uint32_t v : behind.moved) mesh.positions[v] = mirror.positions[v];
   for (uint32_t f : behind.faces) mesh.triangles[f] = mirror.triangles[f];
+  copy_attributes(mirror, mesh);
 }
 
 }  // namespace

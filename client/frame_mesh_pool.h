@@ -17,6 +17,14 @@
 
 namespace meshstream::client {
 
+// Copies every attribute of `from` (normals, colours, texture coordinates,
+// per vertex or per corner, materials, face materials, extra attributes;
+// attributes.h) into `to`, whose positions and triangles are brought up to
+// date by the caller. A mesh without attributes costs nothing; one with them
+// is copied whole (O(attributes)): an attribute record changes them all, and
+// between those records only inserted vertices and rewritten faces change.
+void copy_attributes(const Mesh& from, Mesh& to);
+
 class FrameMeshPool {
  public:
   // How the meshes given out were made, for tests and measurements.

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -59,6 +60,9 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir,
   if (!mesh) return finish(tl::unexpected(mesh.error()));
   auto encoded = encode_hcs(*mesh, options);
   if (!encoded) return finish(tl::unexpected(std::move(encoded.error()).with_context(job.origin)));
+  // What the stream does not carry goes to the log, never dropped in silence.
+  for (const std::string& w : encode_warnings(*mesh))
+    std::fprintf(stderr, "meshstream-server: %s: warning: %s\n", job.origin.c_str(), w.c_str());
   if (!cache_dir.empty()) {
     // Write then rename, so a concurrent or interrupted start never maps a
     // half-written file.

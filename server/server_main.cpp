@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "common/base/heap.h"
 #include "server/catalog.h"
 #include "server/encode_cache.h"
 #include "server/encoder_pool.h"
@@ -88,6 +89,7 @@ WatchMode watch_mode(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  meshstream::keep_heap_tight();  // peak RSS of encodes (heap.h)
   ParsedOptions parsed = parse_server_options(argc, argv);
   if (const int* exit_code = std::get_if<int>(&parsed)) return *exit_code;
   const ServerOptions& options = std::get<ServerOptions>(parsed);

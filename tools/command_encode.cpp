@@ -1,6 +1,6 @@
 // `meshstream encode IN -o OUT.hcs [--quant-bits 12] [--base-vertices N]
 //   [--record-bytes N] [--base-shift B] [--no-bit-planes] [--threads N]
-//   [--progress | --no-progress]`:
+//   [--quant-normal 8] [--quant-uv 12] [--quant-color 8] [--progress | --no-progress]`:
 // import and clean a mesh, encode it into one progressive .hcs stream
 // (common/codec/encoder.h), write it, and say what was made.
 #include <cstdio>
@@ -27,6 +27,9 @@ struct EncodeArgs {
   bool no_asa_guidance = false;
   bool old_flag = false;  // --issue1-order, the old name of --no-bit-planes
   uint32_t threads = EncodeOptions{}.threads;
+  int quant_normal = EncodeOptions{}.quant_normal;
+  int quant_uv = EncodeOptions{}.quant_uv;
+  int quant_color = EncodeOptions{}.quant_color;
   bool progress = false, no_progress = false;  // neither: a bar when stderr is a terminal
 };
 
@@ -49,10 +52,16 @@ int run_encode(const EncodeArgs& args) {
   options.embedded = !(args.no_bit_planes || args.old_flag);
   options.threads = args.threads;
   options.asa_guidance = !args.no_asa_guidance;
+  options.quant_normal = args.quant_normal;
+  options.quant_uv = args.quant_uv;
+  options.quant_color = args.quant_color;
   options.progress = [&bar](const EncodeProgress& p) { bar.update(p.stage, p.fraction); };
   auto bytes = encode_hcs(imported->mesh, options);
   bar.finish();
   if (!bytes) return report_failure(std::move(bytes.error()).with_context(args.input));
+  // What the stream does not carry is said, never dropped in silence.
+  for (const std::string& w : encode_warnings(imported->mesh))
+    std::fprintf(stderr, "meshstream encode: %s: warning: %s\n", args.input.c_str(), w.c_str());
   std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes->data()),
             static_cast<std::streamsize>(bytes->size()));
@@ -80,6 +89,18 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--quant-bits", args->quant_bits, "position quantization bits (8..20)")
       ->check(CLI::Range(8, 20))
       ->capture_default_str();
+  cmd->add_option("--quant-normal", args->quant_normal,
+                  "normal quantization bits per octahedral coordinate (2..16)")
+      ->check(CLI::Range(2, 16))
+      ->capture_default_str();
+  cmd->add_option("--quant-uv", args->quant_uv,
+                  "texture coordinate quantization bits (2..16), one grid over their box")
+      ->check(CLI::Range(2, 16))
+      ->capture_default_str();
+  cmd->add_option("--quant-color", args->quant_color,
+                  "colour quantization bits per channel (2..16; 8 keeps 8-bit colours exact)")
+      ->check(CLI::Range(2, 16))
+      ->capture_default_str();
   cmd->add_option("--base-vertices", args->base_vertices,
                   "stop decimating at about this many vertices")
       ->check(CLI::Range(4u, 1u << 30))
@@ -102,8 +123,8 @@ void add_encode_command(CLI::App& app, int& exit_code) {
                 "none, brings each part of the stream closest to the original; the client's "
                 "--asa auto follows it and shows a stream without it as decoded)");
   cmd->add_option("--threads", args->threads,
-                  "threads for decimation, the candidate streams and their measurement (0: one "
-                  "per core); the stream is the same for every count")
+                  "threads for decimation and the measurement of the candidate record "
+                  "orderings (0: one per core); the stream is the same for every count")
       ->check(CLI::Range(0u, 1024u))
       ->capture_default_str();
   cmd->add_flag("--progress", args->progress,

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/codec/asa_guidance.h"
+#include "common/codec/attribute_codec.h"
 #include "common/codec/base_coder.h"
 #include "common/codec/container.h"
 #include "common/codec/refinement_codec.h"
@@ -35,7 +36,44 @@ const char* base_coder_name(uint8_t id) {
 const char* record_kind(const std::vector<uint8_t>& bytes, const RecordEntry& r, size_t i) {
   if (i == 0) return "base";
   if (r.offset >= bytes.size() || r.size == 0) return nullptr;
+  if (bytes[r.offset] == kRecordAttributes) return "attributes";
   return bytes[r.offset] == kRecordPlane ? "plane" : "structure";
+}
+
+// Bytes of each part of the stream: "positions" (plane records: the bits of
+// positions sent after their vertices), "connectivity" (the base and the
+// structure records: connectivity with the coarse position residuals of the
+// inserted vertices), each attribute and its seams ("normals", "texcoords",
+// "colors", "materials", "extra", "seams", "layout"), records counted
+// with their CRC trailers and read from the file's records that are whole.
+nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& index,
+                          const FileCoverage& in_file) {
+  uint64_t positions = 0, connectivity = 0;
+  std::span<const uint8_t> base_attributes, final_attributes;
+  for (size_t i = 0; i < index.records.size() && i < in_file.complete_records; ++i) {
+    const RecordEntry& r = index.records[i];
+    const char* kind = record_kind(bytes, r, i);
+    const std::string k = kind ? kind : "";
+    auto payload = record_payload(r, std::span<const uint8_t>(bytes.data() + r.offset, r.size));
+    if (k == "plane") {
+      positions += r.size;
+    } else if (k == "attributes") {
+      (payload.size() > 1 && payload[1] == kAttributePartBase ? base_attributes
+                                                              : final_attributes) = payload;
+    } else {
+      connectivity += r.size;
+    }
+  }
+  nlohmann::json out = {{"positions", positions}, {"connectivity", connectivity}};
+  if (!base_attributes.empty()) {
+    auto parts = attribute_record_parts(base_attributes, final_attributes);
+    if (parts) {
+      for (const auto& [name, n] : *parts) out[name] = n;
+    } else {
+      out["attribute_error"] = parts.error().message;
+    }
+  }
+  return out;
 }
 
 // Whether record i is whole in the file, begun, or absent.
@@ -104,6 +142,7 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
                            {{"base", h.base_coder},
                             {"structure", h.structure_coder},
                             {"geometry", h.geometry_coder}}},
+                          {"parts", part_bytes(bytes, *index, in_file)},
                           {"records", records}};
     std::cout << out.dump() << "\n";
     return 0;

@@ -58,8 +58,9 @@ nlohmann::json report_json(const CleanReport& r) {
 }
 
 // The file's own attributes, materials and skipped data, whether or not
-// import keeps them; the stream (encode) carries positions and faces only.
-constexpr const char* kEncodeDrops = "not carried: attributes are dropped by encode";
+// import keeps them; the stream (encode) carries what import keeps
+// (attribute records, docs/hcs-format.md).
+constexpr const char* kEncodeDrops = "carried by encode";
 
 struct AttributeRow {
   const char* name;  // text output
@@ -92,7 +93,7 @@ nlohmann::json contents_json(const ImportedMesh& m, bool obj) {
     nlohmann::json a = {{"count", row.in_file.count}, {"kept_by_import", row.kept}};
     if (row.in_file.count > 0 && !row.kept)
       a["dropped"] = row.in_file.dropped.empty() ? "not read" : row.in_file.dropped;
-    a["carried_by_encode"] = false;
+    a["carried_by_encode"] = row.kept;
     j[row.key] = a;
   }
   nlohmann::json libraries = nlohmann::json::array();

@@ -1,11 +1,13 @@
 // meshstream: offline tools over mesh files and .hcs streams.
 #include <iostream>
 
+#include "common/base/heap.h"
 #include "common/cli/version.h"
 #include "common/mesh/export.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
+  meshstream::keep_heap_tight();  // peak RSS of encodes (heap.h)
   using namespace meshstream::tools;
   CLI::App app{"meshstream: encode, decode, inspect, subdivide and compare meshes"};
   app.require_subcommand(1);

@@ -295,3 +295,171 @@ void faces_per_vertex(const CornerTableScratch& s, std::vector<uint32_t>& faces)
 }
 
 }  // namespace meshstream::asa
+
+// ---- LiveCornerTable ------------------------------------------------------
+
+namespace meshstream::asa {
+
+Status LiveCornerTable::rebuild(const Mesh& mesh) {
+  const uint32_t V = mesh.vertex_count(), F = mesh.face_count();
+  if (auto built = build_opposites(mesh, opposite_, scratch_); !built) {
+    opposite_.clear();
+    vertex_faces_.clear();
+    return built;
+  }
+  vertex_faces_.resize(V);
+  for (uint32_t v = 0; v < V; ++v) {
+    vertex_faces_[v].clear();
+    vertex_faces_[v].reserve(scratch_.offset[v + 1] - scratch_.offset[v]);
+  }
+  for (uint32_t f = 0; f < F; ++f)
+    for (uint32_t v : mesh.triangles[f]) vertex_faces_[v].push_back(f);
+  face_stamp_.assign(F, 0);
+  vertex_stamp_.assign(V, 0);
+  generation_ = 0;
+  return {};
+}
+
+// Finds the corner across the edge that corner c faces (u -> w in c's face)
+// among the faces around u and links both ways; kNone on a boundary.
+Status LiveCornerTable::link_corner(const Mesh& mesh, uint32_t c) {
+  const uint32_t g = c / 3;
+  const Triangle& tg = mesh.triangles[g];
+  const uint32_t u = tg[(c + 1) % 3], w = tg[(c + 2) % 3];
+  const std::vector<uint32_t>& around =
+      vertex_faces_[u].size() <= vertex_faces_[w].size() ? vertex_faces_[u] : vertex_faces_[w];
+  uint32_t partner = kNone, found = 0;
+  for (uint32_t h : around) {
+    if (h == g) continue;
+    const Triangle& t = mesh.triangles[h];
+    const int j = t[0] == u ? 0 : t[1] == u ? 1 : t[2] == u ? 2 : -1;
+    if (j < 0) continue;
+    if (t[(j + 2) % 3] == w) {  // w -> u: the twin
+      partner = 3 * h + static_cast<uint32_t>((j + 1) % 3);
+      ++found;
+    } else if (t[(j + 1) % 3] == w) {
+      return same_direction_error(u, w, g, "face " + std::to_string(h));
+    }
+  }
+  if (found > 1)
+    return make_error(ErrorCode::kNonManifold, edge_name(u, w) + " has more than two faces");
+  opposite_[c] = partner;
+  if (partner != kNone) opposite_[partner] = c;
+  return {};
+}
+
+// The faces around v form one fan: walking across v's edges from one face
+// (both ways where a boundary stops the walk) reaches all of them.
+Status LiveCornerTable::check_fan(const Mesh& mesh, uint32_t v) const {
+  const std::vector<uint32_t>& around = vertex_faces_[v];
+  if (around.size() <= 1) return {};
+  auto corner_at = [&](uint32_t f) {
+    const Triangle& t = mesh.triangles[f];
+    return 3 * f + (t[0] == v ? 0u : t[1] == v ? 1u : 2u);
+  };
+  const uint32_t start = corner_at(around.front());
+  const size_t n = around.size();
+  size_t reached = 1;
+  // Forward: across the edge (v, vertex(prev)) faced by next(corner).
+  uint32_t c = start;
+  bool closed = false;
+  for (size_t step = 0; step < n; ++step) {
+    const uint32_t o = opposite_[next_corner(c)];
+    if (o == kNone) break;
+    c = corner_at(o / 3);
+    if (c == start) {
+      closed = true;
+      break;
+    }
+    ++reached;
+  }
+  if (!closed) {
+    c = start;
+    for (size_t step = 0; step < n; ++step) {
+      const uint32_t o = opposite_[prev_corner(c)];
+      if (o == kNone) break;
+      c = corner_at(o / 3);
+      ++reached;
+    }
+  }
+  if (reached != n) {
+    return make_error(ErrorCode::kNonManifold, "vertex " + std::to_string(v) +
+                                                   " joins more than one fan of faces "
+                                                   "(non-manifold vertex)");
+  }
+  return {};
+}
+
+Status LiveCornerTable::apply(const Mesh& mesh, const std::vector<uint32_t>& changed,
+                              const std::vector<Triangle>& old_corners) {
+  const uint32_t V = mesh.vertex_count(), F = mesh.face_count(), Fo = face_count();
+  if (F < Fo || V < vertex_count()) return rebuild(mesh);
+  vertex_faces_.resize(V);
+  opposite_.resize(3 * static_cast<size_t>(F), kNone);
+  face_stamp_.resize(F, 0);
+  vertex_stamp_.resize(V, 0);
+  if (++generation_ == 0) {  // wrapped: clear the stamps once
+    std::fill(face_stamp_.begin(), face_stamp_.end(), 0);
+    std::fill(vertex_stamp_.begin(), vertex_stamp_.end(), 0);
+    generation_ = 1;
+  }
+  const uint32_t gen = generation_;
+  relink_.clear();
+  fan_vertices_.clear();
+  auto relink = [&](uint32_t f) {
+    if (face_stamp_[f] == gen) return;
+    face_stamp_[f] = gen;
+    relink_.push_back(f);
+  };
+  auto fan_vertex = [&](uint32_t v) {
+    if (vertex_stamp_[v] == gen) return;
+    vertex_stamp_[v] = gen;
+    fan_vertices_.push_back(v);
+  };
+  // Take the changed faces out of their old vertices' lists; their old
+  // neighbours lose them as partners (a neighbour that shares an edge with
+  // a changed face afterwards is linked again from the changed side).
+  for (size_t i = 0; i < changed.size(); ++i) {
+    const uint32_t f = changed[i];
+    if (f >= F || face_stamp_[f] == gen) continue;
+    relink(f);
+    if (f >= Fo) continue;
+    const Triangle& old = old_corners[i];
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t o = opposite_[3 * f + k];
+      if (o != kNone) opposite_[o] = kNone;
+      opposite_[3 * f + k] = kNone;
+      std::vector<uint32_t>& list = vertex_faces_[old[k]];
+      auto it = std::find(list.begin(), list.end(), f);
+      if (it != list.end()) {
+        *it = list.back();
+        list.pop_back();
+      }
+      fan_vertex(old[k]);
+    }
+  }
+  const size_t changed_end = relink_.size();
+  for (size_t i = 0; i < changed_end; ++i) {
+    const uint32_t f = relink_[i];
+    for (uint32_t v : mesh.triangles[f]) {
+      if (v >= V)
+        return make_error(ErrorCode::kInvalidMesh, "triangle " + std::to_string(f) +
+                                                       " refers to vertex " + std::to_string(v) +
+                                                       " but there are only " + std::to_string(V));
+      vertex_faces_[v].push_back(f);
+      fan_vertex(v);
+    }
+  }
+  // Only the changed faces' corners are searched; an old neighbour that
+  // finds no new partner stays a boundary (its entry was cleared above).
+  for (size_t i = 0; i < changed_end; ++i) {
+    const uint32_t f = relink_[i];
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c)
+      if (auto ok = link_corner(mesh, c); !ok) return ok;
+  }
+  for (uint32_t v : fan_vertices_)
+    if (auto ok = check_fan(mesh, v); !ok) return ok;
+  return {};
+}
+
+}  // namespace meshstream::asa

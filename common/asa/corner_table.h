@@ -40,4 +40,43 @@ Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite,
 // (the valence of an interior vertex), read from the buckets. O(V).
 void faces_per_vertex(const CornerTableScratch& scratch, std::vector<uint32_t>& faces);
 
+// The level-0 adjacency of a mesh that changes a record at a time (the
+// client's decoded mesh): opposite corners and the faces around every
+// vertex, brought up to date with the faces a record created or rewrote
+// instead of being rebuilt, so an update costs what it changed. After every
+// apply() it equals build_opposites on the new mesh (tested), with the same
+// acceptance rules for the faces it touched.
+class LiveCornerTable {
+ public:
+  // From scratch. O(V + F).
+  Status rebuild(const Mesh& mesh);
+  // `mesh` differs from the last rebuild()/apply() mesh by the faces in
+  // `changed`: created (index at or past the old face count) or rewritten
+  // (old_corners[i] holds changed[i]'s previous corners; ignored for created
+  // faces), plus vertices appended. Faces never disappear (fewer faces:
+  // call rebuild). Repeats in `changed` are ignored after the first.
+  // Positions do not matter. kNonManifold, naming the edge or vertex, when
+  // a touched edge gets more than two faces or two faces in the same
+  // direction, or a touched vertex's faces form more than one fan; the
+  // table must then be rebuilt before use. O(changed faces x valence).
+  Status apply(const Mesh& mesh, const std::vector<uint32_t>& changed,
+               const std::vector<Triangle>& old_corners);
+
+  const std::vector<uint32_t>& opposite() const { return opposite_; }
+  const std::vector<uint32_t>& faces_around(uint32_t v) const { return vertex_faces_[v]; }
+  uint32_t face_count() const { return static_cast<uint32_t>(opposite_.size() / 3); }
+  uint32_t vertex_count() const { return static_cast<uint32_t>(vertex_faces_.size()); }
+
+ private:
+  Status link_corner(const Mesh& mesh, uint32_t c);
+  Status check_fan(const Mesh& mesh, uint32_t v) const;
+
+  std::vector<uint32_t> opposite_;
+  std::vector<std::vector<uint32_t>> vertex_faces_;
+  std::vector<uint32_t> face_stamp_, vertex_stamp_;
+  uint32_t generation_ = 0;
+  std::vector<uint32_t> relink_, fan_vertices_;
+  CornerTableScratch scratch_;
+};
+
 }  // namespace meshstream::asa

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/asa/flatness.h"
 #include "common/asa/view.h"
 #include "common/mesh/adjacency.h"
 
@@ -47,30 +48,53 @@ void IncrementalSubdivider::remember(const Mesh& input) {
   has_previous_ = true;
 }
 
-// With a camera, a "full" update need not subdivide the whole mesh: faces
-// none of whose edges can matter on screen are not targets by themselves.
-// Taking the input itself (every face its own untouched patch) as the
-// previous result, the faces that may matter are the change, and the region
-// path below subdivides them with their rings and proves the seam. False
-// when the region would be most of the mesh or cannot be proven (the caller
-// subdivides everything).
+// The level-0 adjacency, face normals and (with a camera) feature flags of
+// `input`, from scratch. False when the mesh cannot have one (the caller's
+// subdivision then reports why).
+bool IncrementalSubdivider::rebuild_level0(const Mesh& input) {
+  level0_valid_ = false;
+  if (!table_.rebuild(input)) return false;
+  const asa::LevelView view = level0(input);
+  asa::compute_face_normals(view, face_normal_);
+  changed_vertex_.assign(input.vertex_count(), 0);
+  changed_list_.clear();
+  level0_valid_ = true;
+  return true;
+}
+
+asa::LevelView IncrementalSubdivider::level0(const Mesh& input) {
+  asa::LevelView view;
+  view.positions = input.positions.data();
+  view.corner_vertex = input.triangles.empty() ? nullptr : input.triangles.front().data();
+  view.opposite = table_.opposite().data();
+  view.vertex_count = input.vertex_count();
+  view.face_count = input.face_count();
+  view.feature_edge = feature_.empty() ? nullptr : feature_.data();
+  return view;
+}
+
+// With a camera, a "full" update need not subdivide the whole mesh: only
+// the faces ASA targets (a bent edge that matters on screen; one pass over
+// the faces with the level-0 adjacency) and the closure around them
+// change. Taking the input itself (every face its own untouched patch) as
+// the previous result, those targets are the change, and the region path
+// below subdivides them with their rings and proves the seam. False when
+// the region is most of the mesh or cannot be proven (the caller
+// subdivides everything, which then costs about the same).
 bool IncrementalSubdivider::view_region_update(const Mesh& input) {
-  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  const uint32_t Fn = input.face_count();
   if (!validate_arrays(input)) return false;
+  if (!rebuild_level0(input)) return false;
+  asa::LevelView view = level0(input);
+  asa::tag_feature_edges(view, options_.crease_degrees, face_normal_, feature_);
+  view.feature_edge = feature_.data();
   const asa::ViewTest test(options_.view);
-  changed_vertex_.assign(Vn, 0);
-  uint32_t candidates = 0;
-  for (const Triangle& t : input.triangles) {
-    const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
-    const Vec3f n = normalized(cross(b - a, c - a));
-    if (!test.matters(a, b, n, n) && !test.matters(b, c, n, n) && !test.matters(c, a, n, n))
-      continue;
-    ++candidates;
-    for (uint32_t v : t) changed_vertex_[v] = 1;
-  }
-  // The region is the candidates grown by several rings: give up early
-  // where that is bound to be most of the mesh.
-  if (4.0 * candidates > incremental_.max_dirty_fraction * Fn) return false;
+  const uint32_t targets =
+      asa::mark_targets(view, face_normal_, options_.flatness, target_after_, &test);
+  if (4.0 * targets > Fn) return false;  // most of the mesh: the plain run is as fast
+  for (uint32_t f = 0; f < Fn; ++f)
+    if (target_after_[f])
+      for (uint32_t v : input.triangles[f]) mark_vertex(v);
   result_.mesh.positions.assign(input.positions.begin(), input.positions.end());
   result_.mesh.triangles.assign(input.triangles.begin(), input.triangles.end());
   result_.mesh.colors.assign(input.colors.begin(), input.colors.end());
@@ -80,29 +104,33 @@ bool IncrementalSubdivider::view_region_update(const Mesh& input) {
   result_.source_face.resize(Fn);
   for (uint32_t f = 0; f < Fn; ++f) result_.source_face[f] = f;
   remember(input);
-  if (candidates == 0) {
+  if (targets == 0) {
+    clear_vertex_marks();
     if (!input.normals.empty()) result_.mesh.normals = compute_vertex_normals(result_.mesh);
     return true;
   }
-  index_vertex_faces(input);
   for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
     stats_.attempts = attempt + 1;
     stats_.dirty_faces = grow_region(input, attempt);
-    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn) return false;
+    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn) break;
     extract_region(input);
     stats_.region_faces = region_.face_count();
-    if (!subdivide_into(region_, options_, workspace_, region_result_)) return false;
+    if (!subdivide_into(region_, options_, workspace_, region_result_)) break;
     compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
     if (!seam_matches()) continue;
-    splice(input);
+    splice(input, input.vertex_count());
     std::swap(result_, next_);
-    remember(input);
+    compute_patch_starts(result_.source_face, Fn, patch_start_);
+    clear_vertex_marks();
     return true;
   }
+  clear_vertex_marks();
   return false;
 }
 
 Status IncrementalSubdivider::full_update(const Mesh& input) {
+  level0_valid_ = false;
+  clear_vertex_marks();
   if (options_.view.enabled && !options_.uniform && options_.levels > 0) {
     stats_.full = false;
     if (view_region_update(input)) return {};
@@ -114,69 +142,174 @@ Status IncrementalSubdivider::full_update(const Mesh& input) {
   auto done = subdivide_into(input, options_, workspace_, result_);
   if (!done) {
     has_previous_ = false;
+    level0_valid_ = false;
     return done;
   }
   remember(input);
+  if (!level0_valid_) rebuild_level0(input);  // (view_region_update may have built it)
   return {};
 }
 
-// 1. What changed, by index: vertices moved or with new attributes, and every
-// vertex of a face that is new, gone or re-connected. Returns their count.
-uint32_t IncrementalSubdivider::mark_changed_vertices(const Mesh& input) {
+void IncrementalSubdivider::mark_vertex(uint32_t v) {
+  if (changed_vertex_[v]) return;
+  changed_vertex_[v] = 1;
+  changed_list_.push_back(v);
+}
+
+void IncrementalSubdivider::clear_vertex_marks() {
+  for (uint32_t v : changed_list_) changed_vertex_[v] = 0;
+  changed_list_.clear();
+}
+
+// 1. What changed, by comparing with the previous input: vertices moved or
+// with new attributes, every vertex of a face that is new or re-connected,
+// and those faces with their previous corners. O(V + F).
+Status IncrementalSubdivider::collect_changes_by_diff(const Mesh& input) {
+  if (auto ok = validate_arrays(input); !ok) return ok;
   const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
   const uint32_t Vo = previous_.vertex_count(), Fo = previous_.face_count();
-  changed_vertex_.assign(Vn, 0);
+  changed_vertex_.resize(Vn, 0);
+  changed_faces_.clear();
+  old_corners_.clear();
   for (uint32_t v = 0; v < Vn; ++v) {
-    bool changed =
+    const bool changed =
         v >= Vo || !same_bits(input.positions[v], previous_.positions[v]) ||
         (!input.colors.empty() && !same_bits(input.colors[v], previous_.colors[v])) ||
         (!input.texcoords.empty() && !same_bits(input.texcoords[v], previous_.texcoords[v]));
-    changed_vertex_[v] = changed;
+    if (changed) mark_vertex(v);
   }
-  auto mark = [&](const Triangle& t) {
-    for (uint32_t v : t)
-      if (v < Vn) changed_vertex_[v] = 1;
-  };
   for (uint32_t f = 0; f < Fn; ++f) {
     if (f < Fo && input.triangles[f] == previous_.triangles[f]) continue;
-    mark(input.triangles[f]);
-    if (f < Fo) mark(previous_.triangles[f]);
+    changed_faces_.push_back(f);
+    old_corners_.push_back(f < Fo ? previous_.triangles[f] : Triangle{kNone, kNone, kNone});
+    for (uint32_t v : input.triangles[f]) mark_vertex(v);
+    if (f < Fo)
+      for (uint32_t v : previous_.triangles[f]) mark_vertex(v);
   }
-  for (uint32_t f = Fn; f < Fo; ++f) mark(previous_.triangles[f]);
-  uint32_t changed = 0;
-  for (uint8_t c : changed_vertex_) changed += c;
-  return changed;
+  return {};
 }
 
-// 2. Faces around every vertex of the new input (CSR).
-void IncrementalSubdivider::index_vertex_faces(const Mesh& input) {
+// 1'. The same from the decoder's report: O(changes). The reported
+// vertices and faces are checked as validate_arrays checks a whole mesh.
+Status IncrementalSubdivider::collect_reported_changes(const Mesh& input,
+                                                       const InputChanges& changes) {
+  if (auto ok = check_attribute_counts(input); !ok) return ok;
   const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
-  vertex_faces_offset_.assign(static_cast<size_t>(Vn) + 1, 0);
-  for (const Triangle& t : input.triangles)
-    for (uint32_t v : t) ++vertex_faces_offset_[v + 1];
-  for (uint32_t v = 0; v < Vn; ++v) vertex_faces_offset_[v + 1] += vertex_faces_offset_[v];
-  vertex_faces_.resize(3 * static_cast<size_t>(Fn));
-  std::vector<uint32_t>& cursor = global_vertex_;  // borrowed as a fill cursor
-  cursor.assign(vertex_faces_offset_.begin(), vertex_faces_offset_.end() - 1);
-  for (uint32_t f = 0; f < Fn; ++f)
-    for (uint32_t v : input.triangles[f]) vertex_faces_[cursor[v]++] = f;
+  const uint32_t Vo = previous_.vertex_count(), Fo = previous_.face_count();
+  changed_vertex_.resize(Vn, 0);
+  changed_faces_.clear();
+  old_corners_.clear();
+  auto vertex = [&](uint32_t v) -> Status {
+    if (v >= Vn)
+      return make_error(ErrorCode::kInvalidArgument, "changed vertex " + std::to_string(v) +
+                                                         " is past the mesh's " +
+                                                         std::to_string(Vn) + " vertices");
+    const Vec3f& p = input.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      return make_error(ErrorCode::kInvalidMesh, "vertex " + std::to_string(v) +
+                                                     " has a non-finite coordinate (NaN or Inf)");
+    mark_vertex(v);
+    return {};
+  };
+  for (uint32_t v = Vo; v < Vn; ++v)
+    if (auto ok = vertex(v); !ok) return ok;
+  for (uint32_t v : changes.vertices)
+    if (auto ok = vertex(v); !ok) return ok;
+  for (uint32_t v : changes.moved)
+    if (auto ok = vertex(v); !ok) return ok;
+  face_seen_.resize(Fn, 0);
+  next_generation(Fn, Vn);
+  auto face = [&](uint32_t f) -> Status {
+    if (f >= Fn)
+      return make_error(ErrorCode::kInvalidArgument, "changed face " + std::to_string(f) +
+                                                         " is past the mesh's " +
+                                                         std::to_string(Fn) + " faces");
+    if (face_seen_[f] == generation_) return {};
+    face_seen_[f] = generation_;
+    const Triangle& t = input.triangles[f];
+    for (uint32_t v : t)
+      if (v >= Vn)
+        return make_error(ErrorCode::kInvalidMesh, "triangle " + std::to_string(f) +
+                                                       " refers to vertex " + std::to_string(v) +
+                                                       " but there are only " + std::to_string(Vn));
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
+      return make_error(ErrorCode::kInvalidMesh,
+                        "triangle " + std::to_string(f) + " repeats a vertex (degenerate)");
+    changed_faces_.push_back(f);
+    old_corners_.push_back(f < Fo ? previous_.triangles[f] : Triangle{kNone, kNone, kNone});
+    for (uint32_t v : t) mark_vertex(v);
+    if (f < Fo)
+      for (uint32_t v : previous_.triangles[f]) mark_vertex(v);
+    return {};
+  };
+  for (uint32_t f : changes.faces)
+    if (auto ok = face(f); !ok) return ok;
+  for (uint32_t f = Fo; f < Fn; ++f)
+    if (auto ok = face(f); !ok) return ok;
+  return {};
+}
+
+// previous_ becomes `input` by copying only what changed.
+void IncrementalSubdivider::bring_previous_up_to_date(const Mesh& input) {
+  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  previous_.positions.resize(Vn);
+  if (!input.colors.empty()) previous_.colors.resize(Vn);
+  if (!input.texcoords.empty()) previous_.texcoords.resize(Vn);
+  for (uint32_t v : changed_list_) {
+    previous_.positions[v] = input.positions[v];
+    if (!input.colors.empty()) previous_.colors[v] = input.colors[v];
+    if (!input.texcoords.empty()) previous_.texcoords[v] = input.texcoords[v];
+  }
+  previous_.triangles.resize(Fn);
+  for (uint32_t f : changed_faces_) previous_.triangles[f] = input.triangles[f];
+}
+
+// The normal of every face around a changed vertex, as
+// asa::compute_face_normals computes it.
+void IncrementalSubdivider::refresh_face_normals(const Mesh& input) {
+  const uint32_t Fn = input.face_count();
+  face_normal_.resize(Fn);
+  face_seen_.resize(Fn, 0);
+  next_generation(Fn, input.vertex_count());
+  for (uint32_t v : changed_list_) {
+    for (uint32_t f : table_.faces_around(v)) {
+      if (face_seen_[f] == generation_) continue;
+      face_seen_[f] = generation_;
+      const Triangle& t = input.triangles[f];
+      const Vec3f p0 = input.positions[t[0]], p1 = input.positions[t[1]],
+                  p2 = input.positions[t[2]];
+      face_normal_[f] = normalized(cross(p1 - p0, p2 - p0));
+    }
+  }
+}
+
+void IncrementalSubdivider::next_generation(uint32_t faces, uint32_t vertices) {
+  if (++generation_ == 0) {
+    for (auto* a : {&dirty_stamp_, &region_stamp_, &face_seen_, &vertex_seen_, &local_stamp_})
+      std::fill(a->begin(), a->end(), 0);
+    generation_ = 1;
+  }
+  dirty_stamp_.resize(faces, 0);
+  region_stamp_.resize(faces, 0);
+  face_seen_.resize(faces, 0);
+  vertex_seen_.resize(vertices, 0);
+  local_stamp_.resize(vertices, 0);
 }
 
 // 3. Dirty faces: rings around the changed vertices; then context rings.
 // Faces added in the first context ring are the clean neighbours whose
 // patches prove the seam (seam_faces_). Returns the dirty face count.
+// O(region): the rings walk the live adjacency.
 uint32_t IncrementalSubdivider::grow_region(const Mesh& input, uint32_t attempt) {
-  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
-  dirty_face_.assign(Fn, 0);
-  in_region_.assign(Fn, 0);
-  vertex_mark_.assign(Vn, 0);
+  next_generation(input.face_count(), input.vertex_count());
+  const uint32_t gen = generation_;
   frontier_.clear();
+  region_faces_.clear();
   seam_faces_.clear();
-  for (uint32_t v = 0; v < Vn; ++v)
-    if (changed_vertex_[v]) {
-      vertex_mark_[v] = 1;
-      frontier_.push_back(v);
-    }
+  for (uint32_t v : changed_list_) {
+    vertex_seen_[v] = gen;
+    frontier_.push_back(v);
+  }
   const uint32_t dirty_rings = incremental_.dirty_rings + attempt;
   const uint32_t context_rings = incremental_.context_rings + 2 * attempt;
   uint32_t dirty_count = 0;
@@ -184,48 +317,111 @@ uint32_t IncrementalSubdivider::grow_region(const Mesh& input, uint32_t attempt)
     const bool dirty_ring = ring < dirty_rings;
     next_frontier_.clear();
     for (uint32_t v : frontier_) {
-      for (uint32_t k = vertex_faces_offset_[v]; k < vertex_faces_offset_[v + 1]; ++k) {
-        const uint32_t f = vertex_faces_[k];
-        if (in_region_[f]) continue;
-        in_region_[f] = 1;
+      for (uint32_t f : table_.faces_around(v)) {
+        if (region_stamp_[f] == gen) continue;
+        region_stamp_[f] = gen;
+        region_faces_.push_back(f);
         if (dirty_ring) {
-          dirty_face_[f] = 1;
+          dirty_stamp_[f] = gen;
           ++dirty_count;
         } else if (ring == dirty_rings) {
           seam_faces_.push_back(f);
         }
         for (uint32_t w : input.triangles[f])
-          if (!vertex_mark_[w]) {
-            vertex_mark_[w] = 1;
+          if (vertex_seen_[w] != gen) {
+            vertex_seen_[w] = gen;
             next_frontier_.push_back(w);
           }
       }
     }
     frontier_.swap(next_frontier_);
   }
+  close_region_fans(input);
   return dirty_count;
 }
 
+// The region must be a manifold mesh of its own: where the faces it holds
+// around a vertex of its rim are not one contiguous fan (two blobs of the
+// region touching at a vertex), the corner table of the region would
+// refuse it. Such a vertex gets all its faces, as context; the faces added
+// can pinch at their own vertices, so this repeats until none does. Only
+// the last ring's vertices can have faces outside the region.
+// O(rim x valence).
+void IncrementalSubdivider::close_region_fans(const Mesh& input) {
+  const uint32_t gen = generation_;
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  auto in_region = [&](uint32_t f) { return region_stamp_[f] == gen; };
+  auto corner_at = [&](uint32_t f, uint32_t v) {
+    const Triangle& t = input.triangles[f];
+    return 3 * f + (t[0] == v ? 0u : t[1] == v ? 1u : 2u);
+  };
+  // The region's faces around v form one contiguous run (or all of them).
+  auto one_fan = [&](uint32_t v) {
+    const std::vector<uint32_t>& around = table_.faces_around(v);
+    uint32_t inside = 0, first = kNone;
+    for (uint32_t f : around)
+      if (in_region(f)) {
+        ++inside;
+        if (first == kNone) first = f;
+      }
+    if (inside == 0 || inside == around.size()) return true;
+    const uint32_t start = corner_at(first, v);
+    uint32_t reached = 1, c = start;
+    bool closed = false;
+    for (size_t step = 0; step < around.size(); ++step) {
+      const uint32_t o = opposite[asa::next_corner(c)];
+      if (o == kNone || !in_region(o / 3)) break;
+      c = corner_at(o / 3, v);
+      if (c == start) {
+        closed = true;
+        break;
+      }
+      ++reached;
+    }
+    if (!closed) {
+      c = start;
+      for (size_t step = 0; step < around.size(); ++step) {
+        const uint32_t o = opposite[asa::prev_corner(c)];
+        if (o == kNone || !in_region(o / 3)) break;
+        c = corner_at(o / 3, v);
+        ++reached;
+      }
+    }
+    return reached == inside;
+  };
+  std::vector<uint32_t>& work = frontier_;
+  while (!work.empty()) {
+    const uint32_t v = work.back();
+    work.pop_back();
+    if (one_fan(v)) continue;
+    for (uint32_t f : table_.faces_around(v)) {
+      if (in_region(f)) continue;
+      region_stamp_[f] = gen;
+      region_faces_.push_back(f);
+      for (uint32_t w : input.triangles[f]) work.push_back(w);
+    }
+  }
+}
+
 // 4. The region as a mesh of its own (region_), faces in input order, with
-// the maps between its indices and the input's.
+// the maps between its indices and the input's. O(region log region).
 void IncrementalSubdivider::extract_region(const Mesh& input) {
-  const uint32_t Vn = input.vertex_count(), Fn = input.face_count();
+  const uint32_t gen = generation_;
   region_.positions.clear();
   region_.triangles.clear();
   region_.colors.clear();
   region_.texcoords.clear();
-  local_vertex_.assign(Vn, kNone);
-  local_face_.assign(Fn, kNone);
+  local_vertex_.resize(input.vertex_count());
+  local_face_.resize(input.face_count());
   global_vertex_.clear();
-  region_faces_.clear();
-  for (uint32_t f = 0; f < Fn; ++f) {
-    if (!in_region_[f]) continue;
-    local_face_[f] = static_cast<uint32_t>(region_faces_.size());
-    region_faces_.push_back(f);
+  std::sort(region_faces_.begin(), region_faces_.end());
+  for (uint32_t f : region_faces_) {
+    local_face_[f] = region_.face_count();
     Triangle t{};
     for (int i = 0; i < 3; ++i) {
       const uint32_t v = input.triangles[f][i];
-      if (local_vertex_[v] == kNone) {
+      if (local_stamp_[v] != gen) {
+        local_stamp_[v] = gen;
         local_vertex_[v] = static_cast<uint32_t>(global_vertex_.size());
         global_vertex_.push_back(v);
         region_.positions.push_back(input.positions[v]);
@@ -246,7 +442,7 @@ bool IncrementalSubdivider::seam_matches() {
   const Mesh& reg_out = region_result_.mesh;
   seam_map_.assign(reg_out.vertex_count(), kNone);
   for (uint32_t g : seam_faces_) {
-    if (dirty_face_[g]) continue;
+    if (is_dirty(g)) continue;
     const uint32_t lg = local_face_[g];
     const uint32_t p0 = patch_start_[g], p1 = patch_start_[g + 1];
     const uint32_t r0 = region_patch_start_[lg], r1 = region_patch_start_[lg + 1];
@@ -266,8 +462,8 @@ bool IncrementalSubdivider::seam_matches() {
 
 // 6. Splice into next_: clean patches from the previous result, dirty ones
 // from the region; input vertices first, then others as first used.
-void IncrementalSubdivider::splice(const Mesh& input) {
-  const uint32_t Fn = input.face_count(), Vo = previous_.vertex_count();
+void IncrementalSubdivider::splice(const Mesh& input, uint32_t Vo) {
+  const uint32_t Fn = input.face_count();
   const Mesh& prev_out = result_.mesh;
   const Mesh& reg_out = region_result_.mesh;
   new_id_prev_.assign(prev_out.vertex_count(), kNone);
@@ -307,7 +503,7 @@ void IncrementalSubdivider::splice(const Mesh& input) {
     return id;
   };
   for (uint32_t f = 0; f < Fn; ++f) {
-    if (dirty_face_[f]) {
+    if (is_dirty(f)) {
       const uint32_t lf = local_face_[f];
       for (uint32_t k = region_patch_start_[lf]; k < region_patch_start_[lf + 1]; ++k) {
         const Triangle& t = reg_out.triangles[k];
@@ -404,50 +600,81 @@ class QuietFaces {
 
 }  // namespace
 
-// 1b. After set_view: every vertex of an input face that either view may
-// refine counts as changed. Returns the number of such faces.
+// 1b. After set_view: the vertices of every input face whose level-0 ASA
+// target flag differs between the two views count as changed; with more
+// levels, also those of faces refined in either view that are not wholly
+// quiet for both (their descendants' verdicts may differ). Returns the
+// number of such faces. Two target passes over the faces (flatness first,
+// the view only for bent edges) and one sphere test per refined face.
 uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
+  const uint32_t Fn = input.face_count();
+  asa::LevelView view = level0(input);
+  asa::tag_feature_edges(view, options_.crease_degrees, face_normal_, feature_);
+  view.feature_edge = feature_.data();
+  const asa::ViewTest test_after(options_.view);
+  asa::mark_targets(view, face_normal_, options_.flatness, target_after_, &test_after);
+  if (previous_view_.enabled) {
+    const asa::ViewTest test_before(previous_view_);
+    asa::mark_targets(view, face_normal_, options_.flatness, target_before_, &test_before);
+  } else {
+    asa::mark_targets(view, face_normal_, options_.flatness, target_before_, nullptr);
+  }
+  const bool deeper = options_.levels > 1;
   const QuietFaces before(previous_view_), after(options_.view);
+  const uint32_t patched =
+      static_cast<uint32_t>(patch_start_.empty() ? 0 : patch_start_.size() - 1);
   uint32_t faces = 0;
-  for (const Triangle& t : input.triangles) {
-    const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
-    if (before.quiet(a, b, c) && after.quiet(a, b, c)) continue;
+  for (uint32_t f = 0; f < Fn; ++f) {
+    bool redo = target_before_[f] != target_after_[f];
+    if (!redo && deeper) {
+      const bool refined =
+          target_after_[f] || f >= patched || patch_start_[f + 1] - patch_start_[f] > 1;
+      if (refined) {
+        const Triangle& t = input.triangles[f];
+        const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
+        redo = !(before.quiet(a, b, c) && after.quiet(a, b, c));
+      }
+    }
+    if (!redo) continue;
     ++faces;
-    for (uint32_t v : t) changed_vertex_[v] = 1;
+    for (uint32_t v : input.triangles[f]) mark_vertex(v);
   }
   return faces;
 }
 
-Status IncrementalSubdivider::update(const Mesh& input) {
+Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* changes) {
   stats_ = {};
   const bool view_changed = view_changed_;
   view_changed_ = false;
   if (view_changed && has_previous_ && previous_view_.enabled != options_.view.enabled)
     return full_update(input);  // every decision may change
-  if (!has_previous_ || options_.levels == 0 || !same_attribute_layout(input, previous_) ||
-      input.vertex_count() < previous_.vertex_count()) {
+  if (!has_previous_ || !level0_valid_ || options_.levels == 0 ||
+      !same_attribute_layout(input, previous_) || input.vertex_count() < previous_.vertex_count() ||
+      input.face_count() < previous_.face_count()) {
     return full_update(input);
   }
-  if (auto ok = validate_arrays(input); !ok) {
+  if (auto ok =
+          changes ? collect_reported_changes(input, *changes) : collect_changes_by_diff(input);
+      !ok) {
+    clear_vertex_marks();
     has_previous_ = false;
     return ok;
   }
-  stats_.changed_vertices = mark_changed_vertices(input);
-  if (view_changed) {
+  if (!table_.apply(input, changed_faces_, old_corners_)) {
+    return full_update(input);  // reports the problem (non-manifold) with the whole mesh's view
+  }
+  const uint32_t previous_vertices = previous_.vertex_count();
+  bring_previous_up_to_date(input);
+  refresh_face_normals(input);
+  if (view_changed && options_.view.enabled && !options_.uniform)
     stats_.view_faces = mark_view_changes(input);
-    stats_.changed_vertices = 0;
-    for (uint8_t c : changed_vertex_) stats_.changed_vertices += c;
-  }
-  if (stats_.changed_vertices == 0 && input.face_count() == previous_.face_count()) {
-    if (!input.normals.empty()) previous_.normals = input.normals;
-    return {};
-  }
-  index_vertex_faces(input);
+  stats_.changed_vertices = static_cast<uint32_t>(changed_list_.size());
+  const uint32_t Fn = input.face_count();
+  if (changed_list_.empty() && Fn + 1 == patch_start_.size()) return {};
   for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
     stats_.attempts = attempt + 1;
     stats_.dirty_faces = grow_region(input, attempt);
-    if (stats_.dirty_faces > incremental_.max_dirty_fraction * input.face_count())
-      return full_update(input);
+    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn) return full_update(input);
     extract_region(input);
     stats_.region_faces = region_.face_count();
     if (!subdivide_into(region_, options_, workspace_, region_result_)) {
@@ -455,9 +682,10 @@ Status IncrementalSubdivider::update(const Mesh& input) {
     }
     compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
     if (!seam_matches()) continue;  // the closure reached further: grow the region
-    splice(input);
+    splice(input, previous_vertices);
     std::swap(result_, next_);
-    remember(input);
+    compute_patch_starts(result_.source_face, Fn, patch_start_);
+    clear_vertex_marks();
     return {};
   }
   return full_update(input);

@@ -15,8 +15,11 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "common/asa/corner_table.h"
+#include "common/asa/level_mesh.h"
 #include "common/asa/subdivide.h"
 
 namespace meshstream {
@@ -37,6 +40,18 @@ struct IncrementalStats {
   uint32_t view_faces = 0;        // input faces redone because the view changed
 };
 
+// What changed in the input since the previous update, as the decoder
+// reports it (RecordDelta): with it an update costs the change, without it
+// the subdivider compares the whole input with the previous one. Vertices
+// and faces appended since the previous update count as changed whether
+// listed or not; lists may repeat. A vertex not listed must keep its
+// position and attributes, a face not listed its corners.
+struct InputChanges {
+  std::span<const uint32_t> vertices;  // added
+  std::span<const uint32_t> moved;     // existing ones moved or given new attributes
+  std::span<const uint32_t> faces;     // created or rewritten
+};
+
 class IncrementalSubdivider {
  public:
   explicit IncrementalSubdivider(const AsaOptions& options,
@@ -50,11 +65,15 @@ class IncrementalSubdivider {
   // bit-identical corner positions; vertex numbering may differ beyond the
   // input vertices, which keep their indices). Errors as subdivide(); after an
   // error the next update is a full one.
-  // Cost: O(changed region) subdivision + O(output) copying. With a camera
-  // (options.view), even a first or full update subdivides only the region
-  // of faces whose edges may matter on screen (one pass over the faces finds
-  // them), when that region is small.
-  Status update(const Mesh& input);
+  // Cost: O(changed region) subdivision + O(output) copying; the level-0
+  // adjacency (asa::LiveCornerTable) and face normals are kept up to date
+  // with what changed, not rebuilt. With `changes` finding what changed
+  // costs the change too; without, one comparison pass over the input.
+  // With a camera (options.view), even a first or full update subdivides
+  // only the region around the faces ASA targets on screen (flatness and
+  // view, one pass over the faces finds them), unless that is most of the
+  // mesh.
+  Status update(const Mesh& input, const InputChanges* changes = nullptr);
 
   const AsaResult& result() const { return result_; }
   const IncrementalStats& last_update() const { return stats_; }
@@ -64,10 +83,13 @@ class IncrementalSubdivider {
   // A new camera (or tolerance) for view-dependent ASA, used from the next
   // update on. That update redoes, besides what the input changed, the input
   // faces whose refinement the new view or the old one may ask for: a face
-  // whose every possible edge (its own and its descendants', which stay
-  // inside a sphere around it) is below the tolerance or outside the frustum
-  // for both views keeps its patch, unless the closure around it changed,
-  // which the seam check finds. Cost: O(F) sphere tests.
+  // whose level-0 ASA target flag (flatness and view) is the same for both
+  // views keeps its patch; with more than one level, a face that was or
+  // becomes refined is redone too unless it is wholly below the tolerance
+  // or outside the frustum for both views (its descendants stay inside a
+  // sphere around it). Changes of the closure beyond the faces redone are
+  // found by the seam check. Cost: two O(F) target passes (a dot product
+  // per edge, the view test only for bent edges) plus the region.
   void set_view(const AsaView& view);
   const AsaOptions& options() const { return options_; }
 
@@ -76,13 +98,22 @@ class IncrementalSubdivider {
   bool view_region_update(const Mesh& input);
   void remember(const Mesh& input);
   // The phases of update(), in order (see incremental.cpp).
-  uint32_t mark_changed_vertices(const Mesh& input);
+  Status collect_changes_by_diff(const Mesh& input);
+  Status collect_reported_changes(const Mesh& input, const InputChanges& changes);
+  void mark_vertex(uint32_t v);
+  void clear_vertex_marks();
+  void bring_previous_up_to_date(const Mesh& input);
+  void refresh_face_normals(const Mesh& input);
+  bool rebuild_level0(const Mesh& input);
+  asa::LevelView level0(const Mesh& input);
   uint32_t mark_view_changes(const Mesh& input);
-  void index_vertex_faces(const Mesh& input);
+  void next_generation(uint32_t faces, uint32_t vertices);
+  bool is_dirty(uint32_t f) const { return dirty_stamp_[f] == generation_; }
   uint32_t grow_region(const Mesh& input, uint32_t attempt);
+  void close_region_fans(const Mesh& input);
   void extract_region(const Mesh& input);
   bool seam_matches();
-  void splice(const Mesh& input);
+  void splice(const Mesh& input, uint32_t previous_vertices);
 
   AsaOptions options_;
   IncrementalOptions incremental_;
@@ -94,13 +125,25 @@ class IncrementalSubdivider {
   std::vector<uint32_t> patch_start_;  // per previous input face, into result_ faces (+1 sentinel)
   AsaResult result_;
   IncrementalStats stats_;
+  // Level 0 of the previous input, kept up to date with the changes.
+  bool level0_valid_ = false;
+  asa::LiveCornerTable table_;
+  std::vector<Vec3f> face_normal_;
+  std::vector<uint8_t> feature_, target_before_, target_after_;
+  // What changed this update: vertex marks (all zero between updates) and
+  // their list; changed faces with their previous corners.
+  std::vector<uint8_t> changed_vertex_;
+  std::vector<uint32_t> changed_list_, changed_faces_;
+  std::vector<Triangle> old_corners_;
+  // Per face / vertex stamps: equal to generation_ means set this pass, so
+  // nothing is cleared per update.
+  uint32_t generation_ = 0;
+  std::vector<uint32_t> dirty_stamp_, region_stamp_, face_seen_, vertex_seen_, local_stamp_;
   // Scratch reused between updates.
   AsaResult region_result_, next_;
   Mesh region_;
-  std::vector<uint32_t> vertex_faces_offset_, vertex_faces_, local_vertex_, global_vertex_,
-      region_faces_;
+  std::vector<uint32_t> local_vertex_, global_vertex_, region_faces_;
   std::vector<uint32_t> local_face_, region_patch_start_, seam_map_, new_id_prev_, new_id_region_;
-  std::vector<uint8_t> changed_vertex_, dirty_face_, in_region_, vertex_mark_;
   std::vector<uint32_t> frontier_, next_frontier_, seam_faces_;
 };
 

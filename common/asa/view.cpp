@@ -99,7 +99,7 @@ std::string format_camera(const AsaCamera& c) {
   return text;
 }
 
-AsaCamera fit_camera(const Mesh& mesh, int width, int height) {
+AsaCamera fit_camera(const Mesh& mesh, int width, int height, bool snap) {
   // The viewer's OrbitCamera::frame with its starting yaw, pitch and field
   // of view (client/viewer/camera.cpp), so a snapshot framed there and the
   // camera ASA refines for are the same.
@@ -144,6 +144,17 @@ AsaCamera fit_camera(const Mesh& mesh, int width, int height) {
     const float half_height_world = distance * std::tan(kFovy / 2);
     target += right * (cx * half_height_world * aspect) + up * (cy * half_height_world);
     distance *= extent / kFill;
+  }
+  if (snap && distance > 0 && std::isfinite(distance)) {
+    // Snap the target to a grid and the distance up to it, the grid a power
+    // of two between 1/128 and 1/64 of the distance: records that barely
+    // change the framing give the very same camera bits, so they cause no
+    // view change at all (every tiny move would flip the edges near the
+    // tolerance all over the mesh). Depends on this mesh alone.
+    const float step = std::exp2(std::floor(std::log2(distance / 128)));
+    target = {std::round(target.x / step) * step, std::round(target.y / step) * step,
+              std::round(target.z / step) * step};
+    distance = std::ceil(distance / step) * step;
   }
   camera.target = target;
   camera.eye = target + dir * distance;

@@ -62,8 +62,12 @@ std::string format_camera(const AsaCamera& camera);
 // The snapshot camera: the viewer's default framing of `mesh` (the
 // three-quarter view OrbitCamera starts with, distance and target tightened
 // so the projected vertices fill 85 % of the smaller image side), vertical
-// field of view 0.6 rad. O(V) x 3.
-AsaCamera fit_camera(const Mesh& mesh, int width, int height);
+// field of view 0.6 rad. O(V) x 3. With `snap`, the target is rounded to a
+// grid of about 1/100 of the distance and the distance up to it, so that
+// meshes whose framing differs by less than that (a stream's consecutive
+// records) get bit-identical cameras and view-dependent ASA redoes nothing
+// for the camera.
+AsaCamera fit_camera(const Mesh& mesh, int width, int height, bool snap = false);
 
 // -1 when the mesh's faces enclose negative signed volume about its
 // bounding-box centre (wound inward), else +1. O(F).

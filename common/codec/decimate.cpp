@@ -320,7 +320,8 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     update_costs(mesh, field, alive, cost, threads);
     candidates.clear();
     for (uint32_t v = 0; v < n; ++v) {
-      if (alive[v] && cost[v] >= 0) candidates.push_back({cost[v], v});
+      const bool locked = v < options.locked.size() && options.locked[v] != 0;
+      if (alive[v] && cost[v] >= 0 && !locked) candidates.push_back({cost[v], v});
     }
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
       return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
@@ -345,6 +346,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     }
     if (layer.empty()) break;
     alive_count -= static_cast<uint32_t>(layer.size());
+    layer.shrink_to_fit();  // kept until the encode ends: no growth slack
     result.layers.push_back(std::move(layer));
     if (options.progress) options.progress(double(n - alive_count) / double(n - target));
   }

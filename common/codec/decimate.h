@@ -79,6 +79,10 @@ struct DecimateOptions {
   // Optional: called after each layer, from the calling thread, with the
   // share of the vertices above the target removed so far (0..1).
   std::function<void(double)> progress;
+  // Optional: vertices never removed (locked[v] != 0), e.g. where an
+  // attribute seam or a material border passes (attribute_layout.h): the
+  // patches then never cross a seam. Empty = none locked.
+  std::vector<uint8_t> locked;
 };
 
 inline constexpr uint32_t kMinBaseTarget = 32;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "common/codec/attribute_codec.h"
 #include "common/codec/base_coder.h"
 #include "common/codec/quantize.h"
 #include "common/codec/refinement_codec.h"
@@ -40,6 +41,7 @@ struct IncrementalDecoder::State {
   QuantGrid grid;
   uint32_t records_done = 0;
   std::optional<RefinementState> refine;
+  AttributeDecoder attributes;  // attribute_codec.h: active once record 1 carried them
   DecodedMeshUpkeep upkeep = DecodedMeshUpkeep::kEveryRecord;
   Mesh mesh;  // kEveryRecord: the output, record by record
   std::vector<RecordDelta> deltas;
@@ -113,6 +115,30 @@ struct IncrementalDecoder::State {
     return {};
   }
 
+  uint32_t known_attribute_vertices = 0;  // kEveryRecord: vertices whose values mesh has
+
+  // Record 1 (the base's attributes) or the last record (everything else).
+  Status apply_attribute_record(uint32_t i, std::span<const uint8_t> payload) {
+    const StreamHeader& h = index->header;
+    if (payload.size() >= 2 && payload[1] == kAttributePartBase) {
+      if (i != 1) return make_error(ErrorCode::kParse, "base attribute record is not record 1");
+      if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
+    } else {
+      if (i + 1 != index->records.size())
+        return make_error(ErrorCode::kParse, "final attribute record is not the last record");
+      if (refine->mesh.vertex_count() != h.vertex_count ||
+          refine->mesh.face_slot_count() != h.face_count)
+        return make_error(ErrorCode::kParse, "final attribute record before the mesh is complete");
+      if (auto s = attributes.read_final(payload, refine->mesh); !s) return s;
+    }
+    if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+      attributes.preview(refine->mesh);
+      attributes.write_mesh(refine->mesh, mesh);
+      known_attribute_vertices = refine->mesh.vertex_count();
+    }
+    return {};
+  }
+
   Status apply_record(uint32_t i, std::span<const uint8_t> payload) {
     const RecordEntry& rec = index->records[i];
     const StreamHeader& h = index->header;
@@ -161,6 +187,9 @@ struct IncrementalDecoder::State {
         delta.touched_faces.resize(base->faces.size());
         for (uint32_t f = 0; f < delta.touched_faces.size(); ++f) delta.touched_faces[f] = f;
       }
+    } else if (!payload.empty() && payload[0] == kRecordAttributes) {
+      if (auto s = apply_attribute_record(i, payload); !s) return where(s.error());
+      delta.full_rebuild = true;
     } else {
       AppliedRecord applied;
       // Without an output mesh nobody follows the changes: the lists would
@@ -184,6 +213,13 @@ struct IncrementalDecoder::State {
         for (uint32_t v : applied.moved_vertices) mesh.positions[v] = dequantize(positions[v]);
         mesh.triangles.resize(refine->mesh.face_slot_count());
         for (uint32_t f : applied.touched_faces) mesh.triangles[f] = refine->mesh.faces()[f];
+        if (attributes.active()) {
+          // Inserted vertices show their predicted values until the last record.
+          const uint32_t known = known_attribute_vertices;
+          attributes.preview(refine->mesh);
+          attributes.update_mesh(refine->mesh, known, applied.touched_faces, mesh);
+          known_attribute_vertices = refine->mesh.vertex_count();
+        }
       }
       delta.added_vertices = std::move(applied.added_vertices);
       delta.touched_faces = std::move(applied.touched_faces);
@@ -296,6 +332,9 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
     out.positions.resize(q.size());
     const Dequantizer dequantize(s.grid);
     for (size_t v = 0; v < q.size(); ++v) out.positions[v] = dequantize(q[v]);
+    // Attributes need the faces still in the decoder's table.
+    s.attributes.preview(s.refine->mesh);
+    s.attributes.write_mesh(s.refine->mesh, out);
     // The decoder only inserts, so every face slot is a live face.
     out.triangles = s.refine->mesh.release_faces();
   }

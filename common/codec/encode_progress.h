@@ -10,8 +10,11 @@
 namespace meshstream {
 
 struct EncodeProgress {
-  std::string_view stage;  // "decimating", "coding records", "measuring", "done"
-  double fraction = 0;     // of the whole encode, 0..1, never decreasing
+  // "decimating", "coding records", "measuring" (the automatic record
+  // ordering's choice), "coding the winner" (when the choice fell on a
+  // candidate not coded whole yet), "done"
+  std::string_view stage;
+  double fraction = 0;  // of the whole encode, 0..1, never decreasing
 };
 
 using EncodeProgressCallback = std::function<void(const EncodeProgress&)>;

@@ -5,6 +5,7 @@
 #include "common/codec/encoder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <future>
@@ -12,6 +13,7 @@
 #include <thread>
 
 #include "common/codec/asa_guidance.h"
+#include "common/codec/attribute_codec.h"
 #include "common/codec/decimate.h"
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/editable_mesh.h"
@@ -168,6 +170,7 @@ class ProgressTracker {
 struct CandidateStreams {
   std::vector<EncodedStream> streams;
   std::vector<EncodeReport> reports;  // [i > 0] when a report is wanted
+  uint32_t record_bytes = 0;          // the record size settled on
 };
 
 // Encodes every ordering (encode(i, record_bytes, report) for ordering i).
@@ -211,6 +214,7 @@ Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t
       break;
     record_bytes = std::max<uint32_t>(16, static_cast<uint32_t>(record_bytes * 0.75));
   }
+  out.record_bytes = record_bytes;
   for (size_t i = 1; i < count; ++i) {
     auto candidate =
         parallel ? early[i - 1].get() : encode(i, record_bytes, report_of(i), progress_of(i));
@@ -226,18 +230,25 @@ Result<CandidateStreams> encode_candidates(const EncodeCandidate& encode, size_t
 // whose decoded prefixes lie closest to the original (the quantized one,
 // from the positions already quantized), all judged at the same byte
 // budgets (fractions of the first stream's size). A stream that misses the
-// granularity bound the current choice meets cannot win. The other streams
-// are measured on their own threads when `parallel`.
+// granularity bound the current choice meets cannot win; with
+// `others_are_prefixes` (the streams after the first are prefixes,
+// encode_once's stop_after_bytes) the caller judges that on the winner's
+// whole stream. The other streams are measured on their own threads when
+// `parallel`; each measurement's queries run on `query_threads`
+// (RdMeasureOptions::threads).
 constexpr double kPrepareShare = 0.3;
 
 Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
                              const std::vector<EncodedStream>& streams, const RecordSizing& sizing,
-                             bool parallel, ProgressTracker& progress) {
+                             bool parallel, ProgressTracker& progress,
+                             bool others_are_prefixes = false, unsigned query_threads = 1) {
   Mesh reference;
   reference.triangles = mesh.triangles;
   reference.positions.reserve(q.size());
   for (const Vec3i& p : q) reference.positions.push_back(grid.dequantize(p));
-  auto measure = RdMeasure::prepare(reference);
+  RdMeasureOptions measure_options;
+  measure_options.threads = query_threads;
+  auto measure = RdMeasure::prepare(reference, measure_options);
   if (!measure) return tl::unexpected(measure.error());
   // About a third of the measuring is this preparation (a hierarchy over
   // the whole original); the curves share the rest.
@@ -248,25 +259,30 @@ Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std:
     const double streams_after = parallel ? 1.0 : double(streams.size());
     progress.within(kPrepareShare + (1 - kPrepareShare) * share / streams_after);
   };
-  auto score_of = [&](const std::vector<uint8_t>& bytes,
+  auto score_of = [&](const EncodedStream& stream,
                       const std::function<void(double)>& on_budget) -> Result<double> {
-    auto curve = measure->curve(bytes, reference_bytes, on_budget);
+    // A prefix (shorter index than the first, whole stream's) is cut as
+    // its whole stream would be, whose index is about as long.
+    const uint64_t shortfall = streams[0].payload_offset > stream.payload_offset
+                                   ? streams[0].payload_offset - stream.payload_offset
+                                   : 0;
+    auto curve = measure->curve(stream.bytes, reference_bytes, on_budget, shortfall);
     if (!curve) return tl::unexpected(curve.error());
     return RdMeasure::score(*curve);
   };
   std::vector<std::future<Result<double>>> other_scores;  // joined before `measure` goes
   for (size_t i = 1; i < streams.size(); ++i) {
     other_scores.push_back(std::async(parallel ? std::launch::async : std::launch::deferred,
-                                      score_of, std::cref(streams[i].bytes),
-                                      std::cref(no_progress)));
+                                      score_of, std::cref(streams[i]), std::cref(no_progress)));
   }
-  auto best_score = score_of(streams[0].bytes, first_progress);
+  auto best_score = score_of(streams[0], first_progress);
   if (!best_score) return tl::unexpected(best_score.error());
   size_t best = 0;
   for (size_t i = 1; i < streams.size(); ++i) {
     auto score = other_scores[i - 1].get();
     if (!score) return tl::unexpected(score.error());
-    if (sizing.automatic && sizing.granular(streams[best]) && !sizing.granular(streams[i]))
+    if (!others_are_prefixes && sizing.automatic && sizing.granular(streams[best]) &&
+        !sizing.granular(streams[i]))
       continue;
     if (*score < *best_score) {
       best_score = *score;
@@ -278,14 +294,59 @@ Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std:
 
 }  // namespace
 
+std::vector<std::string> encode_warnings(const Mesh& mesh) {
+  std::vector<std::string> warnings;
+  if (!mesh.textures.empty()) {
+    warnings.push_back(std::to_string(mesh.textures.size()) +
+                       " texture image(s) are not carried by the stream (the material table "
+                       "keeps their indices)");
+  }
+  return warnings;
+}
+
 namespace {
+
+// The geometry stream `bytes` (candidate `stream`) with the attribute
+// records added (attribute_codec.h), and the report's records to match.
+Result<std::vector<uint8_t>> with_attributes(const AttributePlan& plan, const Mesh& mesh,
+                                             const std::vector<Vec3i>& q, EncodedStream& stream,
+                                             EncodeReport* report) {
+  if (plan.empty()) return std::move(stream.bytes);
+  std::vector<uint32_t> to_input(stream.to_decoder.size(), kNone);
+  for (uint32_t v = 0; v < stream.to_decoder.size(); ++v) {
+    if (stream.to_decoder[v] >= to_input.size())
+      return make_error(ErrorCode::kInternal, "encoder: a vertex has no decoder id");
+    to_input[stream.to_decoder[v]] = v;
+  }
+  AttributeParts parts;
+  std::vector<uint32_t> sizes;
+  auto bytes = add_attribute_records(plan, mesh, q, stream.bytes, to_input, &parts, &sizes);
+  if (!bytes) return bytes;
+  if (report) {
+    report->attribute_bytes = parts;
+    report->attribute_locked_vertices = plan.locked_count;
+    if (!report->records.empty()) {
+      EncodedRecord first = report->records[0];
+      first.bytes = sizes.size() > 1 ? sizes[1] : 0;
+      first.distortion_drop = 0;
+      report->records.insert(report->records.begin() + 1, first);
+      EncodedRecord last = report->records.back();
+      last.plane = false;
+      last.bytes = sizes.empty() ? 0 : sizes.back();
+      last.distortion_drop = 0;
+      report->records.push_back(last);
+    }
+  }
+  return bytes;
+}
+
 // The stream with its ASA guidance (asa_guidance.h), when asked for.
-Result<std::vector<uint8_t>> guided(const Mesh& mesh, std::vector<uint8_t> stream,
+Result<std::vector<uint8_t>> guided(const Mesh& mesh, Result<std::vector<uint8_t>> stream,
                                     const EncodeOptions& options) {
-  if (!options.asa_guidance) return stream;
-  auto guidance = measure_asa_guidance(mesh, stream);
+  if (!stream || !options.asa_guidance) return stream;
+  auto guidance = measure_asa_guidance(mesh, *stream);
   if (!guidance) return tl::unexpected(guidance.error());
-  return with_asa_guidance(stream, *guidance);
+  return with_asa_guidance(*stream, *guidance);
 }
 }  // namespace
 
@@ -302,50 +363,109 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
   if (mesh.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "mesh has no triangles");
   std::vector<Vec3i> q = quantize_positions(mesh, *grid);
+  auto plan =
+      plan_attributes(mesh, q, {options.quant_normal, options.quant_uv, options.quant_color});
+  if (!plan) return tl::unexpected(plan.error());
   auto editable = EditableMesh::build(q, mesh.triangles);
   if (!editable) return tl::unexpected(editable.error());
   // The stages' shares of the whole, from their times on a 0.8M-triangle
   // scan on two cores (import is the caller's).
-  const std::vector<RecordOrdering> orderings = orderings_to_try(options);
+  std::vector<RecordOrdering> orderings = orderings_to_try(options);
   const bool measuring = orderings.size() > 1;
+  const bool on_prefixes = measuring && !options.measure_whole_candidates;
   const double decimated_at = measuring ? 0.3 : 0.35, coded_at = measuring ? 0.8 : 1.0;
+  // On prefixes: the first candidate, the measurement, then (when another
+  // wins, which cannot be known before) its whole encode in what is left.
+  const double first_coded_at = 0.72, measured_at = 0.85;
   ProgressTracker progress(options.progress);
   progress.stage("decimating", 0.0, decimated_at);
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
+  dopt.locked = plan->locked;
   DecimationResult dec = decimate_layers(std::move(*editable), dopt);
-  progress.stage("coding records", decimated_at, coded_at);
 
   // The candidates.
+  auto uses_surface = [](const RecordOrdering& o) {
+    return o.distortion_estimate == DistortionEstimate::kSurfaceDistance;
+  };
+  // (on prefixes, built when a candidate that needs it is encoded)
   TriangleBvh surface;
-  if (std::any_of(orderings.begin(), orderings.end(), [](const RecordOrdering& o) {
-        return o.distortion_estimate == DistortionEstimate::kSurfaceDistance;
-      })) {
+  if (on_prefixes ? uses_surface(orderings[0])
+                  : std::any_of(orderings.begin(), orderings.end(), uses_surface))
     surface = grid_surface(mesh, q);
-  }
   const std::vector<Vec3f> input_normals = vertex_normals(q, mesh.triangles);
   auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report,
-                              const std::function<void(double)>& candidate_progress) {
+                              const std::function<void(double)>& candidate_progress,
+                              uint64_t stop_after_bytes = 0) {
     const RecordOrdering& o = orderings[i];
-    return encode_once(
-        mesh, *grid, q, input_normals, dec, options, bytes, o.plane_calibration, candidate_report,
-        o.distortion_estimate == DistortionEstimate::kSurfaceDistance ? &surface : nullptr,
-        candidate_progress);
+    return encode_once(mesh, *grid, q, input_normals, dec, options, bytes, o.plane_calibration,
+                       candidate_report, uses_surface(o) ? &surface : nullptr, candidate_progress,
+                       stop_after_bytes);
   };
   const RecordSizing sizing(mesh.vertex_count(), options);
   const bool parallel =
       measuring && options.threads != 1 && std::thread::hardware_concurrency() > 1;
+  if (on_prefixes) {
+    // The first candidate whole (it settles the record size, as before),
+    // the others only as far as the measurement decodes them, at that record
+    // size; a winner other than the first is then encoded whole. One
+    // encode at a time: the peak holds one replay.
+    progress.stage("coding records", decimated_at, first_coded_at);
+    auto first =
+        encode_candidates(encode_candidate, 1, sizing, false, report, progress.within_function());
+    if (!first) return tl::unexpected(first.error());
+    progress.stage("measuring", first_coded_at, measured_at);
+    const RdMeasureOptions measured{};
+    const auto stop = static_cast<uint64_t>(
+        std::ceil(measured.last_fraction * double(first->streams[0].bytes.size())));
+    std::vector<EncodedStream> streams;
+    streams.push_back(std::move(first->streams[0]));
+    if (surface.empty() && std::any_of(orderings.begin() + 1, orderings.end(), uses_surface))
+      surface = grid_surface(mesh, q);
+    for (size_t i = 1; i < orderings.size(); ++i) {
+      auto prefix = encode_candidate(i, first->record_bytes, nullptr, {}, stop);
+      if (!prefix) return tl::unexpected(prefix.error());
+      streams.push_back(std::move(*prefix));
+    }
+    // The measurement builds its own hierarchy over the original: the
+    // surface's goes first (and comes back for a winner that needs it).
+    // One stream after the other, each measured on every thread: the peak
+    // holds one decoded prefix and its hierarchy.
+    surface = TriangleBvh{};
+    auto best =
+        measured_best(mesh, *grid, q, streams, sizing, false, progress, true, options.threads);
+    if (!best) return tl::unexpected(best.error());
+    if (*best == 0) {
+      progress.stage("done", 1.0, 1.0);
+      return std::move(streams[0].bytes);
+    }
+    progress.stage("coding the winner", measured_at, 1.0);
+    if (uses_surface(orderings[*best])) surface = grid_surface(mesh, q);
+    EncodeReport winner_report;
+    auto winner = encode_candidate(*best, first->record_bytes, report ? &winner_report : nullptr,
+                                   progress.within_function());
+    if (!winner) return tl::unexpected(winner.error());
+    progress.stage("done", 1.0, 1.0);
+    if (sizing.automatic && sizing.granular(streams[0]) && !sizing.granular(*winner))
+      return std::move(streams[0].bytes);
+    if (report) *report = std::move(winner_report);
+    return guided(mesh, std::move(winner->bytes), options);
+  }
+
   auto candidates = encode_candidates(encode_candidate, orderings.size(), sizing, parallel, report,
                                       progress.within_function());
   if (!candidates) return tl::unexpected(candidates.error());
   if (!measuring) {
+    auto out = with_attributes(*plan, mesh, q, candidates->streams[0], report);
+    if (report) report->warnings = encode_warnings(mesh);
     progress.stage("done", 1.0, 1.0);
-    return guided(mesh, std::move(candidates->streams[0].bytes), options);
+    return guided(mesh, std::move(out), options);
   }
-  // What the measurement does not need goes before it builds its own
-  // hierarchy over the original: the peak is then one such hierarchy.
+  // The peer (EncodeOptions::measure_whole_candidates). What the
+  // measurement does not need goes before it builds its own hierarchy over
+  // the original: the peak is then one such hierarchy.
   surface = TriangleBvh{};
   dec = DecimationResult{};
 
@@ -353,9 +473,11 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   progress.stage("measuring", coded_at, 1.0);
   auto best = measured_best(mesh, *grid, q, candidates->streams, sizing, parallel, progress);
   if (!best) return tl::unexpected(best.error());
-  progress.stage("done", 1.0, 1.0);
   if (report && *best > 0) *report = std::move(candidates->reports[*best]);
-  return guided(mesh, std::move(candidates->streams[*best].bytes), options);
+  auto out = with_attributes(*plan, mesh, q, candidates->streams[*best], report);
+  if (report) report->warnings = encode_warnings(mesh);
+  progress.stage("done", 1.0, 1.0);
+  return guided(mesh, std::move(out), options);
 }
 
 }  // namespace meshstream

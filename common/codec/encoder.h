@@ -8,7 +8,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/base/result.h"
@@ -51,9 +53,17 @@ struct EncodeOptions {
   // records against structure records (record_schedule.h). 0 = automatic: the
   // streams of the kOrderingCandidates are decoded at log-spaced budgets and
   // the one with the smallest measured surface distance to the original
-  // wins (rd_measure.h; one encode and 5 distance measurements a candidate).
-  // A fixed balance encodes once. Embedded only.
+  // wins (rd_measure.h; 5 distance measurements a candidate). The first
+  // candidate is encoded whole, the others only as far as the measurement
+  // decodes them (1/8 of the first one's size), and a winner other than the
+  // first is then encoded whole (docs/hcs-format.md, "Record order and
+  // size"). A fixed balance encodes once. Embedded only.
   double plane_calibration = 0;
+  // The automatic choice as it was before issue 15's encoder work, kept as
+  // the peer the benchmarks compare against: every candidate encoded whole
+  // and measured at budgets relative to the first one's size (about twice
+  // the encode time, and the peak memory of two encodes at once).
+  bool measure_whole_candidates = false;
   // How a vertex's error enters that estimate. Embedded only; a value
   // outside the enum is kInvalidArgument.
   DistortionEstimate distortion_estimate = DistortionEstimate::kAutomatic;
@@ -80,6 +90,13 @@ struct EncodeOptions {
   // client's `--asa auto`). false: no guidance block (`meshstream encode
   // --no-asa-guidance`); the client then shows the prefixes as decoded.
   bool asa_guidance = true;
+  // Attribute quantization (attribute_quantize.h), 2..16 bits, else
+  // kInvalidArgument: normals per octahedral coordinate, texture coordinates
+  // per axis over their box, colours per channel on [0, 1] (8: 8-bit colours
+  // come back exactly). `meshstream encode --quant-normal/--quant-uv/--quant-color`.
+  int quant_normal = 8;
+  int quant_uv = 12;
+  int quant_color = 8;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each
@@ -135,7 +152,19 @@ struct EncodeReport {
   // The record ordering the stream was written with (the measured choice's
   // winner when automatic).
   RecordOrdering ordering{0, DistortionEstimate::kAutomatic};
+  // Bytes of the attribute records' parts ("layout", "seams", "normals",
+  // "texcoords", "colors", "materials", "extra"; attribute_codec.h).
+  std::map<std::string, uint64_t> attribute_bytes;
+  // Vertices kept out of decimation because a seam or a material border
+  // passes through them.
+  uint32_t attribute_locked_vertices = 0;
+  // What the stream does not carry (encode_warnings).
+  std::vector<std::string> warnings;
 };
+
+// The data of `mesh` an encode does not carry, one message each (empty when
+// everything is carried): `meshstream encode` prints them, the server logs them.
+std::vector<std::string> encode_warnings(const Mesh& mesh);
 
 // Encodes a clean manifold mesh (see import.h). kInvalidArgument for bad
 // options, kNonManifold / kInvalidMesh for a mesh the codec cannot take;

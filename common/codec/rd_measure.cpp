@@ -30,7 +30,8 @@ Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOption
 
 Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
                                               uint64_t reference_bytes,
-                                              const std::function<void(double)>& progress) const {
+                                              const std::function<void(double)>& progress,
+                                              uint64_t index_shortfall) const {
   auto index = read_stream_index(stream);
   if (!index) return tl::unexpected(index.error());
   std::vector<RdPoint> points;
@@ -42,7 +43,8 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
   for (uint32_t i = 0; i < n; ++i) {
     RdPoint p;
     p.budget = static_cast<uint64_t>(std::exp(n == 1 ? hi : lo + (hi - lo) * i / (n - 1)));
-    p.bytes = prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, double(p.budget)});
+    const double within = std::max(0.0, double(p.budget) - double(index_shortfall));
+    p.bytes = prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, within});
     if (p.bytes > fed) {
       auto applied = decoder.feed(stream.subspan(fed, p.bytes - fed));
       if (!applied) return tl::unexpected(applied.error());
@@ -61,9 +63,11 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
 }
 
 double RdMeasure::relative_rms(const Mesh& shown) const {
-  const double to_shown = weighted_rms_distance(original_samples_, TriangleBvh::build(shown));
+  const unsigned threads = options_.threads;
+  const double to_shown =
+      weighted_rms_distance(original_samples_, TriangleBvh::build(shown), threads);
   const double to_original =
-      weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_);
+      weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_, threads);
   return diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;
 }
 

@@ -37,6 +37,9 @@ struct RdMeasureOptions {
       5;  // log-spaced budgets between first_fraction and last_fraction of the stream
   double first_fraction = 1.0 / 64;
   double last_fraction = 1.0 / 8;
+  // Threads for the closest-point queries of each measurement (0 = one per
+  // core); the results are the same for every count.
+  unsigned threads = 1;
 };
 
 // One measured point of a stream's curve.
@@ -56,12 +59,16 @@ class RdMeasure {
 
   // Decodes `stream` at the budgets (fractions of `reference_bytes`, the
   // same for every candidate so their curves are compared at equal bytes)
-  // and measures each prefix. Fails with the decoder's error on a stream it
-  // cannot decode. Cost: one decode plus, per budget, a hierarchy over the
-  // prefix and 2 x samples closest-point queries. `progress`, when set, is
-  // called after each budget with the share of the budgets done.
+  // and measures each prefix. `index_shortfall`: for a stream that is
+  // itself a prefix (encode_once's stop_after_bytes), how many bytes its
+  // header and index are shorter than its whole stream's would be; the
+  // budgets then cut it where they would cut the whole stream. Fails with the decoder's error on a
+  // stream it cannot decode. Cost: one decode plus, per budget, a hierarchy over the prefix and 2 x
+  // samples closest-point queries. `progress`, when set, is called after each budget with the share
+  // of the budgets done.
   Result<std::vector<RdPoint>> curve(std::span<const uint8_t> stream, uint64_t reference_bytes,
-                                     const std::function<void(double)>& progress = {}) const;
+                                     const std::function<void(double)>& progress = {},
+                                     uint64_t index_shortfall = 0) const;
 
   // The symmetric RMS distance of `shown` (e.g. one decoded prefix) to the
   // original, over the original's bounding-box diagonal. Precondition:

@@ -79,6 +79,7 @@ class RecordScheduler {
     // vertices restored so far (0..1).
     const std::function<void(double)>& progress;
     uint32_t total_vertices;
+    uint64_t stop_after_bytes = 0;  // encode_once's: 0 = the whole mesh
   };
 
   // `state` is the decoder's state after the base, `truth` the encoder's
@@ -110,7 +111,7 @@ class RecordScheduler {
   // group's, else that group's next plane.
   Status run() {
     add_plane_groups(0, state_.mesh.vertex_count());
-    while (true) {
+    while (!prefix_done()) {
       const bool structure_left = writer_.layer_open() || next_layer_ > 0;
       const double n_now = state_.mesh.vertex_count();
       double best_slope = -std::numeric_limits<double>::infinity();
@@ -125,6 +126,15 @@ class RecordScheduler {
     }
     return {};
   }
+
+  // True once a prefix encode has its bytes (Inputs::stop_after_bytes);
+  // trailers counted, as the container sizes records.
+  bool prefix_done() const {
+    return in_.stop_after_bytes > 0 && refinement_bytes_ >= in_.stop_after_bytes;
+  }
+
+  // The input -> decoder vertex map once the replay is done.
+  std::vector<uint32_t> take_to_decoder() { return std::move(to_decoder_); }
 
  private:
   // Plane groups: about a record's worth of plane bits each. New ids join
@@ -191,6 +201,7 @@ class RecordScheduler {
       in_.report->records.push_back(
           {false, f.vertices, uint32_t(f.payload.size()), hash_state(), f.drop});
     }
+    refinement_bytes_ += f.payload.size() + 4;
     records_.push_back(std::move(f));
     add_plane_groups(first_new, state_.mesh.vertex_count() - first_new);
     return {};
@@ -231,6 +242,7 @@ class RecordScheduler {
           {true, f.vertices, uint32_t(f.payload.size()), hash_state(), f.drop});
     }
     evaluate_group(state_, truth_, g);
+    refinement_bytes_ += f.payload.size() + 4;
     records_.push_back(std::move(f));
   }
 
@@ -250,6 +262,7 @@ class RecordScheduler {
   double plane_bits_per_step_[kMaxShift + 1];
   std::vector<std::pair<uint32_t, uint32_t>> inserted_;
   PlainPlaneModels plain_models_;
+  uint64_t refinement_bytes_ = 0;  // records after the base, trailers counted
 };
 
 // The container (version 3: compact index, each record's CRC-32 in a
@@ -279,6 +292,7 @@ Result<EncodedStream> write_stream(const StreamHeader& header, std::vector<Writt
     out.largest_refinement = std::max<size_t>(out.largest_refinement, written->records[i].size);
   }
   out.records = written->records.size();
+  out.payload_offset = written->payload_offset;
   out.bytes = std::move(written->bytes);
   return out;
 }
@@ -291,7 +305,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                   const DecimationResult& dec, const EncodeOptions& options,
                                   uint32_t record_bytes, double plane_calibration,
                                   EncodeReport* report, const TriangleBvh* surface,
-                                  const std::function<void(double)>& progress) {
+                                  const std::function<void(double)>& progress,
+                                  uint64_t stop_after_bytes) {
   // The base: coarse positions, the smaller coder, the decoder's state.
   const int bits = grid.bits;
   // check_options let only writable formats through.
@@ -325,8 +340,15 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   records.push_back(std::move(base_record));
 
   // The records after the base.
-  const RecordScheduler::Inputs inputs{
-      grid, dec, options, record_bytes, plane_calibration, report, progress, mesh.vertex_count()};
+  const RecordScheduler::Inputs inputs{grid,
+                                       dec,
+                                       options,
+                                       record_bytes,
+                                       plane_calibration,
+                                       report,
+                                       progress,
+                                       mesh.vertex_count(),
+                                       stop_after_bytes};
   RecordScheduler scheduler(inputs, format, *state, truth, std::move(to_decoder), records);
   if (report) {
     report->records.clear();
@@ -344,6 +366,10 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   StreamHeader header;
   header.vertex_count = mesh.vertex_count();
   header.face_count = mesh.face_count();
+  if (stop_after_bytes > 0) {  // a prefix: the mesh its last record shows
+    header.vertex_count = records.back().vertices;
+    header.face_count = records.back().faces;
+  }
   header.base_vertex_count = base_n;
   header.base_face_count = base_faces;
   header.bounds = grid.bounds;
@@ -353,7 +379,9 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
   header.geometry_coder = kGeometryCoderEmbedded;
   header.layer_count = static_cast<uint32_t>(dec.layers.size());
   header.extra = {format.header_byte(), static_cast<uint8_t>(base_shift)};
-  return write_stream(header, std::move(records));
+  auto out = write_stream(header, std::move(records));
+  if (out) out->to_decoder = scheduler.take_to_decoder();
+  return out;
 }
 
 }  // namespace meshstream

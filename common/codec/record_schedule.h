@@ -23,6 +23,8 @@ struct EncodedStream {
   std::vector<uint8_t> bytes;
   size_t largest_refinement = 0;
   size_t records = 0;
+  uint64_t payload_offset = 0;  // bytes of magic, header and index
+  std::vector<uint32_t> to_decoder;  // input vertex id -> the decoder's id
 };
 
 // Encodes `mesh` (quantized to `q` on `grid`, decimated to `dec`) with
@@ -32,12 +34,18 @@ struct EncodedStream {
 // displacement. Fills `report` when given. Thread-safe for concurrent
 // calls that share the read-only inputs. Cost: O(V log V) plus one
 // closest-point query per estimated vertex error with a surface.
+// `stop_after_bytes` > 0 stops after the first record that brings the
+// records' bytes (trailers counted) to at least that many: the stream is
+// then a prefix, record for record the full stream's, whose header names
+// the mesh the prefix shows (for measuring orderings, encoder.cpp); its
+// cost is about that share of a full encode.
 Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                   const std::vector<Vec3i>& q,
                                   const std::vector<Vec3f>& input_normals,
                                   const DecimationResult& dec, const EncodeOptions& options,
                                   uint32_t record_bytes, double plane_calibration,
                                   EncodeReport* report, const TriangleBvh* surface,
-                                  const std::function<void(double)>& progress = {});
+                                  const std::function<void(double)>& progress = {},
+                                  uint64_t stop_after_bytes = 0);
 
 }  // namespace meshstream

@@ -98,8 +98,17 @@ uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, ui
     centroid_bounds.grow(centroids[refs[i]]);
   }
   const Vec3d pad{inflate_, inflate_, inflate_};
-  nodes_[index].lo = bounds.lo - pad;
-  nodes_[index].hi = bounds.hi + pad;
+  const Vec3d lo = bounds.lo - pad, hi = bounds.hi + pad;
+  auto down = [](double x) {
+    float f = static_cast<float>(x);
+    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+  };
+  auto up = [](double x) {
+    float f = static_cast<float>(x);
+    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+  };
+  nodes_[index].lo = {down(lo.x), down(lo.y), down(lo.z)};
+  nodes_[index].hi = {up(hi.x), up(hi.y), up(hi.z)};
 
   const uint32_t count = end - begin;
   auto make_leaf = [&] {
@@ -198,7 +207,10 @@ ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
   };
   Entry stack[kStackSize];
   uint32_t top = 0;
-  stack[top++] = {0, squared_distance_to_box(query, nodes_[0].lo, nodes_[0].hi)};
+  auto box_d2 = [&](const Node& n) {
+    return squared_distance_to_box(query, vec3_cast<double>(n.lo), vec3_cast<double>(n.hi));
+  };
+  stack[top++] = {0, box_d2(nodes_[0])};
   while (top > 0) {
     const Entry e = stack[--top];
     // Every triangle below lies at least e.d2 away (closest_point.h), so a
@@ -211,8 +223,8 @@ ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
     }
     const uint32_t left = e.node + 1;
     const uint32_t right = node.first;
-    const double dl = squared_distance_to_box(query, nodes_[left].lo, nodes_[left].hi);
-    const double dr = squared_distance_to_box(query, nodes_[right].lo, nodes_[right].hi);
+    const double dl = box_d2(nodes_[left]);
+    const double dr = box_d2(nodes_[right]);
     // Push the farther child first so the nearer one is searched first.
     if (dl <= dr) {
       if (dr <= best.squared_distance) stack[top++] = {right, dr};

@@ -1,7 +1,10 @@
 #include "common/metrics/surface_quadrature.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
+#include <vector>
 
 namespace meshstream {
 
@@ -35,14 +38,40 @@ WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area) {
   return out;
 }
 
-double weighted_rms_distance(const WeightedSamples& from, const TriangleBvh& to) {
+double weighted_rms_distance(const WeightedSamples& from, const TriangleBvh& to, unsigned threads) {
+  // Fixed blocks, each summed in order and the block sums added in order:
+  // the same result for every thread count.
+  constexpr size_t kBlock = 8192;
+  const size_t blocks = (from.points.size() + kBlock - 1) / kBlock;
+  std::vector<double> sums(blocks, 0.0), weights(blocks, 0.0);
+  auto run_block = [&](size_t b) {
+    uint32_t hint = TriangleBvh::kNoHint;
+    const size_t end = std::min(from.points.size(), (b + 1) * kBlock);
+    for (size_t i = b * kBlock; i < end; ++i) {
+      const ClosestHit hit = to.closest(from.points[i], hint);
+      hint = hit.triangle;
+      sums[b] += from.weights[i] * hit.squared_distance;
+      weights[b] += from.weights[i];
+    }
+  };
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<size_t>(threads, blocks));
+  if (threads <= 1) {
+    for (size_t b = 0; b < blocks; ++b) run_block(b);
+  } else {
+    std::atomic<size_t> next{0};
+    auto worker = [&] {
+      for (size_t b = next++; b < blocks; b = next++) run_block(b);
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+  }
   double sum = 0, weight = 0;
-  uint32_t hint = TriangleBvh::kNoHint;
-  for (size_t i = 0; i < from.points.size(); ++i) {
-    const ClosestHit hit = to.closest(from.points[i], hint);
-    hint = hit.triangle;
-    sum += from.weights[i] * hit.squared_distance;
-    weight += from.weights[i];
+  for (size_t b = 0; b < blocks; ++b) {
+    sum += sums[b];
+    weight += weights[b];
   }
   return weight > 0 ? std::sqrt(sum / weight) : 0;
 }

@@ -34,8 +34,10 @@ struct WeightedSamples {
 WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area);
 
 // sqrt(sum of weight x squared distance to `to` / total weight): the RMS
-// distance from the sampled surface to `to`. 0 for no samples.
-// Precondition: !to.empty(). O(points log F).
-double weighted_rms_distance(const WeightedSamples& from, const TriangleBvh& to);
+// distance from the sampled surface to `to`. 0 for no samples. The points
+// are queried on `threads` threads (0 = one per core); the result is the
+// same for every count. Precondition: !to.empty(). O(points log F).
+double weighted_rms_distance(const WeightedSamples& from, const TriangleBvh& to,
+                             unsigned threads = 1);
 
 }  // namespace meshstream

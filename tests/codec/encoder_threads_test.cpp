@@ -62,7 +62,8 @@ TEST(EncoderThreads, ProgressAdvancesSmoothlyThroughTheStages) {
     EXPECT_LE(calls.size(), 800u);
     EXPECT_EQ(calls.back().stage, "done");
     EXPECT_DOUBLE_EQ(calls.back().fraction, 1.0);
-    const std::vector<std::string> order = {"decimating", "coding records", "measuring", "done"};
+    const std::vector<std::string> order = {"decimating", "coding records", "measuring",
+                                            "coding the winner", "done"};
     size_t stage = 0;
     std::vector<int> calls_in(order.size(), 0);
     for (size_t i = 0; i < calls.size(); ++i) {

@@ -109,11 +109,39 @@ int main(int argc, char** argv) {
     std::string name;
     Mesh mesh;
   };
-  const std::vector<Named> meshes = {
+  std::vector<Named> meshes = {
       {"icosahedron", make_icosahedron()},      {"icosphere2", make_icosphere(2)},
       {"icosphere3", make_icosphere(3)},        {"grid8", make_open_grid(8)},
       {"components3", make_multi_component(3)}, {"torus", make_torus(16, 8)},
   };
+  // Attribute records (attribute_codec.h): per-vertex colours and normals;
+  // per-corner texture coordinates with seams (each face its own island, so
+  // every edge is a seam), face materials and an extra attribute.
+  {
+    Mesh colored = make_icosphere(3);
+    for (const Vec3f& p : colored.positions) {
+      colored.colors.push_back({0.5f + p.x / 2, 0.5f + p.y / 2, 0.5f + p.z / 2, 1.0f});
+      colored.normals.push_back(p);
+    }
+    meshes.push_back({"icosphere3_colors", colored});
+    Mesh seamed = make_torus(16, 8);
+    for (uint32_t f = 0; f < seamed.face_count(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        seamed.corner_texcoords.corners.push_back(uint32_t(seamed.corner_texcoords.values.size()));
+        seamed.corner_texcoords.values.push_back(
+            {float(f % 16) / 16 + 0.01f * k, float(f / 16) / 16});
+      }
+      seamed.face_materials.push_back(f % 2);
+    }
+    seamed.materials.resize(2);
+    seamed.materials[1].name = "second";
+    ExtraAttribute extra;
+    extra.name = "TEXCOORD_1";
+    extra.components = 2;
+    extra.bytes.assign(3 * seamed.face_count() * 8, 0x3f);
+    seamed.extra_attributes.push_back(extra);
+    meshes.push_back({"torus_seams", seamed});
+  }
 
   // ---- hcs_decoder: whole streams, several coders and sizes.
   std::vector<uint8_t> sample_stream;

@@ -7,7 +7,8 @@
 // Checked: read_stream_index and decode_hcs on the whole input, and
 // IncrementalDecoder fed piece by piece never crash, never read out of
 // bounds (ASan) and never hit undefined behaviour (UBSan); once the decoder
-// reports an error it stays in error and keeps its last good (valid) mesh; a resume
+// reports an error it stays in error and keeps its last good (valid) mesh, its
+// attribute arrays included (check_attribute_counts); a resume
 // at the decoder's own resume offset is accepted.
 //
 // The container's CRC-32s would stop almost every mutation at the index or
@@ -74,6 +75,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       check(decoder.records_decoded() >= before);
       check(decoder.records_decoded() > before || decoder.mesh().triangles.size() == faces_before);
       check(validate_arrays(decoder.mesh()).has_value());
+      check(check_attribute_counts(decoder.mesh()).has_value());  // attribute arrays too
       check(!decoder.feed(piece).has_value());
       break;
     }
@@ -86,6 +88,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(decoder.resume_offset() == resume);
     const Mesh& mesh = decoder.mesh();
     check(validate_arrays(mesh).has_value());  // every index names a vertex
+    // Attribute arrays as long as the vertex and corner arrays, indices in range.
+    check(check_attribute_counts(mesh).has_value());
   }
   return 0;
 }

@@ -134,7 +134,7 @@ TEST(MeshCommands, InfoReportsWhatTheFileHoldsEvenWhatImportDrops) {
   EXPECT_EQ(contents["materials_used"][0], "shiny");
 }
 
-TEST(MeshCommands, InfoOfKeptAttributesSaysEncodeDropsThem) {
+TEST(MeshCommands, InfoOfKeptAttributesSaysEncodeCarriesThem) {
   REQUIRE_BINARY();
   const std::string path = temp_path("per_vertex.obj");
   std::ofstream(path) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
@@ -143,14 +143,15 @@ TEST(MeshCommands, InfoOfKeptAttributesSaysEncodeDropsThem) {
   std::filesystem::remove(path);
   ASSERT_EQ(text.exit_code, 0);
   EXPECT_NE(text.out.find("texture coordinates   3 'vt' lines (kept by import and subdivide; "
-                          "not carried: attributes are dropped by encode)"),
+                          "carried by encode)"),
             std::string::npos)
       << text.out;
-  EXPECT_NE(text.out.find("attributes      texture coordinates (not carried"), std::string::npos)
+  EXPECT_NE(text.out.find("attributes      texture coordinates (carried by encode"),
+            std::string::npos)
       << text.out;
   const auto json = nlohmann::json::parse(json_run.out);
   EXPECT_EQ(json["contents"]["texcoords"]["kept_by_import"], true);
-  EXPECT_EQ(json["contents"]["texcoords"]["carried_by_encode"], false);
+  EXPECT_EQ(json["contents"]["texcoords"]["carried_by_encode"], true);
 }
 
 TEST(MeshCommands, InfoOfTheSharedFilesNamesTheirAttributes) {

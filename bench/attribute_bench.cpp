@@ -1,0 +1,322 @@
+// attribute_bench (issue 18, point 5): every model of ../shared/models that
+// Draco's reader takes, our stream against Draco at the same quantization
+// (positions 12 bits, normals 8, texture coordinates 12, colours 8:
+// `draco_encoder -qp 12 -qn 8 -qt 12 -qg 8`, through the library so glTF
+// files go the same way), total bytes and bytes per attribute, decode time
+// (median of 5), exactness of our full-rate decode, and what locking the
+// seam vertices costs (our stream with and without the attributes).
+//
+// Draco's cost of an attribute: its bytes with every attribute minus its
+// bytes without that one. Ours: the attribute's sections of the attribute
+// records, plus the seam bits when it is per corner (counted again for each
+// per-corner attribute: conservative). Inputs: each model read by
+// draco::ReadMeshFromFile, welded by position (Draco's points split at
+// seams), attributes per vertex where every corner of a vertex agrees, else
+// per corner; the mesh then cleaned as import does (clean_mesh). Only the
+// first normal, texture coordinate and colour attribute are compared (Draco
+// is given the same: SheenCloth's tangents and second UV set are left out of
+// both).
+//
+// Usage: attribute_bench [MODELS_DIR] [--out FILE.md]
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/io/mesh_io.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/codec/attribute_codec.h"
+#include "common/codec/container.h"
+#include "common/codec/decoder.h"
+#include "common/codec/encoder.h"
+#include "common/mesh/import.h"
+#include "tests/codec/attribute_test_util.h"
+
+namespace fs = std::filesystem;
+using namespace meshstream;
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+template <class F>
+double median_ms(F&& f, int runs = 5) {
+  std::vector<double> t;
+  for (int i = 0; i < runs; ++i) {
+    const auto a = std::chrono::steady_clock::now();
+    f();
+    t.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+  }
+  return median(t);
+}
+
+// Values of `att` at point p as floats (n components).
+std::vector<float> value_at(const draco::PointAttribute* att, draco::PointIndex p) {
+  std::vector<float> out(att->num_components());
+  att->ConvertValue<float>(att->mapped_index(p), att->num_components(), out.data());
+  return out;
+}
+
+// Draco's mesh as ours: positions welded, attributes per vertex or corner.
+Mesh to_mesh(const draco::Mesh& dm, std::string& kinds) {
+  Mesh m;
+  const auto* pos = dm.GetNamedAttribute(draco::GeometryAttribute::POSITION);
+  std::map<std::array<float, 3>, uint32_t> ids;
+  std::vector<uint32_t> vertex_of(dm.num_points());
+  for (uint32_t p = 0; p < dm.num_points(); ++p) {
+    const auto v = value_at(pos, draco::PointIndex(p));
+    const std::array<float, 3> key{v[0], v[1], v[2]};
+    auto it = ids.find(key);
+    if (it == ids.end()) {
+      it = ids.emplace(key, m.vertex_count()).first;
+      m.positions.push_back({v[0], v[1], v[2]});
+    }
+    vertex_of[p] = it->second;
+  }
+  std::vector<uint32_t> corner_point;
+  for (uint32_t f = 0; f < dm.num_faces(); ++f) {
+    const auto& face = dm.face(draco::FaceIndex(f));
+    m.triangles.push_back(
+        {vertex_of[face[0].value()], vertex_of[face[1].value()], vertex_of[face[2].value()]});
+    for (int k = 0; k < 3; ++k) corner_point.push_back(face[k].value());
+  }
+  // One attribute: per vertex when every corner of each vertex agrees.
+  auto take = [&](draco::GeometryAttribute::Type type, auto& per_vertex, auto& per_corner,
+                  auto make) {
+    const auto* att = dm.GetNamedAttribute(type);
+    if (!att) return;
+    const uint32_t nv = m.vertex_count();
+    std::vector<std::vector<float>> first(nv);
+    bool seams = false;
+    for (size_t c = 0; c < corner_point.size(); ++c) {
+      const auto value = value_at(att, draco::PointIndex(corner_point[c]));
+      auto& f = first[m.triangles[c / 3][c % 3]];
+      if (f.empty())
+        f = value;
+      else if (f != value)
+        seams = true;
+    }
+    if (!seams) {
+      for (uint32_t v = 0; v < nv; ++v) per_vertex.push_back(make(first[v]));
+    } else {
+      std::map<std::vector<float>, uint32_t> index;
+      for (size_t c = 0; c < corner_point.size(); ++c) {
+        const auto value = value_at(att, draco::PointIndex(corner_point[c]));
+        auto it = index.find(value);
+        if (it == index.end()) {
+          it = index.emplace(value, uint32_t(per_corner.values.size())).first;
+          per_corner.values.push_back(make(value));
+        }
+        per_corner.corners.push_back(it->second);
+      }
+    }
+    kinds += std::string(kinds.empty() ? "" : ", ") +
+             (type == draco::GeometryAttribute::NORMAL      ? "normals"
+              : type == draco::GeometryAttribute::TEX_COORD ? "uv"
+                                                            : "colors") +
+             (seams ? " (seams)" : "");
+  };
+  take(draco::GeometryAttribute::NORMAL, m.normals, m.corner_normals,
+       [](const std::vector<float>& v) {
+         return Vec3f{v[0], v[1], v[2]};
+       });
+  take(draco::GeometryAttribute::TEX_COORD, m.texcoords, m.corner_texcoords,
+       [](const std::vector<float>& v) {
+         return Vec2f{v[0], v[1]};
+       });
+  take(draco::GeometryAttribute::COLOR, m.colors, m.corner_colors, [](const std::vector<float>& v) {
+    return Vec4f{v[0], v.size() > 1 ? v[1] : 0, v.size() > 2 ? v[2] : 0,
+                 v.size() > 3 ? v[3] : 1.0f};
+  });
+  return m;
+}
+
+size_t draco_bytes(const draco::Mesh& mesh, std::vector<uint8_t>* out = nullptr) {
+  draco::Encoder enc;
+  enc.SetAttributeQuantization(draco::GeometryAttribute::POSITION, 12);
+  enc.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, 8);
+  enc.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, 12);
+  enc.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, 8);
+  enc.SetSpeedOptions(3, 3);  // draco_encoder's default -cl 7
+  draco::EncoderBuffer buffer;
+  if (!enc.EncodeMeshToBuffer(mesh, &buffer).ok()) return 0;
+  if (out) out->assign(buffer.data(), buffer.data() + buffer.size());
+  return buffer.size();
+}
+
+// Draco's mesh with the first normal, texture coordinate and colour
+// attribute (what we encode from it), minus the types in `drop`.
+std::unique_ptr<draco::Mesh> draco_only(const draco::Mesh& in,
+                                        const std::vector<draco::GeometryAttribute::Type>& drop) {
+  auto m = std::make_unique<draco::Mesh>();
+  m->Copy(in);
+  for (int i = m->num_attributes() - 1; i >= 0; --i) {
+    const auto type = m->attribute(i)->attribute_type();
+    if (type == draco::GeometryAttribute::POSITION) continue;
+    const bool modelled = type == draco::GeometryAttribute::NORMAL ||
+                          type == draco::GeometryAttribute::TEX_COORD ||
+                          type == draco::GeometryAttribute::COLOR;
+    const bool first = m->GetNamedAttributeId(type) == i;
+    if (!modelled || !first || std::find(drop.begin(), drop.end(), type) != drop.end())
+      m->DeleteAttribute(i);
+  }
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string dir = "/work/shared/models", out_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--out" && i + 1 < argc)
+      out_path = argv[++i];
+    else
+      dir = a;
+  }
+  std::vector<fs::path> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    const std::string ext = e.path().extension().string();
+    if (ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".gltf")
+      files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::string table =
+      "| model | vertices | attributes | ours total | Draco total | ratio | ours geometry | Draco "
+      "geometry | normals ours/Draco | uv ours/Draco | colors ours/Draco | seams | locked vertices "
+      "| "
+      "geometry without attributes (base vertices) | first display: bytes with attributes / "
+      "without | exact | decode ms ours / Draco |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const fs::path& file : files) {
+    auto read = draco::ReadMeshFromFile(file.string());
+    const std::string name = fs::relative(file, dir).string();
+    if (!read.ok()) {
+      std::printf("%s: Draco cannot read it: %s\n", name.c_str(), read.status().error_msg());
+      table += "| " + name + " | not read by Draco: " + read.status().error_msg_string() + " |\n";
+      continue;
+    }
+    const draco::Mesh& dm = *read.value();
+    std::string kinds;
+    Mesh mesh = to_mesh(dm, kinds);
+    if (auto cleaned = clean_mesh(mesh); !cleaned) {
+      table += "| " + name + " | clean failed: " + cleaned.error().message + " |\n";
+      continue;
+    }
+    if (auto s = check_attribute_counts(mesh); !s) {
+      table += "| " + name + " | " + s.error().message + " |\n";
+      continue;
+    }
+    EncodeOptions options;
+    EncodeReport report;
+    auto stream = encode_hcs(mesh, options, &report);
+    if (!stream) {
+      std::printf("%s: encode failed: %s\n", name.c_str(), stream.error().message.c_str());
+      table += "| " + name + " | encode failed: " + stream.error().message + " |\n";
+      continue;
+    }
+    Mesh plain = mesh;
+    plain.normals.clear();
+    plain.texcoords.clear();
+    plain.colors.clear();
+    plain.corner_normals = {};
+    plain.corner_texcoords = {};
+    plain.corner_colors = {};
+    auto plain_stream = encode_hcs(plain, options);
+    const auto plain_index =
+        plain_stream ? read_stream_index(*plain_stream)
+                     : Result<StreamIndex>(tl::unexpected(Error{ErrorCode::kInternal, ""}));
+    auto index = read_stream_index(*stream);
+    uint64_t attribute_total = 0;
+    for (const auto& [k, n] : report.attribute_bytes) attribute_total += n;
+    // Attribute records with their index entries and trailers: the stream
+    // minus the records' payload sections counted above is ours geometry.
+    uint64_t attribute_records = 0;
+    for (size_t i = 1; i < index->records.size(); ++i)
+      if ((*stream)[index->records[i].offset] == kRecordAttributes)
+        attribute_records += index->records[i].size;
+    const uint64_t ours_total = stream->size();
+    const uint64_t ours_geometry = ours_total - attribute_records;
+    // The first display with attributes: through record 1 (record 0 when
+    // the stream has none); without: the plain stream's base.
+    const size_t shown =
+        index->records.size() > 1 && (*stream)[index->records[1].offset] == kRecordAttributes ? 1
+                                                                                              : 0;
+    const uint64_t first_display = index->records[shown].offset + index->records[shown].size;
+    const uint64_t plain_first =
+        plain_index ? plain_index->records[0].offset + plain_index->records[0].size : 0;
+    Result<Mesh> decoded = decode_hcs(*stream);
+    const bool exact = decoded && testing::faces_of(*decoded) ==
+                                      testing::faces_of(testing::expected_mesh(mesh, options));
+    const double ours_ms = median_ms([&] { (void)decode_hcs(*stream); });
+
+    const std::vector<draco::GeometryAttribute::Type> all = {draco::GeometryAttribute::NORMAL,
+                                                             draco::GeometryAttribute::TEX_COORD,
+                                                             draco::GeometryAttribute::COLOR};
+    std::vector<uint8_t> draco_stream;
+    const size_t draco_all = draco_bytes(*draco_only(dm, {}), &draco_stream);
+    const size_t draco_geometry = draco_bytes(*draco_only(dm, all));
+    const double draco_ms = median_ms([&] {
+      draco::DecoderBuffer b;
+      b.Init(reinterpret_cast<const char*>(draco_stream.data()), draco_stream.size());
+      draco::Decoder d;
+      (void)d.DecodeMeshFromBuffer(&b);
+    });
+    auto draco_cost = [&](draco::GeometryAttribute::Type t) -> long {
+      if (!dm.GetNamedAttribute(t)) return -1;
+      return long(draco_all) - long(draco_bytes(*draco_only(dm, {t})));
+    };
+    const uint64_t seams =
+        report.attribute_bytes.count("seams") ? report.attribute_bytes["seams"] : 0;
+    auto ours_cost = [&](const char* part, bool per_corner) -> long {
+      if (!report.attribute_bytes.count(part)) return -1;
+      return long(report.attribute_bytes[part] + (per_corner ? seams : 0));
+    };
+    auto cell = [](long ours, long draco) {
+      if (ours < 0 && draco < 0) return std::string("-");
+      char b[96];
+      std::snprintf(b, sizeof b, "%ld / %ld (%.2f)", ours, draco,
+                    draco > 0 ? double(ours) / draco : 0.0);
+      return std::string(b);
+    };
+    char row[1024];
+    std::snprintf(row, sizeof row,
+                  "| %s | %u | %s | %llu | %zu | %.3f | %llu | %zu | %s | %s | %s | %llu | %u | "
+                  "%zu (%u) | %llu / %llu (%.2f) | %s | %.2f / %.2f |\n",
+                  name.c_str(), mesh.vertex_count(), kinds.c_str(), (unsigned long long)ours_total,
+                  draco_all, draco_all ? double(ours_total) / draco_all : 0.0,
+                  (unsigned long long)ours_geometry, draco_geometry,
+                  cell(ours_cost("normals", !mesh.corner_normals.empty()),
+                       draco_cost(draco::GeometryAttribute::NORMAL))
+                      .c_str(),
+                  cell(ours_cost("texcoords", !mesh.corner_texcoords.empty()),
+                       draco_cost(draco::GeometryAttribute::TEX_COORD))
+                      .c_str(),
+                  cell(ours_cost("colors", !mesh.corner_colors.empty()),
+                       draco_cost(draco::GeometryAttribute::COLOR))
+                      .c_str(),
+                  (unsigned long long)seams, report.attribute_locked_vertices,
+                  plain_stream ? plain_stream->size() : 0,
+                  plain_index ? plain_index->header.base_vertex_count : 0,
+                  (unsigned long long)first_display, (unsigned long long)plain_first,
+                  plain_first ? double(first_display) / plain_first : 0.0, exact ? "yes" : "NO",
+                  ours_ms, draco_ms);
+    std::printf("%s", row);
+    std::printf("  base vertices with attributes %u, without %u\n", index->header.base_vertex_count,
+                plain_index ? plain_index->header.base_vertex_count : 0);
+    table += row;
+  }
+  std::printf("\n%s", table.c_str());
+  if (!out_path.empty()) std::ofstream(out_path) << table;
+  return 0;
+}

@@ -1,0 +1,1085 @@
+// See attribute_codec.h and docs/hcs-format.md ("Attribute records").
+#include "common/codec/attribute_codec.h"
+
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+#include "common/codec/byte_io.h"
+#include "common/codec/container.h"
+#include "common/codec/decoder.h"
+#include "common/codec/range_coder.h"
+#include "common/codec/refinement_state.h"
+#include "common/codec/stream_format.h"
+
+namespace meshstream {
+
+const char* attribute_kind_name(AttributeKind kind) {
+  switch (kind) {
+    case AttributeKind::kNormal:
+      return "normals";
+    case AttributeKind::kTexcoord:
+      return "texcoords";
+    case AttributeKind::kColor:
+      return "colors";
+    case AttributeKind::kMaterial:
+      return "materials";
+  }
+  return "unknown";
+}
+
+uint32_t wedge_of_corner(const EditableMesh& m, const AttributeValues& a, uint32_t c) {
+  const uint32_t v = m.vertex(c);
+  const uint32_t first = a.wedge_start[v], count = a.wedge_start[v + 1] - first;
+  if (count <= 1) return first;
+  // Walk across the edges (v, b) until one ends the wedge.
+  uint32_t cur = c;
+  for (uint32_t guard = 0; guard < 4 * kMaxPatchValence * 64; ++guard) {
+    const uint32_t b = m.vertex(EditableMesh::prev(cur));
+    const uint32_t o = m.opposite(EditableMesh::next(cur));
+    const uint32_t key = o == kNone ? kBoundaryKey : b;
+    for (uint32_t w = first; w < first + count; ++w)
+      if (a.wedge_key[w] == key) return w;
+    if (o == kNone) break;
+    cur = EditableMesh::next(o);
+    if (cur == c) break;
+  }
+  return first;  // only a hostile stream gets here (read_base checked the wedges)
+}
+
+namespace {
+
+constexpr int kContexts = 4;  // parallelogram, neighbours, none, geometric
+
+struct ChannelModels {
+  AdaptiveIntModel residual[kContexts][4];
+};
+
+// Values of channel `ch` at corner c.
+const int32_t* corner_value(const EditableMesh& m, const AttributeValues& a,
+                            const AttributeChannel& channel, size_t ch, uint32_t c) {
+  const uint32_t idx = channel.per_corner ? wedge_of_corner(m, a, c) : m.vertex(c);
+  return &a.data[ch][size_t(idx) * channel.components()];
+}
+
+// The prediction of vertex v's value (wedge w of a per-corner channel) from
+// vertices below v; returns its context.
+int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayout& layout,
+            size_t ch, uint32_t v, uint32_t w, bool geometric, int32_t* out,
+            std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) {
+  const AttributeChannel& channel = layout.channels[ch];
+  const uint32_t n = channel.components();
+  const int32_t max = layout.max_value(channel);
+  m.star(v, ring, corners);
+  int64_t para[4] = {0, 0, 0, 0}, near[4] = {0, 0, 0, 0};
+  int64_t para_count = 0, near_count = 0;
+  double normal[3] = {0, 0, 0};
+  for (uint32_t c : corners) {
+    if (channel.per_corner && a.wedge_start[v + 1] - a.wedge_start[v] > 1 &&
+        wedge_of_corner(m, a, c) != w)
+      continue;
+    const uint32_t na = EditableMesh::next(c), pb = EditableMesh::prev(c);
+    const uint32_t va = m.vertex(na), vb = m.vertex(pb);
+    if (geometric) {
+      const Vec3i& p = m.positions()[v];
+      const Vec3i& pa = m.positions()[va];
+      const Vec3i& pbv = m.positions()[vb];
+      const int64_t ax = pa.x - p.x, ay = pa.y - p.y, az = pa.z - p.z;
+      const int64_t bx = pbv.x - p.x, by = pbv.y - p.y, bz = pbv.z - p.z;
+      normal[0] += double(ay * bz - az * by);
+      normal[1] += double(az * bx - ax * bz);
+      normal[2] += double(ax * by - ay * bx);
+      continue;
+    }
+    const bool a_known = va < v, b_known = vb < v;
+    if (a_known && b_known) {
+      const uint32_t o = m.opposite(c);
+      if (o != kNone && m.vertex(o) < v) {
+        const int32_t* A = corner_value(m, a, channel, ch, na);
+        const int32_t* B = corner_value(m, a, channel, ch, pb);
+        const int32_t* X = corner_value(m, a, channel, ch, o);
+        for (uint32_t i = 0; i < n; ++i) para[i] += int64_t(A[i]) + B[i] - X[i];
+        ++para_count;
+        continue;
+      }
+    }
+    if (a_known) {
+      const int32_t* A = corner_value(m, a, channel, ch, na);
+      for (uint32_t i = 0; i < n; ++i) near[i] += A[i];
+      ++near_count;
+    }
+    if (b_known) {
+      const int32_t* B = corner_value(m, a, channel, ch, pb);
+      for (uint32_t i = 0; i < n; ++i) near[i] += B[i];
+      ++near_count;
+    }
+  }
+  if (geometric && (normal[0] != 0 || normal[1] != 0 || normal[2] != 0)) {
+    const auto q = quantize_direction(normal[0], normal[1], normal[2], channel.bits);
+    out[0] = q[0];
+    out[1] = q[1];
+    return 3;
+  }
+  if (geometric) return predict(m, a, layout, ch, v, w, false, out, ring, corners);
+  int context = 2;
+  for (uint32_t i = 0; i < n; ++i) out[i] = 0;
+  if (para_count > 0) {
+    context = 0;
+    for (uint32_t i = 0; i < n; ++i) out[i] = int32_t(para[i] / para_count);
+  } else if (near_count > 0) {
+    context = 1;
+    for (uint32_t i = 0; i < n; ++i) out[i] = int32_t(near[i] / near_count);
+  } else if (v > 0 || w > 0) {
+    // The previous value of this channel.
+    const size_t idx = channel.per_corner ? (w > 0 ? w - 1 : 0) : v - 1;
+    for (uint32_t i = 0; i < n; ++i) out[i] = a.data[ch][idx * n + i];
+  }
+  for (uint32_t i = 0; i < n; ++i) out[i] = std::clamp(out[i], 0, max);
+  return context;
+}
+
+// Residual of value against prediction: normals wrap around the octahedral
+// grid (both ends are one fold apart), the others are plain differences.
+int32_t residual_of(const AttributeChannel& c, int32_t max, int32_t value, int32_t pred) {
+  int32_t r = value - pred;
+  if (c.kind == AttributeKind::kNormal) {
+    const int32_t span = max + 1;
+    if (r > span / 2)
+      r -= span;
+    else if (r < -((span - 1) / 2))
+      r += span;
+  }
+  return r;
+}
+
+// The value a residual gives; false when it leaves the grid.
+bool value_of(const AttributeChannel& c, int32_t max, int32_t pred, int64_t r, int32_t& value) {
+  int64_t v = int64_t(pred) + r;
+  if (c.kind == AttributeKind::kNormal) {
+    const int64_t span = int64_t(max) + 1;
+    if (r < -span || r > span) return false;
+    v = ((v % span) + span) % span;
+  }
+  if (v < 0 || v > max) return false;
+  value = int32_t(v);
+  return true;
+}
+
+// Normals are predicted from the geometry: in the last record from the exact
+// positions, in record 1 from the base's coarse ones (what the decoder has).
+bool use_geometric(const AttributeChannel& c, bool /*final_record*/) {
+  return c.kind == AttributeKind::kNormal;
+}
+
+// The wedges of every vertex of `m` from per-corner values (all corner
+// channels, each corner's ints concatenated): seam sets per vertex.
+std::vector<std::vector<uint32_t>> seams_of(const EditableMesh& m,
+                                            const std::vector<std::vector<int32_t>>& values,
+                                            const AttributeLayout& layout,
+                                            const std::vector<uint32_t>* corner_map) {
+  std::vector<std::vector<uint32_t>> seams(m.vertex_count());
+  auto same = [&](uint32_t c1, uint32_t c2) {
+    const uint32_t i1 = corner_map ? (*corner_map)[c1] : c1;
+    const uint32_t i2 = corner_map ? (*corner_map)[c2] : c2;
+    for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+      const AttributeChannel& channel = layout.channels[ch];
+      if (!channel.per_corner) continue;
+      const uint32_t n = channel.components();
+      for (uint32_t i = 0; i < n; ++i)
+        if (values[ch][size_t(i1) * n + i] != values[ch][size_t(i2) * n + i]) return false;
+    }
+    return true;
+  };
+  for (uint32_t c = 0; c < 3 * m.face_slot_count(); ++c) {
+    if (m.face_dead(c / 3)) continue;
+    const uint32_t o = m.opposite(EditableMesh::next(c));
+    if (o == kNone) continue;
+    const uint32_t c2 = EditableMesh::next(o);
+    if (!same(c, c2)) seams[m.vertex(c)].push_back(m.vertex(EditableMesh::prev(c)));
+  }
+  return seams;
+}
+
+bool any_corner_channel(const AttributeLayout& l) {
+  return std::any_of(l.channels.begin(), l.channels.end(),
+                     [](const AttributeChannel& c) { return c.per_corner; });
+}
+
+// ---- layout bytes ----
+
+void put_f64(std::vector<uint8_t>& out, double d) {
+  uint64_t b;
+  std::memcpy(&b, &d, 8);
+  put_u32(out, uint32_t(b));
+  put_u32(out, uint32_t(b >> 32));
+}
+
+void put_string(std::vector<uint8_t>& out, const std::string& s) {
+  put_varint(out, uint32_t(s.size()));
+  out.insert(out.end(), s.begin(), s.end());
+}
+
+std::vector<uint8_t> write_layout(const AttributeLayout& l) {
+  std::vector<uint8_t> out;
+  out.push_back(uint8_t(l.channels.size()));
+  for (const AttributeChannel& c : l.channels) {
+    out.push_back(uint8_t(c.kind));
+    out.push_back(c.per_corner ? 1 : 0);
+    out.push_back(c.bits);
+    if (c.kind == AttributeKind::kTexcoord) {
+      put_f32(out, c.uv.min.x);
+      put_f32(out, c.uv.min.y);
+      put_f64(out, c.uv.step);
+    }
+  }
+  put_varint(out, uint32_t(l.materials.size()));
+  for (const Material& m : l.materials) {
+    put_string(out, m.name);
+    for (float f :
+         {m.base_color.x, m.base_color.y, m.base_color.z, m.base_color.w, m.metallic, m.roughness})
+      put_f32(out, f);
+    for (int32_t t : {m.base_color_texture, m.normal_texture, m.metallic_roughness_texture,
+                      m.occlusion_texture, m.emissive_texture})
+      put_u32(out, uint32_t(t));
+    put_varint(out, m.base_color_texcoord_set);
+    out.push_back(m.double_sided ? 1 : 0);
+  }
+  return out;
+}
+
+struct Reader {
+  std::span<const uint8_t> in;
+  size_t pos = 0;
+  bool ok = true;
+  bool need(size_t n) {
+    if (in.size() - pos < n) ok = false;
+    return ok;
+  }
+  uint8_t u8() { return need(1) ? in[pos++] : 0; }
+  uint32_t u32() {
+    if (!need(4)) return 0;
+    const uint32_t v = get_u32(in.data() + pos);
+    pos += 4;
+    return v;
+  }
+  float f32() {
+    if (!need(4)) return 0;
+    const float f = get_f32(in.data() + pos);
+    pos += 4;
+    return f;
+  }
+  double f64() {
+    const uint64_t lo = u32(), hi = u32();
+    const uint64_t b = lo | (hi << 32);
+    double d;
+    std::memcpy(&d, &b, 8);
+    return d;
+  }
+  uint32_t varint() {
+    uint32_t v = 0;
+    if (ok && !get_varint(in, pos, v)) ok = false;
+    return ok ? v : 0;
+  }
+  std::string string(size_t limit) {
+    const uint32_t n = varint();
+    if (!ok || n > limit || !need(n)) {
+      ok = false;
+      return {};
+    }
+    std::string s(reinterpret_cast<const char*>(in.data() + pos), n);
+    pos += n;
+    return s;
+  }
+  std::span<const uint8_t> section() {
+    const uint32_t n = varint();
+    if (!ok || !need(n)) return {};
+    auto s = in.subspan(pos, n);
+    pos += n;
+    return s;
+  }
+};
+
+Error parse_error(const std::string& what) {
+  return Error{ErrorCode::kParse, "attribute record: " + what};
+}
+
+Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
+  Reader r{bytes};
+  AttributeLayout l;
+  const uint32_t count = r.u8();
+  if (count > 8) return tl::unexpected(parse_error("more than 8 attributes"));
+  for (uint32_t i = 0; i < count && r.ok; ++i) {
+    AttributeChannel c;
+    const uint8_t kind = r.u8();
+    if (kind < 1 || kind > 4) return tl::unexpected(parse_error("unknown attribute kind"));
+    c.kind = AttributeKind(kind);
+    c.per_corner = r.u8() != 0;
+    c.bits = r.u8();
+    for (const AttributeChannel& other : l.channels)
+      if (other.kind == c.kind) return tl::unexpected(parse_error("an attribute kind repeats"));
+    if (c.kind != AttributeKind::kMaterial &&
+        (c.bits < kMinAttributeBits || c.bits > kMaxAttributeBits))
+      return tl::unexpected(parse_error("quantization bits out of 2..16"));
+    if (c.kind == AttributeKind::kMaterial && !c.per_corner)
+      return tl::unexpected(parse_error("face materials must be per corner"));
+    if (c.kind == AttributeKind::kTexcoord) {
+      c.uv.bits = c.bits;
+      c.uv.min.x = r.f32();
+      c.uv.min.y = r.f32();
+      c.uv.step = r.f64();
+      if (!std::isfinite(c.uv.min.x) || !std::isfinite(c.uv.min.y) || !std::isfinite(c.uv.step) ||
+          !(c.uv.step > 0))
+        return tl::unexpected(parse_error("texture coordinate grid is not finite"));
+    }
+    l.channels.push_back(c);
+  }
+  const uint32_t materials = r.varint();
+  if (materials > 65536) return tl::unexpected(parse_error("more than 65536 materials"));
+  for (uint32_t i = 0; i < materials && r.ok; ++i) {
+    Material m;
+    m.name = r.string(4096);
+    m.base_color = {r.f32(), r.f32(), r.f32(), r.f32()};
+    m.metallic = r.f32();
+    m.roughness = r.f32();
+    m.base_color_texture = int32_t(r.u32());
+    m.normal_texture = int32_t(r.u32());
+    m.metallic_roughness_texture = int32_t(r.u32());
+    m.occlusion_texture = int32_t(r.u32());
+    m.emissive_texture = int32_t(r.u32());
+    m.base_color_texcoord_set = r.varint();
+    m.double_sided = r.u8() != 0;
+    l.materials.push_back(std::move(m));
+  }
+  if (!r.ok || r.pos != bytes.size())
+    return tl::unexpected(parse_error("layout section is truncated or too long"));
+  for (const AttributeChannel& c : l.channels)
+    if (c.kind == AttributeKind::kMaterial && l.materials.empty())
+      return tl::unexpected(parse_error("face materials without a material table"));
+  return l;
+}
+
+void put_section(std::vector<uint8_t>& out, const std::vector<uint8_t>& bytes) {
+  put_varint(out, uint32_t(bytes.size()));
+  out.insert(out.end(), bytes.begin(), bytes.end());
+}
+
+// Codes (or decodes) the values of vertices [first, last) of channel ch, in
+// id order, wedges in order. Encoder: `truth` holds them.
+struct ValueCoder {
+  const AttributeLayout& layout;
+  bool final_record;
+  std::vector<uint32_t> ring, corners;
+
+  std::vector<uint8_t> encode(const EditableMesh& m, const AttributeValues& truth, size_t ch,
+                              uint32_t first, uint32_t last) {
+    const AttributeChannel& c = layout.channels[ch];
+    const uint32_t n = c.components();
+    const int32_t max = layout.max_value(c);
+    ChannelModels models;
+    RangeEncoder enc;
+    int32_t pred[4];
+    for (uint32_t v = first; v < last; ++v) {
+      const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
+      const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
+      for (uint32_t w = w0; w < w1; ++w) {
+        const int ctx = predict(m, truth, layout, ch, v, w, use_geometric(c, final_record), pred,
+                                ring, corners);
+        for (uint32_t i = 0; i < n; ++i)
+          models.residual[ctx][i].encode(enc,
+                                         residual_of(c, max, truth.data[ch][w * n + i], pred[i]));
+      }
+    }
+    return enc.finish();
+  }
+
+  Status decode(const EditableMesh& m, AttributeValues& a, size_t ch, uint32_t first, uint32_t last,
+                std::span<const uint8_t> bytes) {
+    const AttributeChannel& c = layout.channels[ch];
+    const uint32_t n = c.components();
+    const int32_t max = layout.max_value(c);
+    ChannelModels models;
+    RangeDecoder dec(bytes);
+    int32_t pred[4];
+    for (uint32_t v = first; v < last; ++v) {
+      const uint32_t w0 = c.per_corner ? a.wedge_start[v] : v;
+      const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
+      for (uint32_t w = w0; w < w1; ++w) {
+        const int ctx =
+            predict(m, a, layout, ch, v, w, use_geometric(c, final_record), pred, ring, corners);
+        for (uint32_t i = 0; i < n; ++i) {
+          const int64_t r = models.residual[ctx][i].decode(dec);
+          if (!value_of(c, max, pred[i], r, a.data[ch][w * n + i]))
+            return tl::unexpected(parse_error(std::string(attribute_kind_name(c.kind)) +
+                                              " value of vertex " + std::to_string(v) +
+                                              " off the grid"));
+        }
+      }
+      if (dec.exhausted_badly())
+        return tl::unexpected(
+            parse_error(std::string(attribute_kind_name(c.kind)) + " data runs out"));
+    }
+    return {};
+  }
+};
+
+// Seam bits of the base: per vertex one bit "more than one wedge", then one
+// bit per interior edge of its star (is it a seam at the vertex).
+struct SeamModels {
+  BitModel split[2];    // by boundary
+  BitModel edge[2][2];  // by boundary, previous edge bit
+};
+
+// The wedge keys of base vertex v from its seam edges (in star order).
+void keys_from_star(const EditableMesh& base, uint32_t v, const std::vector<uint8_t>& bits,
+                    const std::vector<uint32_t>& corners, std::vector<uint32_t>& keys) {
+  keys.clear();
+  size_t k = 0;
+  for (uint32_t c : corners) {
+    if (base.opposite(EditableMesh::next(c)) == kNone) continue;
+    if (bits[k++]) keys.push_back(base.vertex(EditableMesh::prev(c)));
+  }
+  if (!keys.empty() && base.is_boundary(v)) keys.push_back(kBoundaryKey);
+}
+
+}  // namespace
+
+// ---------------- encoder ----------------
+
+Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>& q,
+                                      const AttributeOptions& options) {
+  for (int b : {options.normal_bits, options.texcoord_bits, options.color_bits})
+    if (b < kMinAttributeBits || b > kMaxAttributeBits)
+      return make_error(ErrorCode::kInvalidArgument,
+                        "attribute quantization bits " + std::to_string(b) + " out of 2..16");
+  if (auto s = check_attribute_counts(mesh); !s) return tl::unexpected(s.error());
+  AttributePlan plan;
+  plan.extras = &mesh.extra_attributes;
+  const size_t corners = 3 * mesh.triangles.size();
+  auto finite2 = [](Vec2f v) { return std::isfinite(v.x) && std::isfinite(v.y); };
+  auto finite3 = [](Vec3f v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  // Normals.
+  auto add_normals = [&](const Vec3f* values, size_t count, const uint32_t* index, size_t n,
+                         bool per_corner) -> Status {
+    AttributeChannel c{AttributeKind::kNormal, per_corner, uint8_t(options.normal_bits), {}};
+    std::vector<int32_t> out(2 * n);
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3f& v = values[index ? index[i] : i];
+      if (!finite3(v)) return make_error(ErrorCode::kInvalidMesh, "a normal is not finite");
+      const auto qn = quantize_normal(v, c.bits);
+      out[2 * i] = qn[0];
+      out[2 * i + 1] = qn[1];
+    }
+    (void)count;
+    plan.layout.channels.push_back(c);
+    plan.input_values.push_back(std::move(out));
+    return {};
+  };
+  if (!mesh.normals.empty()) {
+    if (auto s = add_normals(mesh.normals.data(), mesh.normals.size(), nullptr, mesh.normals.size(),
+                             false);
+        !s)
+      return tl::unexpected(s.error());
+  } else if (!mesh.corner_normals.empty()) {
+    if (auto s = add_normals(mesh.corner_normals.values.data(), mesh.corner_normals.values.size(),
+                             mesh.corner_normals.corners.data(), corners, true);
+        !s)
+      return tl::unexpected(s.error());
+  }
+  // Texture coordinates.
+  auto add_uv = [&](const std::vector<Vec2f>& values, const uint32_t* index, size_t n,
+                    bool per_corner) -> Status {
+    for (const Vec2f& v : values)
+      if (!finite2(v))
+        return make_error(ErrorCode::kInvalidMesh, "a texture coordinate is not finite");
+    AttributeChannel c{AttributeKind::kTexcoord, per_corner, uint8_t(options.texcoord_bits), {}};
+    c.uv = make_texcoord_grid(values.data(), values.size(), c.bits);
+    std::vector<int32_t> out(2 * n);
+    for (size_t i = 0; i < n; ++i) {
+      const auto qt = quantize_texcoord(c.uv, values[index ? index[i] : i]);
+      out[2 * i] = qt[0];
+      out[2 * i + 1] = qt[1];
+    }
+    plan.layout.channels.push_back(c);
+    plan.input_values.push_back(std::move(out));
+    return {};
+  };
+  if (!mesh.texcoords.empty()) {
+    if (auto s = add_uv(mesh.texcoords, nullptr, mesh.texcoords.size(), false); !s)
+      return tl::unexpected(s.error());
+  } else if (!mesh.corner_texcoords.empty()) {
+    if (auto s = add_uv(mesh.corner_texcoords.values, mesh.corner_texcoords.corners.data(), corners,
+                        true);
+        !s)
+      return tl::unexpected(s.error());
+  }
+  // Colours.
+  auto add_colors = [&](const std::vector<Vec4f>& values, const uint32_t* index, size_t n,
+                        bool per_corner) {
+    AttributeChannel c{AttributeKind::kColor, per_corner, uint8_t(options.color_bits), {}};
+    std::vector<int32_t> out(4 * n);
+    for (size_t i = 0; i < n; ++i) {
+      const Vec4f& v = values[index ? index[i] : i];
+      const float ch[4] = {v.x, v.y, v.z, v.w};
+      for (int k = 0; k < 4; ++k) out[4 * i + k] = quantize_color_channel(ch[k], c.bits);
+    }
+    plan.layout.channels.push_back(c);
+    plan.input_values.push_back(std::move(out));
+  };
+  if (!mesh.colors.empty()) {
+    add_colors(mesh.colors, nullptr, mesh.colors.size(), false);
+  } else if (!mesh.corner_colors.empty()) {
+    add_colors(mesh.corner_colors.values, mesh.corner_colors.corners.data(), corners, true);
+  }
+  plan.layout.materials = mesh.materials;
+  if (!mesh.face_materials.empty()) {
+    AttributeChannel c{AttributeKind::kMaterial, true, 0, {}};
+    std::vector<int32_t> out(corners);
+    for (size_t f = 0; f < mesh.triangles.size(); ++f)
+      for (int k = 0; k < 3; ++k) out[3 * f + k] = int32_t(mesh.face_materials[f]);
+    plan.layout.channels.push_back(c);
+    plan.input_values.push_back(std::move(out));
+  }
+  // Locks: both ends of every seam edge.
+  if (any_corner_channel(plan.layout)) {
+    auto m = EditableMesh::build(q, mesh.triangles);
+    if (!m) return tl::unexpected(m.error());
+    const auto seams = seams_of(*m, plan.input_values, plan.layout, nullptr);
+    plan.locked.assign(mesh.vertex_count(), 0);
+    for (uint32_t v = 0; v < seams.size(); ++v) {
+      if (seams[v].empty()) continue;
+      plan.locked[v] = 1;
+      for (uint32_t b : seams[v]) plan.locked[b] = 1;
+    }
+    plan.locked_count = uint32_t(std::count(plan.locked.begin(), plan.locked.end(), 1));
+  }
+  return plan;
+}
+
+Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, const Mesh& mesh,
+                                                   const std::vector<Vec3i>& q,
+                                                   std::span<const uint8_t> stream,
+                                                   const std::vector<uint32_t>& to_input,
+                                                   AttributeParts* parts,
+                                                   std::vector<uint32_t>* payload_sizes) {
+  auto internal = [](const std::string& what) {
+    return tl::unexpected(Error{ErrorCode::kInternal, "encoder attributes: " + what});
+  };
+  auto index = read_stream_index(stream);
+  if (!index) return tl::unexpected(index.error());
+  const StreamIndex& idx = *index;
+  const uint32_t n = mesh.vertex_count();
+  if (to_input.size() != n) return internal("vertex map size");
+  const uint32_t base_n = idx.records[0].vertices;
+  // The decoder's base and final meshes, as it will hold them.
+  IncrementalDecoder base_decoder;
+  if (auto f = base_decoder.feed(stream.subspan(0, idx.records[0].offset + idx.records[0].size));
+      !f)
+    return tl::unexpected(f.error());
+  // The base as the decoder's state holds it after record 0: coarse
+  // positions q >> b at the middle of their unknown low bits.
+  const int quant_bits = idx.header.quant_bits;
+  const auto format = idx.header.extra.empty()
+                          ? std::nullopt
+                          : RefinementFormatInfo::from_header_byte(idx.header.extra[0]);
+  const int base_shift =
+      format && format->embedded && idx.header.extra.size() > 1 ? idx.header.extra[1] : 0;
+  std::vector<Vec3i> coarse(base_n);
+  for (uint32_t v = 0; v < base_n; ++v)
+    for (int a = 0; a < 3; ++a) coarse[v][a] = q[to_input[v]][a] >> base_shift;
+  auto base_state = RefinementState::from_coarse_base(coarse, base_decoder.mesh().triangles,
+                                                      quant_bits, base_shift);
+  if (!base_state) return tl::unexpected(base_state.error());
+  const EditableMesh* base = &base_state->mesh;
+  auto decoded = decode_hcs(stream);
+  if (!decoded) return tl::unexpected(decoded.error());
+  std::vector<Vec3i> positions(n);
+  for (uint32_t v = 0; v < n; ++v) positions[v] = q[to_input[v]];
+  auto full = EditableMesh::build(positions, decoded->triangles);
+  if (!full) return tl::unexpected(full.error());
+
+  // Decoded corner -> input corner.
+  auto key_of = [](uint32_t a, uint32_t b, uint32_t c) {
+    // Rotate so the smallest id leads: a rotation-invariant key of an oriented face.
+    if (b < a && b < c) return std::tuple{b, c, a};
+    if (c < a && c < b) return std::tuple{c, a, b};
+    return std::tuple{a, b, c};
+  };
+  auto hash = [](std::tuple<uint32_t, uint32_t, uint32_t> t) {
+    const auto [a, b, c] = t;
+    return (uint64_t(a) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b) << 21) ^
+           (uint64_t(c) * 0xC2B2AE3D27D4EB4Full);
+  };
+  std::unordered_multimap<uint64_t, uint32_t> faces_by_key;
+  faces_by_key.reserve(mesh.triangles.size());
+  for (uint32_t f = 0; f < mesh.triangles.size(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    faces_by_key.emplace(hash(key_of(t[0], t[1], t[2])), f);
+  }
+  std::vector<uint32_t> corner_map(3 * decoded->triangles.size());
+  for (uint32_t f = 0; f < decoded->triangles.size(); ++f) {
+    const Triangle& d = decoded->triangles[f];
+    const uint32_t a = to_input[d[0]], b = to_input[d[1]], c = to_input[d[2]];
+    const auto k = key_of(a, b, c);
+    bool found = false;
+    auto range = faces_by_key.equal_range(hash(k));
+    for (auto it = range.first; it != range.second && !found; ++it) {
+      const Triangle& t = mesh.triangles[it->second];
+      if (key_of(t[0], t[1], t[2]) != k) continue;
+      for (int r = 0; r < 3; ++r) {
+        if (t[r] == a) {
+          corner_map[3 * f] = 3 * it->second + r;
+          corner_map[3 * f + 1] = 3 * it->second + (r + 1) % 3;
+          corner_map[3 * f + 2] = 3 * it->second + (r + 2) % 3;
+          found = true;
+        }
+      }
+    }
+    if (!found) return internal("decoded face " + std::to_string(f) + " is not an input face");
+  }
+
+  // The values in decoder terms: wedges from the full mesh, named as the
+  // base's stars give them.
+  const AttributeLayout& layout = plan.layout;
+  AttributeValues truth;
+  truth.data.resize(layout.channels.size());
+  const auto seams = seams_of(*full, plan.input_values, layout, &corner_map);
+  std::vector<uint32_t> ring, corners, keys;
+  std::vector<std::vector<uint8_t>> seam_bits(base_n);
+  truth.wedge_start.assign(1, 0);
+  for (uint32_t v = 0; v < n; ++v) {
+    keys.clear();
+    if (!seams[v].empty()) {
+      if (v >= base_n) return internal("seam vertex " + std::to_string(v) + " was decimated");
+      base->star(v, ring, corners);
+      std::vector<uint8_t>& bits = seam_bits[v];
+      for (uint32_t c : corners) {
+        if (base->opposite(EditableMesh::next(c)) == kNone) continue;
+        const uint32_t b = base->vertex(EditableMesh::prev(c));
+        bits.push_back(std::find(seams[v].begin(), seams[v].end(), b) != seams[v].end());
+      }
+      keys_from_star(*base, v, bits, corners, keys);
+      const size_t expected = seams[v].size() + (base->is_boundary(v) ? 1 : 0);
+      if (keys.size() != expected) return internal("seam edges of a base vertex left the base");
+    } else if (v < base_n && !base->is_isolated(v)) {
+      base->star(v, ring, corners);
+      uint32_t interior = 0;
+      for (uint32_t c : corners) interior += base->opposite(EditableMesh::next(c)) != kNone;
+      seam_bits[v].assign(interior, 0);
+    }
+    if (keys.empty()) keys.push_back(kNone);
+    for (uint32_t k : keys) truth.wedge_key.push_back(k);
+    truth.wedge_start.push_back(uint32_t(truth.wedge_key.size()));
+  }
+  const uint32_t wedges = uint32_t(truth.wedge_key.size());
+  for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    const AttributeChannel& c = layout.channels[ch];
+    const uint32_t nc = c.components();
+    auto& data = truth.data[ch];
+    if (!c.per_corner) {
+      data.resize(size_t(n) * nc);
+      for (uint32_t v = 0; v < n; ++v)
+        for (uint32_t i = 0; i < nc; ++i)
+          data[size_t(v) * nc + i] = plan.input_values[ch][size_t(to_input[v]) * nc + i];
+      continue;
+    }
+    data.assign(size_t(wedges) * nc, 0);
+    for (uint32_t dc = 0; dc < corner_map.size(); ++dc) {
+      const uint32_t w = wedge_of_corner(*full, truth, dc);
+      for (uint32_t i = 0; i < nc; ++i)
+        data[size_t(w) * nc + i] = plan.input_values[ch][size_t(corner_map[dc]) * nc + i];
+    }
+  }
+  // Check: every corner's value is its wedge's (the seam rule holds).
+  for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    const AttributeChannel& c = layout.channels[ch];
+    if (!c.per_corner) continue;
+    const uint32_t nc = c.components();
+    for (uint32_t dc = 0; dc < corner_map.size(); ++dc) {
+      const uint32_t w = wedge_of_corner(*full, truth, dc);
+      for (uint32_t i = 0; i < nc; ++i)
+        if (truth.data[ch][size_t(w) * nc + i] !=
+            plan.input_values[ch][size_t(corner_map[dc]) * nc + i])
+          return internal("a wedge holds two values");
+    }
+  }
+
+  // Record 1: layout, seams, base values.
+  AttributeParts local_parts;
+  std::vector<uint8_t> first{kRecordAttributes, kAttributePartBase};
+  const std::vector<uint8_t> layout_bytes = write_layout(layout);
+  put_section(first, layout_bytes);
+  local_parts["layout"] += layout_bytes.size();
+  if (any_corner_channel(layout)) {
+    RangeEncoder enc;
+    SeamModels models;
+    for (uint32_t v = 0; v < base_n; ++v) {
+      if (base->is_isolated(v)) continue;
+      const bool boundary = base->is_boundary(v);
+      const bool split = truth.wedge_start[v + 1] - truth.wedge_start[v] > 1;
+      enc.encode_bit(models.split[boundary], split);
+      if (!split) continue;
+      uint32_t prev = 0;
+      for (uint8_t bit : seam_bits[v]) {
+        enc.encode_bit(models.edge[boundary][prev], bit);
+        prev = bit;
+      }
+    }
+    const std::vector<uint8_t> bytes = enc.finish();
+    put_section(first, bytes);
+    local_parts["seams"] += bytes.size();
+  }
+  ValueCoder base_coder{layout, false, {}, {}};
+  for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    // The base's values predicted over the base mesh (the decoder's state
+    // after record 0); the wedge tables of base vertices are the same.
+    AttributeValues base_truth;
+    base_truth.wedge_start.assign(truth.wedge_start.begin(),
+                                  truth.wedge_start.begin() + base_n + 1);
+    base_truth.wedge_key.assign(truth.wedge_key.begin(),
+                                truth.wedge_key.begin() + base_truth.wedge_start.back());
+    base_truth.data.resize(layout.channels.size());
+    const AttributeChannel& c = layout.channels[ch];
+    const size_t count =
+        size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
+    base_truth.data[ch].assign(truth.data[ch].begin(), truth.data[ch].begin() + count);
+    const std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
+    put_section(first, bytes);
+    local_parts[attribute_kind_name(c.kind)] += bytes.size();
+  }
+
+  // The last record: inserted vertices' values, then the extra attributes.
+  std::vector<uint8_t> last{kRecordAttributes, kAttributePartFinal};
+  ValueCoder final_coder{layout, true, {}, {}};
+  for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    const std::vector<uint8_t> bytes = final_coder.encode(*full, truth, ch, base_n, n);
+    put_section(last, bytes);
+    local_parts[attribute_kind_name(layout.channels[ch].kind)] += bytes.size();
+  }
+  const auto& extras = *plan.extras;
+  put_varint(last, uint32_t(extras.size()));
+  for (const ExtraAttribute& e : extras) {
+    const size_t before = last.size();
+    put_string(last, e.name);
+    last.push_back(uint8_t(e.component_type));
+    last.push_back(e.components);
+    last.push_back(e.normalized ? 1 : 0);
+    const uint32_t es = element_size(e);
+    std::vector<uint8_t> raw(corner_map.size() * es);
+    for (size_t dc = 0; dc < corner_map.size(); ++dc)
+      std::memcpy(raw.data() + dc * es, e.bytes.data() + size_t(corner_map[dc]) * es, es);
+    std::vector<uint8_t> packed(ZSTD_compressBound(raw.size()));
+    const size_t z = ZSTD_compress(packed.data(), packed.size(), raw.data(), raw.size(), 19);
+    if (ZSTD_isError(z)) return internal(std::string("zstd: ") + ZSTD_getErrorName(z));
+    packed.resize(z);
+    put_varint(last, uint32_t(raw.size()));
+    put_section(last, packed);
+    local_parts["extra"] += last.size() - before;
+  }
+
+  // The stream again with both records.
+  std::vector<std::vector<uint8_t>> payloads;
+  std::vector<RecordCounts> counts;
+  for (size_t i = 0; i < idx.records.size(); ++i) {
+    const RecordEntry& r = idx.records[i];
+    const auto bytes = record_payload(r, stream.subspan(r.offset, r.size));
+    payloads.emplace_back(bytes.begin(), bytes.end());
+    counts.push_back({r.vertices, r.faces});
+    if (i == 0) {
+      payloads.push_back(first);
+      counts.push_back({r.vertices, r.faces});
+    }
+  }
+  payloads.push_back(last);
+  counts.push_back(counts.back());
+  if (payload_sizes) {
+    payload_sizes->clear();
+    for (const auto& p : payloads) payload_sizes->push_back(uint32_t(p.size()));
+  }
+  auto written = write_container(idx.header, payloads, counts);
+  if (!written) return tl::unexpected(written.error());
+  if (parts) *parts = std::move(local_parts);
+  return std::move(written->bytes);
+}
+
+Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payload,
+                                              std::span<const uint8_t> final_payload) {
+  AttributeParts parts;
+  if (base_payload.size() < 2 || base_payload[0] != kRecordAttributes ||
+      base_payload[1] != kAttributePartBase)
+    return tl::unexpected(parse_error("record 1 is not the base attribute record"));
+  Reader r{base_payload, 2};
+  auto layout_bytes = r.section();
+  if (!r.ok) return tl::unexpected(parse_error("truncated"));
+  auto layout = read_layout(layout_bytes);
+  if (!layout) return tl::unexpected(layout.error());
+  parts["layout"] += layout_bytes.size();
+  if (any_corner_channel(*layout)) parts["seams"] += r.section().size();
+  for (const AttributeChannel& c : layout->channels)
+    parts[attribute_kind_name(c.kind)] += r.section().size();
+  if (!r.ok) return tl::unexpected(parse_error("base attribute record truncated"));
+  if (final_payload.empty()) return parts;
+  if (final_payload.size() < 2 || final_payload[0] != kRecordAttributes ||
+      final_payload[1] != kAttributePartFinal)
+    return tl::unexpected(parse_error("the last record is not the final attribute record"));
+  Reader f{final_payload, 2};
+  for (const AttributeChannel& c : layout->channels)
+    parts[attribute_kind_name(c.kind)] += f.section().size();
+  const uint32_t extras = f.varint();
+  for (uint32_t i = 0; i < extras && f.ok && i < 64; ++i) {
+    const size_t before = f.pos;
+    f.string(4096);
+    f.u8();
+    f.u8();
+    f.u8();
+    f.varint();
+    f.section();
+    parts["extra"] += f.pos - before;
+  }
+  if (!f.ok) return tl::unexpected(parse_error("final attribute record truncated"));
+  return parts;
+}
+
+// ---------------- decoder ----------------
+
+Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const EditableMesh& base) {
+  if (active_) return tl::unexpected(parse_error("a second base attribute record"));
+  if (payload.size() < 2 || payload[1] != kAttributePartBase)
+    return tl::unexpected(parse_error("the first attribute record is not the base part"));
+  Reader r{payload, 2};
+  auto layout_bytes = r.section();
+  if (!r.ok) return tl::unexpected(parse_error("layout section truncated"));
+  auto layout = read_layout(layout_bytes);
+  if (!layout) return tl::unexpected(layout.error());
+  layout_ = std::move(*layout);
+  const uint32_t n = base.vertex_count();
+  base_vertices_ = n;
+  values_ = AttributeValues{};
+  values_.data.resize(layout_.channels.size());
+  std::vector<uint32_t> ring, corners, keys;
+  std::vector<uint8_t> bits;
+  if (any_corner_channel(layout_)) {
+    auto seam_bytes = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("seam section truncated"));
+    RangeDecoder dec(seam_bytes);
+    SeamModels models;
+    for (uint32_t v = 0; v < n; ++v) {
+      keys.clear();
+      if (!base.is_isolated(v)) {
+        const bool boundary = base.is_boundary(v);
+        if (dec.decode_bit(models.split[boundary])) {
+          base.star(v, ring, corners);
+          bits.clear();
+          uint32_t prev = 0;
+          for (uint32_t c : corners) {
+            if (base.opposite(EditableMesh::next(c)) == kNone) continue;
+            prev = dec.decode_bit(models.edge[boundary][prev]);
+            bits.push_back(uint8_t(prev));
+          }
+          keys_from_star(base, v, bits, corners, keys);
+          if (keys.size() < 2)
+            return tl::unexpected(parse_error("base vertex " + std::to_string(v) +
+                                              " is split by fewer than two seams"));
+        }
+      }
+      if (keys.empty()) keys.push_back(kNone);
+      for (uint32_t k : keys) values_.wedge_key.push_back(k);
+      values_.wedge_start.push_back(uint32_t(values_.wedge_key.size()));
+      if (dec.exhausted_badly()) return tl::unexpected(parse_error("seam data runs out"));
+    }
+  } else {
+    for (uint32_t v = 0; v < n; ++v) {
+      values_.wedge_key.push_back(kNone);
+      values_.wedge_start.push_back(v + 1);
+    }
+  }
+  ValueCoder coder{layout_, false, {}, {}};
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),
+                            0);
+    auto bytes = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
+    if (auto s = coder.decode(base, values_, ch, 0, n, bytes); !s) return s;
+  }
+  if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the base part"));
+  active_ = true;
+  return {};
+}
+
+void AttributeDecoder::preview(const EditableMesh& m) {
+  if (!active_) return;
+  std::vector<uint32_t> ring, corners;
+  int32_t pred[4];
+  for (uint32_t v = values_.vertices(); v < m.vertex_count(); ++v) {
+    const uint32_t w = uint32_t(values_.wedge_key.size());
+    values_.wedge_key.push_back(kNone);
+    values_.wedge_start.push_back(w + 1);
+    for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+      const AttributeChannel& c = layout_.channels[ch];
+      const uint32_t nc = c.components();
+      values_.data[ch].resize(values_.data[ch].size() + nc);
+      predict(m, values_, layout_, ch, v, w, false, pred, ring, corners);
+      std::copy(pred, pred + nc, values_.data[ch].end() - nc);
+    }
+  }
+}
+
+Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const EditableMesh& full) {
+  if (!active_) return tl::unexpected(parse_error("final attribute record before the base one"));
+  if (complete_) return tl::unexpected(parse_error("a second final attribute record"));
+  if (payload.size() < 2 || payload[1] != kAttributePartFinal)
+    return tl::unexpected(parse_error("unknown attribute record part"));
+  Reader r{payload, 2};
+  const uint32_t n = full.vertex_count();
+  // Back to the base's values; every inserted vertex decoded exactly.
+  values_.wedge_start.resize(base_vertices_ + 1);
+  values_.wedge_key.resize(values_.wedge_start.back());
+  for (uint32_t v = base_vertices_; v < n; ++v) {
+    values_.wedge_key.push_back(kNone);
+    values_.wedge_start.push_back(uint32_t(values_.wedge_key.size()));
+  }
+  ValueCoder coder{layout_, true, {}, {}};
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    values_.data[ch].resize(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components());
+    auto bytes = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
+    if (auto s = coder.decode(full, values_, ch, base_vertices_, n, bytes); !s) return s;
+  }
+  const uint32_t extra_count = r.varint();
+  if (!r.ok || extra_count > 64) return tl::unexpected(parse_error("bad extra attribute count"));
+  const size_t corners = 3 * size_t(full.face_slot_count());
+  extras_.clear();
+  for (uint32_t i = 0; i < extra_count; ++i) {
+    ExtraAttribute e;
+    e.name = r.string(4096);
+    const uint8_t type = r.u8();
+    e.components = r.u8();
+    e.normalized = r.u8() != 0;
+    const uint32_t raw = r.varint();
+    auto packed = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("extra attribute truncated"));
+    if (type > uint8_t(ExtraAttribute::ComponentType::kFloat32) || e.components < 1 ||
+        e.components > 4)
+      return tl::unexpected(parse_error("extra attribute '" + e.name + "' has a bad type"));
+    e.component_type = ExtraAttribute::ComponentType(type);
+    if (raw != corners * element_size(e))
+      return tl::unexpected(
+          parse_error("extra attribute '" + e.name + "' size differs from the corners'"));
+    const unsigned long long frame = ZSTD_getFrameContentSize(packed.data(), packed.size());
+    if (frame != raw)
+      return tl::unexpected(
+          parse_error("extra attribute '" + e.name + "' is not a zstd frame of its size"));
+    e.bytes.resize(raw);
+    const size_t got = ZSTD_decompress(e.bytes.data(), raw, packed.data(), packed.size());
+    if (ZSTD_isError(got) || got != raw)
+      return tl::unexpected(parse_error("extra attribute '" + e.name + "' does not decompress"));
+    extras_.push_back(std::move(e));
+  }
+  if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the final part"));
+  complete_ = true;
+  return {};
+}
+
+void AttributeDecoder::write_vertex_values(uint32_t first_vertex, Mesh& out) const {
+  const uint32_t n = values_.vertices();
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    const auto& d = values_.data[ch];
+    if (c.kind == AttributeKind::kMaterial) continue;
+    const uint32_t w0 =
+        c.per_corner ? values_.wedge_start[std::min(first_vertex, n)] : first_vertex;
+    const uint32_t w1 = c.per_corner ? uint32_t(values_.wedge_key.size()) : n;
+    auto normal = [&](uint32_t w) { return dequantize_normal({d[2 * w], d[2 * w + 1]}, c.bits); };
+    auto uv = [&](uint32_t w) { return dequantize_texcoord(c.uv, {d[2 * w], d[2 * w + 1]}); };
+    auto color = [&](uint32_t w) {
+      return Vec4f{dequantize_color_channel(d[4 * w], c.bits),
+                   dequantize_color_channel(d[4 * w + 1], c.bits),
+                   dequantize_color_channel(d[4 * w + 2], c.bits),
+                   dequantize_color_channel(d[4 * w + 3], c.bits)};
+    };
+    switch (c.kind) {
+      case AttributeKind::kNormal: {
+        auto& target = c.per_corner ? out.corner_normals.values : out.normals;
+        target.resize(w1);
+        for (uint32_t w = w0; w < w1; ++w) target[w] = normal(w);
+        break;
+      }
+      case AttributeKind::kTexcoord: {
+        auto& target = c.per_corner ? out.corner_texcoords.values : out.texcoords;
+        target.resize(w1);
+        for (uint32_t w = w0; w < w1; ++w) target[w] = uv(w);
+        break;
+      }
+      case AttributeKind::kColor: {
+        auto& target = c.per_corner ? out.corner_colors.values : out.colors;
+        target.resize(w1);
+        for (uint32_t w = w0; w < w1; ++w) target[w] = color(w);
+        break;
+      }
+      case AttributeKind::kMaterial:
+        break;
+    }
+  }
+}
+
+void AttributeDecoder::write_face(const EditableMesh& m, uint32_t f, Mesh& out) const {
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    if (!c.per_corner) continue;
+    if (c.kind == AttributeKind::kMaterial) {
+      const uint32_t w = wedge_of_corner(m, values_, 3 * f);
+      out.face_materials[f] = uint32_t(values_.data[ch][w]);
+      continue;
+    }
+    auto& corners = c.kind == AttributeKind::kNormal     ? out.corner_normals.corners
+                    : c.kind == AttributeKind::kTexcoord ? out.corner_texcoords.corners
+                                                         : out.corner_colors.corners;
+    for (uint32_t k = 0; k < 3; ++k) corners[3 * f + k] = wedge_of_corner(m, values_, 3 * f + k);
+  }
+}
+
+void AttributeDecoder::write_mesh(const EditableMesh& m, Mesh& out) const {
+  if (!active_) return;
+  out.materials = layout_.materials;
+  const int32_t textures = int32_t(out.textures.size());
+  for (Material& m : out.materials) {
+    for (int32_t* t : {&m.base_color_texture, &m.normal_texture, &m.metallic_roughness_texture,
+                       &m.occlusion_texture, &m.emissive_texture})
+      if (*t >= textures || *t < -1) *t = -1;
+  }
+  write_vertex_values(0, out);
+  const uint32_t faces = m.face_slot_count();
+  for (const AttributeChannel& c : layout_.channels) {
+    if (!c.per_corner) continue;
+    if (c.kind == AttributeKind::kMaterial) out.face_materials.assign(faces, 0);
+    if (c.kind == AttributeKind::kNormal) out.corner_normals.corners.assign(3 * size_t(faces), 0);
+    if (c.kind == AttributeKind::kTexcoord)
+      out.corner_texcoords.corners.assign(3 * size_t(faces), 0);
+    if (c.kind == AttributeKind::kColor) out.corner_colors.corners.assign(3 * size_t(faces), 0);
+  }
+  for (uint32_t f = 0; f < faces; ++f) write_face(m, f, out);
+  if (complete_) out.extra_attributes = extras_;
+}
+
+void AttributeDecoder::update_mesh(const EditableMesh& m, uint32_t first_vertex,
+                                   std::span<const uint32_t> faces, Mesh& out) const {
+  if (!active_) return;
+  write_vertex_values(first_vertex, out);
+  const size_t count = m.face_slot_count();
+  for (const AttributeChannel& c : layout_.channels) {
+    if (!c.per_corner) continue;
+    if (c.kind == AttributeKind::kMaterial) out.face_materials.resize(count);
+    if (c.kind == AttributeKind::kNormal) out.corner_normals.corners.resize(3 * count);
+    if (c.kind == AttributeKind::kTexcoord) out.corner_texcoords.corners.resize(3 * count);
+    if (c.kind == AttributeKind::kColor) out.corner_colors.corners.resize(3 * count);
+  }
+  for (uint32_t f : faces) write_face(m, f, out);
+}
+
+}  // namespace meshstream

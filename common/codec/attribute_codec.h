@@ -1,0 +1,157 @@
+// Attribute records (docs/hcs-format.md, "Attribute records"): normals,
+// texture coordinates, colours and face materials, per vertex or per corner
+// (with seams), plus extra attributes carried byte for byte.
+//
+// Seams: an edge (v, b) is a seam at v when the two faces on it give v
+// different values (any per-corner attribute, the face material included).
+// Both ends of every seam edge are locked against decimation (decimate.h's
+// DecimateOptions::locked), so seam edges exist in every prefix mesh and a
+// vertex's star is cut by them into the same wedges at every prefix. A
+// vertex has one value per wedge; a wedge is named by the seam edge that
+// ends it walking around the vertex (kBoundary: the boundary ends it).
+// Inserted vertices are never seam vertices: one value each.
+//
+// Two records: record 1, right after the base, carries the layout (which
+// attributes, their grids, the material table), one seam bit per interior
+// edge of each base vertex that has more than one wedge, and the base
+// vertices' values. The last record carries the exact values of every
+// inserted vertex and the extra attributes (zstd). Between them the decoder
+// shows each inserted vertex with its prediction (from its neighbours at
+// insertion), so every prefix after record 1 has attributes. Values are
+// predicted in exact integers from what the decoder has (parallelograms over
+// the connectivity, neighbours; normals: the geometric normal of the wedge's
+// faces) and the residuals range-coded with adaptive models.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "common/base/result.h"
+#include "common/codec/attribute_quantize.h"
+#include "common/codec/editable_mesh.h"
+#include "common/mesh/mesh.h"
+
+namespace meshstream {
+
+// First payload byte of an attribute record (stream_format.h's record flags).
+inline constexpr uint8_t kRecordAttributes = 4;
+inline constexpr uint8_t kAttributePartBase = 0;   // record 1
+inline constexpr uint8_t kAttributePartFinal = 1;  // the last record
+// Wedge key of the wedge the boundary ends; kNone (editable_mesh.h): the
+// vertex's only wedge.
+inline constexpr uint32_t kBoundaryKey = 0xFFFFFFFEu;
+
+enum class AttributeKind : uint8_t { kNormal = 1, kTexcoord = 2, kColor = 3, kMaterial = 4 };
+const char* attribute_kind_name(AttributeKind kind);
+
+struct AttributeChannel {
+  AttributeKind kind = AttributeKind::kColor;
+  bool per_corner = false;
+  uint8_t bits = 8;  // quantization bits (normals: per octahedral coordinate); unused for materials
+  TexcoordGrid uv;   // texture coordinates only
+  uint32_t components() const {
+    return kind == AttributeKind::kColor ? 4 : kind == AttributeKind::kMaterial ? 1 : 2;
+  }
+};
+
+struct AttributeLayout {
+  std::vector<AttributeChannel> channels;
+  std::vector<Material> materials;  // the material table (texture indices kept as given)
+  int32_t max_value(const AttributeChannel& c) const {
+    if (c.kind == AttributeKind::kMaterial)
+      return materials.empty() ? 0 : int32_t(materials.size()) - 1;
+    return (int32_t(1) << c.bits) - 1;
+  }
+};
+
+// Integer values in decoder vertex ids. Vertex v has wedges
+// [wedge_start[v], wedge_start[v+1]); data[channel] holds components() ints
+// per vertex (per-vertex channels) or per wedge (per-corner channels).
+struct AttributeValues {
+  std::vector<uint32_t> wedge_start{0};
+  std::vector<uint32_t> wedge_key;
+  std::vector<std::vector<int32_t>> data;
+  uint32_t vertices() const { return uint32_t(wedge_start.size() - 1); }
+};
+
+// The wedge of corner c (at vertex v = m.vertex(c)) of `m`. O(valence).
+uint32_t wedge_of_corner(const EditableMesh& m, const AttributeValues& a, uint32_t c);
+
+struct AttributeOptions {
+  int normal_bits = 8;
+  int texcoord_bits = 12;
+  int color_bits = 8;
+};
+
+// What the encoder takes from the input before decimation: the layout, the
+// quantized values (per input corner or vertex) and the vertices to lock.
+struct AttributePlan {
+  AttributeLayout layout;
+  // Per channel: per input vertex (per-vertex channels) or per input corner.
+  std::vector<std::vector<int32_t>> input_values;
+  std::vector<uint8_t> locked;  // input vertex ids
+  uint32_t locked_count = 0;
+  const std::vector<ExtraAttribute>* extras = nullptr;
+  bool empty() const { return layout.channels.empty() && (!extras || extras->empty()); }
+};
+
+// kInvalidArgument for bits out of 2..16, kInvalidMesh for non-finite values.
+Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>& q,
+                                      const AttributeOptions& options);
+
+// Bytes of each part of the attribute records ("seams", "normals",
+// "texcoords", "colors", "materials", "extra", "layout").
+using AttributeParts = std::map<std::string, uint64_t>;
+
+// Rewrites `stream` (a geometry stream of encode_once, whose decoder vertex
+// i is input vertex to_input[i]) with the two attribute records added.
+// Fills `parts` when given. kInternal when the stream disagrees with the plan.
+Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, const Mesh& mesh,
+                                                   const std::vector<Vec3i>& q,
+                                                   std::span<const uint8_t> stream,
+                                                   const std::vector<uint32_t>& to_input,
+                                                   AttributeParts* parts,
+                                                   std::vector<uint32_t>* payload_sizes);
+
+// The parts of a stream's two attribute records' payloads (for `meshstream
+// info`; `final_payload` may be empty when the file is cut short). kParse when
+// they are not well-formed attribute records.
+Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payload,
+                                              std::span<const uint8_t> final_payload);
+
+// The decoder's side: see the file comment.
+class AttributeDecoder {
+ public:
+  bool active() const { return active_; }
+  bool complete() const { return complete_; }
+  // Record 1, on the base mesh (the decoder's state right after record 0).
+  Status read_base(std::span<const uint8_t> payload, const EditableMesh& base);
+  // Predicted values for the vertices of `m` beyond those known.
+  void preview(const EditableMesh& m);
+  // The last record, on the complete mesh.
+  Status read_final(std::span<const uint8_t> payload, const EditableMesh& full);
+  // Writes every attribute array of `out` for `m` (whose vertices all have
+  // values: call preview first).
+  void write_mesh(const EditableMesh& m, Mesh& out) const;
+  // The material table as the stream has it, texture indices included
+  // (write_mesh drops the indices of textures `out` does not hold, so the
+  // mesh stays valid until the images arrive).
+  const std::vector<Material>& materials() const { return layout_.materials; }
+  // The same for the vertices from `first_vertex` on and the faces listed.
+  void update_mesh(const EditableMesh& m, uint32_t first_vertex, std::span<const uint32_t> faces,
+                   Mesh& out) const;
+
+ private:
+  void write_vertex_values(uint32_t first_vertex, Mesh& out) const;
+  void write_face(const EditableMesh& m, uint32_t f, Mesh& out) const;
+  bool active_ = false, complete_ = false;
+  AttributeLayout layout_;
+  AttributeValues values_;
+  uint32_t base_vertices_ = 0;
+  std::vector<ExtraAttribute> extras_;
+};
+
+}  // namespace meshstream
