@@ -439,7 +439,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
     if (!best) return tl::unexpected(best.error());
     if (*best == 0) {
       progress.stage("done", 1.0, 1.0);
-      return std::move(streams[0].bytes);
+      return guided(mesh, std::move(streams[0].bytes), options);
     }
     progress.stage("coding the winner", measured_at, 1.0);
     if (uses_surface(orderings[*best])) surface = grid_surface(mesh, q);
@@ -449,7 +449,7 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
     if (!winner) return tl::unexpected(winner.error());
     progress.stage("done", 1.0, 1.0);
     if (sizing.automatic && sizing.granular(streams[0]) && !sizing.granular(*winner))
-      return std::move(streams[0].bytes);
+      return guided(mesh, std::move(streams[0].bytes), options);
     if (report) *report = std::move(winner_report);
     return guided(mesh, std::move(winner->bytes), options);
   }
