@@ -192,6 +192,7 @@ class StreamingRun {
     PipelineSettings settings;
     settings.asa_enabled = o.asa_enabled;
     settings.asa_on_complete = o.asa_complete;
+    settings.asa_guided = o.asa_guided;
     settings.asa = o.asa;
     settings.path = o.asa_path;
     settings.view.dependent = !o.view_independent;
@@ -239,6 +240,7 @@ class StreamingRun {
 
   // Pipeline thread, after each published frame: events and files.
   void on_frame(const DisplayFrame& frame, const FrameInfo& info) {
+    if (!info.guidance_warning.empty()) log_.note("warning: " + info.guidance_warning);
     if (!info.new_records && info.rerun) log_.view_update(frame, info, elapsed());
     if (info.new_records) {
       last_frame_ = frame;

@@ -58,6 +58,14 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_flag("--overwrite", o.overwrite,
                "let --out use a folder that is not empty: first delete the files this program "
                "writes there (NNNN.ply, final.ply, final.decoded.ply), nothing else");
+  std::string asa_mode = "auto";
+  app.add_option("--asa", asa_mode,
+                 "auto: the post-processing the stream's encoder measured closest to the "
+                 "original for each part of the stream (none where none helped, and for streams "
+                 "without guidance); on: ASA with --asa-levels, --flatness, --rule, --crease (any "
+                 "of them implies on); off: the decoded mesh (as --no-asa)")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
   app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
@@ -199,7 +207,15 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
     o.camera->height = o.height;
   }
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
-  o.asa_enabled = !no_asa;
+  const bool fixed_settings = app.count("--asa-levels") + app.count("--flatness") +
+                                  app.count("--rule") + app.count("--crease") >
+                              0;
+  if (no_asa && app.count("--asa") && asa_mode != "off")
+    return usage("--no-asa contradicts --asa " + asa_mode);
+  if (asa_mode == "off" && fixed_settings)
+    return usage("--asa off takes no --asa-levels, --flatness, --rule or --crease");
+  o.asa_enabled = !no_asa && asa_mode != "off";
+  o.asa_guided = o.asa_enabled && asa_mode == "auto" && !fixed_settings;
   if (o.asa_enabled) {
     if (std::string clash = asa_settings_problem(o.asa, "--crease", "--flatness"); !clash.empty())
       return usage(clash);

@@ -30,11 +30,15 @@ struct ClientOptions {
   std::string model;            // empty with --list; the file name without .hcs for a URL
   std::optional<HttpUrl> http;  // set: stream the .hcs file at this URL from a web server
   bool list = false;
-  std::string out_dir;                // --out: final.ply, final.decoded.ply (+ NNNN.ply)
-  uint32_t out_every = 0;             // --out-every: NNNN.ply at every N-th record (0 = none)
-  std::vector<uint32_t> out_at;       // --out-at: NNNN.ply at these records
-  bool overwrite = false;             // --overwrite: reuse a folder of an earlier run
-  bool asa_enabled = true;            // --no-asa turns it off
+  std::string out_dir;           // --out: final.ply, final.decoded.ply (+ NNNN.ply)
+  uint32_t out_every = 0;        // --out-every: NNNN.ply at every N-th record (0 = none)
+  std::vector<uint32_t> out_at;  // --out-at: NNNN.ply at these records
+  bool overwrite = false;        // --overwrite: reuse a folder of an earlier run
+  bool asa_enabled = true;       // --no-asa (--asa off) turns it off
+  // --asa auto (the default): follow the stream's ASA guidance (guided_asa.h);
+  // --asa on, or any of --asa-levels, --flatness, --rule, --crease: the
+  // fixed settings in `asa`.
+  bool asa_guided = true;
   bool asa_complete = false;          // --asa-complete: ASA on the complete mesh too
   AsaOptions asa;                     // levels, flatness, rule, crease
   AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)

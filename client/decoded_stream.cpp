@@ -109,6 +109,13 @@ uint32_t DecodedStream::records_decoded() const {
   return decoder_.records_decoded();
 }
 
+std::optional<StreamHeader> DecodedStream::stream_header() const {
+  std::lock_guard lock(mutex_);
+  const StreamIndex* index = decoder_.index();
+  if (!index) return std::nullopt;
+  return index->header;
+}
+
 std::optional<std::pair<uint64_t, uint32_t>> DecodedStream::index_summary() const {
   std::lock_guard lock(mutex_);
   const StreamIndex* index = decoder_.index();

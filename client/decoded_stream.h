@@ -106,6 +106,9 @@ class DecodedStream {
   // From the stream's own index once its prefix arrived: (total bytes,
   // records); nullopt before.
   std::optional<std::pair<uint64_t, uint32_t>> index_summary() const;
+  // The stream's own header once its prefix arrived (the encoder's ASA
+  // guidance is in it: asa_guidance.h); nullopt before.
+  std::optional<StreamHeader> stream_header() const;
   uint64_t bytes_received() const;
   void set_bytes_received(uint64_t offset);
   void finish(StreamOutcome outcome);

@@ -173,7 +173,20 @@ void DisplayPipeline::loop() {
     // redoes only what the views may refine.
     const bool complete = records_total > 0 && frame.records_decoded >= records_total;
     PipelineSettings effective = settings;
-    effective.asa_enabled = settings.asa_enabled && (!complete || settings.asa_on_complete);
+    if (settings.asa_guided) {
+      guided_.update(decoded_);
+      info.guidance_warning = guided_.take_warning();
+      info.asa_guided = guided_.label_for(frame.records_decoded);
+      const std::optional<AsaOptions> chosen = guided_.options_for(frame.records_decoded);
+      effective.asa_enabled = chosen.has_value();
+      if (chosen) {
+        effective.asa.levels = chosen->levels;
+        effective.asa.flatness = chosen->flatness;
+        effective.asa.crease_degrees = chosen->crease_degrees;
+        effective.asa.rule = chosen->rule;
+      }
+    }
+    effective.asa_enabled = effective.asa_enabled && (!complete || settings.asa_on_complete);
     const bool options_changed = !used || asa_settings_changed(effective, *used);
     used = effective;
     const AsaOptions options = options_with_view(effective, *frame.decoded, frame.camera);
@@ -207,6 +220,7 @@ void DisplayPipeline::set_asa(bool asa_enabled, const AsaOptions& options) {
     std::lock_guard lock(mutex_);
     settings_.asa_enabled = asa_enabled;
     settings_.asa = options;
+    settings_.asa_guided = false;
     // A change made while streaming (the viewer's panel) is an explicit
     // request: it applies to the complete mesh too.
     settings_.asa_on_complete = true;

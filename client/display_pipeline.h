@@ -16,6 +16,7 @@
 #include "client/decoded_stream.h"
 #include "client/display_builder.h"
 #include "client/display_frame.h"
+#include "client/guided_asa.h"
 #include "client/stream_source.h"
 
 namespace meshstream::client {
@@ -25,6 +26,10 @@ struct FrameInfo {
   bool new_records = false;  // it shows records the previous frame did not
   bool rerun = false;        // ASA options changed
   BuildReport build;
+  // --asa auto: the setting the stream's guidance chose for this frame
+  // ("" when not guided), and once, why the guidance was refused.
+  std::string asa_guided;
+  std::string guidance_warning;
   double elapsed_ms = 0;  // since the pipeline started
 };
 
@@ -47,6 +52,9 @@ struct PipelineSettings {
   // the original than its ASA: crank 0.118 % against 4.08 % of the diagonal),
   // unless this asks for ASA there too (--asa-complete, or any set_asa()).
   bool asa_on_complete = false;
+  // --asa auto: asa_enabled and asa come from the stream's guidance, per
+  // frame (guided_asa.h); any set_asa() ends it (an explicit choice).
+  bool asa_guided = false;
   AsaPath path = AsaPath::kAuto;
   ViewSettings view;
 };
@@ -91,6 +99,7 @@ class DisplayPipeline : public StreamControls {
   LatestFrameMailbox& mailbox_;
   FrameObserver observer_;
   DisplayBuilder builder_;
+  GuidedAsa guided_;  // the pipeline thread's
 
   mutable std::mutex mutex_;  // guards settings_, finished_, error_, totals
   std::condition_variable finished_changed_;

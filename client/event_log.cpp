@@ -97,6 +97,7 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
                      {"asa_path", info.build.incremental ? "incremental" : "full"},
                      {"final", fr.final}};
     add_view_fields(j, fr);
+    if (!info.asa_guided.empty()) j["asa"] = info.asa_guided;
     line(j.dump());
     return;
   }

@@ -24,6 +24,7 @@ struct EncodeArgs {
   uint32_t record_bytes = EncodeOptions{}.record_bytes;
   std::optional<int> base_shift;  // empty: automatic
   bool no_bit_planes = false;
+  bool no_asa_guidance = false;
   bool old_flag = false;  // --issue1-order, the old name of --no-bit-planes
   uint32_t threads = EncodeOptions{}.threads;
   int quant_normal = EncodeOptions{}.quant_normal;
@@ -53,6 +54,7 @@ int run_encode(const EncodeArgs& args) {
   options.base_shift = args.base_shift;
   options.embedded = !(args.no_bit_planes || args.old_flag);
   options.threads = args.threads;
+  options.asa_guidance = !args.no_asa_guidance;
   options.quant_normal = args.quant_normal;
   options.quant_uv = args.quant_uv;
   options.quant_color = args.quant_color;
@@ -119,6 +121,10 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--no-bit-planes", args->no_bit_planes,
                 "every position exact when its vertex arrives: no plane records, structure "
                 "records in decimation order (the peer benchmarks compare against)");
+  cmd->add_flag("--no-asa-guidance", args->no_asa_guidance,
+                "write no ASA guidance (by default the encoder measures which ASA setting, or "
+                "none, brings each part of the stream closest to the original; the client's "
+                "--asa auto follows it and shows a stream without it as decoded)");
   cmd->add_option("--threads", args->threads,
                   "threads for decimation and the measurement of the candidate record "
                   "orderings (0: one per core); the stream is the same for every count")

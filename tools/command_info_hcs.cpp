@@ -8,6 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "common/codec/asa_guidance.h"
 #include "common/codec/attribute_codec.h"
 #include "common/codec/base_coder.h"
 #include "common/codec/container.h"
@@ -216,6 +217,17 @@ int run_info_hcs(const std::string& path, bool json, bool list_records) {
   std::printf("header + index: %llu bytes; %u layers; coders: base %s, structure %u, geometry %u\n",
               static_cast<unsigned long long>(index->payload_offset), h.layer_count,
               base_coder_name(h.base_coder), h.structure_coder, h.geometry_coder);
+  if (auto guidance = read_asa_guidance(h, uint32_t(index->records.size())); !guidance) {
+    std::printf("ASA guidance: refused (%s)\n", guidance.error().message.c_str());
+  } else if (!*guidance) {
+    std::printf("ASA guidance: none (the client shows the prefixes as decoded)\n");
+  } else {
+    std::string groups;
+    for (const AsaGuidanceGroup& g : (*guidance)->groups)
+      groups += (groups.empty() ? "" : ", ") + std::string("from record ") +
+                std::to_string(g.first_record) + " " + asa_choice_label(g.choice);
+    std::printf("ASA guidance: %s\n", groups.c_str());
+  }
   std::printf("base mesh: %u vertices, %u faces, %u bytes\n", h.base_vertex_count,
               h.base_face_count, index->records[0].size);
   std::string not_in_file;

@@ -13,7 +13,9 @@ constexpr size_t kIndexEntryBytes = 24;
 // The header fields this version writes, in order; `extra` follows.
 constexpr size_t kHeaderFixedBytes = 4 * 4 + 6 * 4 + 4 + 4;
 
-std::vector<uint8_t> encode_header(const StreamHeader& h) {
+}  // namespace
+
+std::vector<uint8_t> encode_stream_header(const StreamHeader& h) {
   std::vector<uint8_t> out;
   put_u32(out, h.vertex_count);
   put_u32(out, h.face_count);
@@ -34,9 +36,11 @@ std::vector<uint8_t> encode_header(const StreamHeader& h) {
   return out;
 }
 
+namespace {
+
 // Magic, version, flags, header and its CRC: the same in every version.
 std::vector<uint8_t> write_magic_and_header(uint16_t version, const StreamHeader& header) {
-  std::vector<uint8_t> head = encode_header(header);
+  std::vector<uint8_t> head = encode_stream_header(header);
   std::vector<uint8_t> out(kContainerMagic, kContainerMagic + 4);
   put_u16(out, version);
   put_u16(out, 0);
@@ -91,7 +95,7 @@ Result<WrittenContainer> write_container(const StreamHeader& header,
                       "write_container: " + std::to_string(payloads.size()) + " payloads but " +
                           std::to_string(counts.size()) + " record counts");
   }
-  if (encode_header(header).size() > kMaxHeaderBytes) {
+  if (encode_stream_header(header).size() > kMaxHeaderBytes) {
     return make_error(ErrorCode::kInvalidArgument, "write_container: header too large");
   }
   WrittenContainer out;

@@ -66,6 +66,11 @@ struct StreamIndex {
   }
 };
 
+// The header's H bytes as every container version writes them (the
+// fixed fields, then `extra`); the u32 size before and the CRC-32 after
+// them are the caller's.
+std::vector<uint8_t> encode_stream_header(const StreamHeader& header);
+
 // Serializes magic, header and a VERSION 2 index for records of the given
 // payload sizes and CRCs (offsets are filled in). Returns the bytes to put
 // before the payloads. Kept for tests and synthetic streams: version 2 stays

@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "common/codec/asa_guidance.h"
 #include "common/codec/attribute_codec.h"
 #include "common/codec/decimate.h"
 #include "common/codec/distortion_estimate.h"
@@ -340,6 +341,14 @@ Result<std::vector<uint8_t>> with_attributes(const AttributePlan& plan, const Me
   return bytes;
 }
 
+// The stream with its ASA guidance (asa_guidance.h), when asked for.
+Result<std::vector<uint8_t>> guided(const Mesh& mesh, Result<std::vector<uint8_t>> stream,
+                                    const EncodeOptions& options) {
+  if (!stream || !options.asa_guidance) return stream;
+  auto guidance = measure_asa_guidance(mesh, *stream);
+  if (!guidance) return tl::unexpected(guidance.error());
+  return with_asa_guidance(*stream, *guidance);
+}
 }  // namespace
 
 Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& options) {
@@ -403,10 +412,13 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
   auto finish = [&](EncodedStream& stream) -> Result<std::vector<uint8_t>> {
     auto out = with_attributes(*plan, mesh, q, stream, report);
     if (report) report->warnings = encode_warnings(mesh);
-    progress.stage("done", 1.0, 1.0);
     if (!out) return out;
-    // Textures go in last: the record order and sizes above are the geometry's.
-    return add_texture_records(std::move(*out), mesh.textures);
+    // Textures go in after: the record order and sizes above are the geometry's.
+    auto textured = add_texture_records(std::move(*out), mesh.textures);
+    // The ASA guidance last: it names records by their final numbers.
+    auto done = guided(mesh, std::move(textured), options);
+    progress.stage("done", 1.0, 1.0);
+    return done;
   };
   if (on_prefixes) {
     // The first candidate whole (it settles the record size, as before),

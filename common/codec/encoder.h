@@ -85,6 +85,11 @@ struct EncodeOptions {
   // Called as the encode advances (encode_progress.h); empty = no calls. It
   // does not change the stream.
   EncodeProgressCallback progress;
+  // Measure which ASA post-processing brings each group of prefixes closest
+  // to the original and write it into the header (asa_guidance.h; the
+  // client's `--asa auto`). false: no guidance block (`meshstream encode
+  // --no-asa-guidance`); the client then shows the prefixes as decoded.
+  bool asa_guidance = true;
   // Attribute quantization (attribute_quantize.h), 2..16 bits, else
   // kInvalidArgument: normals per octahedral coordinate, texture coordinates
   // per axis over their box, colours per channel on [0, 1] (8: 8-bit colours

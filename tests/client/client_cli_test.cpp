@@ -326,8 +326,13 @@ TEST_F(ClientCliTest, TheCompleteStreamIsShownAndSavedAsDecoded) {
   EXPECT_TRUE(same_geometry(load_ply(out / "full/final.ply"), decoded));
   EXPECT_EQ(done["display_faces"].get<uint32_t>(), decoded.face_count());
 
-  const CliRun part =
-      client(fast_->address(), {"demo", "--json", "--percent-bytes", "30", "--out", out / "part"});
+  // The default (--asa auto) follows the stream's guidance and names the
+  // setting it used in every refinement event.
+  for (const auto& e : full.events)
+    if (e["event"] == "refinement") EXPECT_TRUE(e.contains("asa")) << e.dump();
+  // Fixed ASA (--asa on) post-processes every prefix.
+  const CliRun part = client(fast_->address(), {"demo", "--json", "--asa", "on", "--percent-bytes",
+                                                "30", "--out", out / "part"});
   ASSERT_EQ(part.status, 0) << part.err;
   EXPECT_LT(part.events.back()["records"].get<int>(),
             part.events.back()["records_total"].get<int>());
@@ -335,8 +340,8 @@ TEST_F(ClientCliTest, TheCompleteStreamIsShownAndSavedAsDecoded) {
             load_ply(out / "part/final.decoded.ply").face_count())
       << "the prefix was not post-processed";
 
-  const CliRun asked =
-      client(fast_->address(), {"demo", "--json", "--asa-complete", "--out", out / "asked"});
+  const CliRun asked = client(fast_->address(), {"demo", "--json", "--asa", "on", "--asa-complete",
+                                                 "--out", out / "asked"});
   ASSERT_EQ(asked.status, 0) << asked.err;
   EXPECT_GT(load_ply(out / "asked/final.ply").face_count(), decoded.face_count())
       << "--asa-complete did not post-process the complete mesh";

@@ -383,8 +383,9 @@ TEST_F(ClientStreamTest, RealMeshFinalMeshesEqualOfflineDecodeAndSubdivide) {
   ASSERT_TRUE(server.start({"--models", models.path(), "--cache", out / "cache"}, out.path()))
       << server.log();
   // --asa-complete: the complete mesh gets ASA too, so its boundary rules are checked here.
-  const ClientRun r = client(server.address(), {"bunny", "--json", "--asa-complete", "--out",
-                                                out / "snaps", "--view-independent"});
+  // --asa on: the fixed settings `subdivide` applies (the default follows the guidance).
+  const ClientRun r = client(server.address(), {"bunny", "--json", "--asa", "on", "--asa-complete",
+                                                "--out", out / "snaps", "--view-independent"});
   ASSERT_EQ(r.status, 0) << r.err;
   expect_monotone_events(r.events);
   ASSERT_EQ(
