@@ -96,9 +96,12 @@ namespace {
 // Measured: 480 bytes a vertex (one replay at a time since the ordering
 // is chosen on prefixes; the mesh itself, the decimation's quadrics and
 // layers, the replay, the surface hierarchy); 696 with two candidate
-// replays at once, over 1 KB with the whole-mesh copies. The issue's
-// 300-byte target is not met yet; this bound catches a return of either.
-constexpr double kBoundBytesPerVertex = 650;
+// replays at once, over 1 KB with the whole-mesh copies. The ASA guidance
+// (asa_guidance.h, on by default since encoder version 10) measures its
+// prefixes against the original after the records are coded, and lifts the
+// peak to 918 bytes a vertex: the next thing to cut. The 300-byte
+// target is not met; this bound catches anything worse than today.
+constexpr double kBoundBytesPerVertex = 960;
 
 // The counter sees this binary's allocations.
 TEST(EncoderMemory, TheCounterCountsAllocations) {

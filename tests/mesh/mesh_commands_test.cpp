@@ -164,9 +164,14 @@ TEST(MeshCommands, InfoOfTheSharedFilesNamesTheirAttributes) {
   REQUIRE_BINARY();
   MESHSTREAM_REQUIRE_TEST_MESHES();
   const CommandResult cube = run("info " + testing::test_mesh("cube_att.obj"));
-  EXPECT_NE(cube.out.find("normals               6 'vn' lines (not kept"), std::string::npos)
+  // Per-face values are kept per corner now (seams), and the stream carries them.
+  EXPECT_NE(cube.out.find("normals               6 'vn' lines (kept by import and subdivide; "
+                          "carried by encode)"),
+            std::string::npos)
       << cube.out;
-  EXPECT_NE(cube.out.find("texture coordinates   4 'vt' lines (not kept"), std::string::npos)
+  EXPECT_NE(cube.out.find("texture coordinates   4 'vt' lines (kept by import and subdivide; "
+                          "carried by encode)"),
+            std::string::npos)
       << cube.out;
   const auto bunny =
       nlohmann::json::parse(run("info --json " + testing::test_mesh("bun_zipper.ply")).out);
@@ -175,11 +180,12 @@ TEST(MeshCommands, InfoOfTheSharedFilesNamesTheirAttributes) {
   const std::string usb = testing::test_mesh_dir() + "/../models/usb/usb.obj";
   if (!std::filesystem::exists(usb)) GTEST_SKIP() << "../shared/models/usb/usb.obj not found";
   const CommandResult text = run("info " + usb);
-  EXPECT_NE(text.out.find("texture coordinates   601 'vt' lines (not kept by import"),
+  EXPECT_NE(text.out.find("texture coordinates   601 'vt' lines (kept by import and subdivide; "
+                          "carried by encode)"),
             std::string::npos)
       << text.out;
   EXPECT_NE(text.out.find("material library      usb.mtl: 1 material (Material_usb.jpg), "
-                          "textures usb.jpg; not read"),
+                          "textures usb.jpg; Kd and map_Kd kept"),
             std::string::npos)
       << text.out;
   const auto json = nlohmann::json::parse(run("info --json " + usb).out);
