@@ -22,7 +22,6 @@ MESHSTREAM_PACKAGES=(
   nginx  # tests/http: the HTTP stream path against a real web server
   haproxy curl  # deploy tests: servers behind a real HAProxy; scraping --metrics
   libeigen3-dev  # glTF import: Draco's scene headers (node transforms) use Eigen
-  nodejs npm  # tests: the Khronos glTF validator (npm gltf-validator) on our glTF output
 )
 
 ms_install_packages() {
@@ -61,6 +60,14 @@ ms_find_meshes() {
   if [ -n "${MESHSTREAM_TEST_MESHES:-}" ]; then echo "$MESHSTREAM_TEST_MESHES"; return; fi
   local candidate="$MESHSTREAM_ROOT/../shared/meshes"
   if [ -d "$candidate" ]; then (cd "$candidate" && pwd); fi
+}
+
+# Node and npm for the glTF validator below (tests only). Debian's nodejs
+# and npm unless a node with its own npm is there already (NodeSource's
+# nodejs bundles npm and conflicts with Debian's npm package).
+ms_install_node() {
+  if command -v node >/dev/null && command -v npm >/dev/null; then return 0; fi
+  ms_install_packages nodejs npm
 }
 
 # The Khronos glTF validator (npm gltf-validator, a JS library) for the glTF
