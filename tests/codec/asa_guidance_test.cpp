@@ -14,17 +14,13 @@
 #include "common/codec/encoder.h"
 #include "common/mesh/import.h"
 #include "common/mesh/procedural.h"
+#include "tests/codec/stream_samples.h"
 #include "tests/test_meshes.h"
 
 namespace meshstream {
 namespace {
 
-std::vector<uint8_t> read_sample(const std::string& name) {
-  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/" + name,
-                   std::ios::binary);
-  EXPECT_TRUE(in) << name;
-  return std::vector<uint8_t>{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::read_sample;
 
 StreamHeader header_with(const AsaGuidance& g) {
   StreamHeader h;

@@ -18,16 +18,12 @@
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
+#include "tests/codec/stream_samples.h"
 
 namespace meshstream {
 namespace {
 
-std::vector<uint8_t> read_sample(const std::string& name) {
-  std::ifstream in(std::string(MESHSTREAM_SOURCE_DIR) + "/tests/codec/data/" + name,
-                   std::ios::binary);
-  EXPECT_TRUE(in) << name;
-  return std::vector<uint8_t>{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::read_sample;
 
 // Positions bit for bit (encoder.h's position_hash) and the face list.
 uint64_t mesh_hash(const Mesh& m) {
