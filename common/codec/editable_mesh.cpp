@@ -28,55 +28,24 @@ Result<EditableMesh> EditableMesh::build(std::vector<Vec3i> positions,
 
 void EditableMesh::star(uint32_t v, std::vector<uint32_t>& ring,
                         std::vector<uint32_t>& corners) const {
+  ring.clear();
+  corners.clear();
   const uint32_t start = vertex_corner_[v];
-  if (start == kNone) {
-    ring.clear();
-    corners.clear();
-    return;
-  }
+  if (start == kNone) return;
   const uint32_t* corner_vertex = reinterpret_cast<const uint32_t*>(faces_.data());
   const uint32_t* opposite = opposite_.data();
-  // Ordinary stars go through raw stack arrays and are copied out once:
-  // a push_back per entry (its capacity test and size update) cost about
-  // as much as the swing itself, which runs for every apex of the encoder
-  // and decoder. Valences above kFast fall back to the vectors.
-  constexpr uint32_t kFast = 2 * kMaxPatchValence;
-  uint32_t ring_buf[kFast + 1], corner_buf[kFast];
-  uint32_t n = 0;
   uint32_t c = start;
   uint32_t last = start;
-  bool closed = false;
-  while (n < kFast) {
-    corner_buf[n] = c;
-    const uint32_t nc = next(c);
-    ring_buf[n] = corner_vertex[nc];
-    ++n;
+  // The bound only guards against a broken table; a valid one ends the loop.
+  for (size_t guard = opposite_.size(); guard > 0; --guard) {
+    corners.push_back(c);
+    const uint32_t n = next(c);
+    ring.push_back(corner_vertex[n]);
     last = c;
-    const uint32_t o = opposite[nc];
-    if (o == kNone) {
-      closed = true;
-      break;
-    }
+    const uint32_t o = opposite[n];
+    if (o == kNone) break;
     c = next(o);
-    if (c == start) {
-      closed = true;
-      break;
-    }
-  }
-  ring.assign(ring_buf, ring_buf + n);
-  corners.assign(corner_buf, corner_buf + n);
-  if (!closed) {
-    // The bound only guards against a broken table; a valid one ends the loop.
-    for (size_t guard = opposite_.size(); guard > 0; --guard) {
-      corners.push_back(c);
-      const uint32_t nc = next(c);
-      ring.push_back(corner_vertex[nc]);
-      last = c;
-      const uint32_t o = opposite[nc];
-      if (o == kNone) break;
-      c = next(o);
-      if (c == start) break;
-    }
+    if (c == start) break;
   }
   if (boundary_[v]) ring.push_back(corner_vertex[prev(last)]);
 }
