@@ -26,6 +26,10 @@ constexpr double kCandidateShare = 0.5;
 constexpr double kValenceWeight = 0.25;
 constexpr double kPredictionWeight = 0.05;
 constexpr double kShapeWeight = 10.0;
+// An upper bound of best_apex's shape term min(area2 / s) over a fan: the
+// equilateral triangle's sqrt(3) / 6 = 0.28868, rounded up so that the
+// floating-point quotient of any triangle stays below it.
+constexpr double kMaxShape = 0.2887;
 
 // Edge vectors and their cross products in 64 bits: exact for 20-bit grids.
 Vec3l sub(Vec3i a, Vec3i b) { return vec3_cast<int64_t>(a) - vec3_cast<int64_t>(b); }
@@ -159,10 +163,23 @@ class LayerBuilder {
       if (std::find(apex_ring_.begin(), apex_ring_.end(), ring_[0]) != apex_ring_.end())
         return kNone;
     }
+    // The ring twice over, so ring[(a + j) % k] is wrapped[a + j]: a
+    // division by the variable k costs tens of cycles, and this runs for
+    // every fan triangle of every apex of every live vertex of every layer.
+    // q: the ring's positions the same way, in 64 bits; edge2[i]: the
+    // squared length of ring edge (R_i, R_i+1).
+    uint32_t wrapped[2 * kMaxRemovalValence];
+    Vec3l q[2 * kMaxRemovalValence];
+    int64_t edge2[2 * kMaxRemovalValence];
+    for (uint32_t i = 0; i < k; ++i) {
+      wrapped[i] = wrapped[i + k] = ring_[i];
+      q[i] = q[i + k] = vec3_cast<int64_t>(p[ring_[i]]);
+    }
+    for (uint32_t i = 0; i + 1 < 2 * k; ++i) edge2[i] = squared_length(q[i + 1] - q[i]);
     Vec3l star_normal{0, 0, 0};
     bool folded_star = false;
     for (uint32_t i = 0; i < corners_.size(); ++i) {
-      const Vec3l n = cross(sub(p[ring_[i]], p[v]), sub(p[ring_[(i + 1) % k]], p[v]));
+      const Vec3l n = cross(sub(p[ring_[i]], p[v]), sub(p[wrapped[i + 1]], p[v]));
       if (n.x == 0 && n.y == 0 && n.z == 0) folded_star = true;
       star_normal += n;
     }
@@ -172,17 +189,35 @@ class LayerBuilder {
     const bool flat_star = snl == 0;
     const Vec3d sn = flat_star ? Vec3d{} : vec3_cast<double>(star_normal) / snl;
 
+    const Quadric& quadric = quadrics[v];
     double best_quality = -1;
     uint32_t best_apex = kNone;
     for (uint32_t a = 0; a < k; ++a) {
       const uint32_t apex = ring_[a];
+      // The quadric term first: an apex whose score could not beat the best
+      // one even with the best possible shape term (worst <= kMaxShape)
+      // would be skipped below anyway, so its fan need not be checked. The
+      // same apex wins, so the same removals are made.
+      const double apex_error = std::sqrt(quadric.mean_error(p[apex]));
+      if (best_apex != kNone && kShapeWeight * kMaxShape - apex_error <= best_quality) continue;
       bool ok = true;
       double worst = 1e300;
-      for (uint32_t j = 1; j + 1 < k && ok; ++j) {
-        const Vec3i A = p[apex], B = p[ring_[(a + j) % k]], C = p[ring_[(a + j + 1) % k]];
-        const Vec3l n = cross(sub(B, A), sub(C, A));
-        const double area2 = norm(n);
-        if (area2 == 0) {
+      // Fan triangle j is (A, B, C) = (R_a, R_a+j, R_a+j+1): its B - A is
+      // the previous one's C - A, and its C - B a ring edge, so each step
+      // computes one new difference. All exact integers (20-bit grids:
+      // squared lengths below 2^53), so the values are those of computing
+      // each triangle on its own.
+      const Vec3l A = q[a];
+      Vec3l ba = q[a + 1] - A;
+      int64_t ba2 = squared_length(ba);
+      for (uint32_t j = 1; j + 1 < k; ++j) {
+        const Vec3l ca = q[a + j + 1] - A;
+        const int64_t ca2 = squared_length(ca);
+        const Vec3l n = cross(ba, ca);
+        const int64_t s = ba2 + edge2[a + j] + ca2;
+        ba = ca;
+        ba2 = ca2;
+        if (n.x == 0 && n.y == 0 && n.z == 0) {
           // Folded flat on the grid: it covers nothing and faces no way, so
           // it cannot turn over. Dense scans have many such triangles at 12
           // bits, and refusing every fan that makes one left their vertices
@@ -199,27 +234,32 @@ class LayerBuilder {
           worst = 0;
           continue;
         }
-        if (flat_star || dot(vec3_cast<double>(n), sn) <= kMinFanCosine * area2) {
+        // A triangle facing away from the star's normal fails whatever its
+        // area (which is positive here): no square root needed for it.
+        const double facing = flat_star ? 0.0 : dot(vec3_cast<double>(n), sn);
+        if (facing <= 0) {
           ok = false;
           break;
         }
-        // Squared edge lengths: integers below 2^53, so exact in any order.
-        const double s = squared_length(to_double(B - A)) + squared_length(to_double(C - B)) +
-                         squared_length(to_double(A - C));
-        worst = std::min(worst, area2 / s);  // 2*sqrt(3)*this = 1 for equilateral
+        const double area2 = norm(n);
+        if (facing <= kMinFanCosine * area2) {
+          ok = false;
+          break;
+        }
+        worst = std::min(worst, area2 / double(s));  // 2*sqrt(3)*this = 1 for equilateral
       }
       if (!ok) continue;
       // The fan from `apex` is the half-edge collapse of v into it: least
       // quadric error wins, triangle shape (worst in [0, 0.29]) breaks
       // near-ties worth up to ~3 grid steps. The first best in ring order.
-      const double score = kShapeWeight * worst - std::sqrt(quadrics[v].mean_error(p[apex]));
+      const double score = kShapeWeight * worst - apex_error;
       if (best_apex != kNone && score <= best_quality) continue;
       // Only an apex that would win pays for its star (the edge checks).
       m_.star(apex, apex_ring_, apex_corners_);
       if (k == 3 && !boundary) {
         // The single new triangle must not already exist (a tetrahedron's
         // last vertex): look for a face of the apex holding both others.
-        const uint32_t b = ring_[(a + 1) % 3], c = ring_[(a + 2) % 3];
+        const uint32_t b = wrapped[a + 1], c = wrapped[a + 2];
         for (uint32_t corner : apex_corners_) {
           const uint32_t x = m_.vertex(EditableMesh::next(corner));
           const uint32_t y = m_.vertex(EditableMesh::prev(corner));
@@ -227,7 +267,7 @@ class LayerBuilder {
         }
       } else {
         for (uint32_t j = 2; j + 2 <= k && ok; ++j) {
-          const uint32_t w = ring_[(a + j) % k];
+          const uint32_t w = wrapped[a + j];
           if (std::find(apex_ring_.begin(), apex_ring_.end(), w) != apex_ring_.end()) ok = false;
         }
       }
