@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -185,7 +186,8 @@ int main(int argc, char** argv) {
   bool quick = false;
   std::vector<std::string> names;
   AsaGuidanceOptions guidance_options;  // the encoder's defaults unless asked otherwise
-  bool guidance_only = false;           // no pictures: the guidance's choices and cost
+  guidance_options.threads = EncodeOptions{}.threads;  // as encode_hcs passes them
+  bool guidance_only = false;  // no pictures: the guidance's choices and cost
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--report-dir" && i + 1 < argc) {
@@ -196,6 +198,14 @@ int main(int argc, char** argv) {
       guidance_options.groups_per_octave = std::atoi(argv[++i]);
     } else if (a == "--guidance-samples" && i + 1 < argc) {
       guidance_options.samples = uint32_t(std::atoi(argv[++i]));
+    } else if (a == "--probe-faces" && i + 1 < argc) {
+      guidance_options.probe_faces = uint32_t(std::atoi(argv[++i]));
+    } else if (a == "--candidates" && i + 1 < argc) {
+      guidance_options.candidates.clear();
+      for (const std::string& c : split_commas(argv[++i]))
+        guidance_options.candidates.push_back(uint8_t(std::stoi(c, nullptr, 0)));
+    } else if (a == "--normal-weight" && i + 1 < argc) {
+      guidance_options.normal_weight = std::atof(argv[++i]);
     } else if (a == "--guidance-only") {
       guidance_only = true;
     } else if (a == "--quick") {
@@ -250,8 +260,10 @@ int main(int argc, char** argv) {
     EncodeOptions unguided;
     unguided.asa_guidance = false;
     const double t_plain = now_s();
+    const std::clock_t cpu_plain = std::clock();
     auto plain_stream = encode_hcs(original, unguided);
     const double t_guided = now_s();
+    const std::clock_t cpu_guided = std::clock();
     // What encode_hcs does by default (encoder.cpp), here with the bench's
     // options: measure the guidance on the finished stream, then write it.
     AsaGuidanceReport guidance_report;
@@ -261,12 +273,17 @@ int main(int argc, char** argv) {
     auto stream =
         measured ? with_asa_guidance(*plain_stream, *measured) : tl::unexpected(measured.error());
     const double t_done = now_s();
+    const std::clock_t cpu_done = std::clock();
     for (const AsaGuidanceReport::Group& g : guidance_report.groups) {
-      std::printf("%s guidance group from record %u (measured at ratio %.1f): %s; RMS / off:",
-                  name.c_str(), g.first_record, g.ratio, asa_choice_label(g.choice).c_str());
+      std::printf(
+          "%s guidance group from record %u (measured at ratio %.1f, %u faces, %.2f s): %s; RMS "
+          "/ off:",
+          name.c_str(), g.first_record, g.ratio, g.prefix_faces, g.seconds,
+          asa_choice_label(g.choice).c_str());
       for (size_t k = 1; k < g.rms.size(); ++k)
-        std::printf(" %s %.3f;", asa_choice_label(guidance_options.candidates[k - 1]).c_str(),
-                    g.rms[k] / g.rms[0]);
+        std::printf(" %s %.3f n %.3f;",
+                    asa_choice_label(guidance_options.candidates[k - 1]).c_str(),
+                    g.rms[k] / g.rms[0], g.normal[k] / g.normal[0]);
       std::printf("\n");
     }
     auto index = stream ? read_stream_index(*stream) : tl::unexpected(stream.error());
@@ -295,8 +312,10 @@ int main(int argc, char** argv) {
         c.choices += std::to_string(g.first_record) + ": " + asa_choice_label(g.choice);
       }
       costs.push_back(c);
-      std::printf("%s: encode %.2f s, with guidance %.2f s; %s\n", name.c_str(), c.seconds_plain,
-                  c.seconds_guided, c.choices.c_str());
+      std::printf("%s: encode %.2f s, with guidance %.2f s (CPU %.2f s, guidance %.2f s); %s\n",
+                  name.c_str(), c.seconds_plain, c.seconds_guided,
+                  double(cpu_guided - cpu_plain) / CLOCKS_PER_SEC,
+                  double(cpu_done - cpu_guided) / CLOCKS_PER_SEC, c.choices.c_str());
       std::fflush(stdout);
     }
     if (guidance_only) continue;

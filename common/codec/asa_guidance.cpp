@@ -1,15 +1,19 @@
 #include "common/codec/asa_guidance.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <thread>
 
 #include "common/asa/settings_check.h"
 #include "common/codec/byte_io.h"
 #include "common/codec/crc32.h"
 #include "common/codec/decoder.h"
-#include "common/codec/rd_measure.h"
+#include "common/metrics/surface_quadrature.h"
+#include "common/metrics/surface_sampling.h"
 
 namespace meshstream {
 namespace {
@@ -54,12 +58,11 @@ Result<std::optional<BlockSpan>> find_block(const std::vector<uint8_t>& extra) {
 }  // namespace
 
 std::vector<uint8_t> AsaGuidanceOptions::default_candidates() {
-  // L1 t0.85 (the old fixed default), with creases at 45 and 60 degrees (the
-  // bench's best fixed variant and a gentler one), and t0.95 with creases.
-  // Two levels (t0.85, crease 45) were tried too and never chosen on the 12
-  // real meshes (bench/REPORT.md, fidelity), at the highest cost.
-  return {make_choice(1, 0, 0, false), make_choice(1, 0, 2, false), make_choice(1, 0, 3, false),
-          make_choice(1, 2, 2, false)};
+  // L1 t0.85 (the old fixed default), with creases at 60 degrees, and t0.95
+  // with creases at 45. Two levels (t0.85, crease 45) and L1 t0.85 crease 45
+  // were tried too and never chosen on the 12 real meshes (bench/REPORT.md,
+  // fidelity): each candidate costs a measurement per group.
+  return {make_choice(1, 0, 0, false), make_choice(1, 0, 3, false), make_choice(1, 2, 2, false)};
 }
 
 Result<std::optional<AsaOptions>> asa_choice_options(uint8_t choice) {
@@ -164,6 +167,205 @@ Result<std::optional<AsaGuidance>> read_asa_guidance(const StreamHeader& header,
   return std::optional<AsaGuidance>(std::move(g));
 }
 
+namespace {
+
+// Runs body(b) for b in [0, blocks) on `threads` threads (0 = one per core).
+// Each block writes only its own slot, so results do not depend on the count.
+template <class Body>
+void for_blocks(size_t blocks, unsigned threads, const Body& body) {
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<size_t>(threads, blocks));
+  if (threads <= 1) {
+    for (size_t b = 0; b < blocks; ++b) body(b);
+    return;
+  }
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t b = next++; b < blocks; b = next++) body(b);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+}
+
+constexpr size_t kBlock = 4096;
+
+// A well-spread subset of a prefix's faces, about one in `stride`: a
+// multiplicative hash of the face index, so the subset follows no pattern
+// of the decoder's face order.
+bool is_probe(uint32_t face, uint32_t stride) {
+  return stride <= 1 || (face * 2654435761u) % stride == 0;
+}
+
+// The distances the guidance judges a shown mesh by, against the original.
+struct Distances {
+  double rms = 0;     // symmetric RMS surface distance over the diagonal
+  double normal = 0;  // mean 1 - cos of the angle between the original's
+                      // and the shown surface's normals at the original's
+                      // samples (what shading shows and distance does not)
+};
+
+// Where one prefix and its candidates are measured: a fixed, well-spread
+// subset of the prefix's faces (the probes), their neighbours (faces
+// sharing a vertex: where a probe's nearby surface may move to), and the
+// original's samples whose closest point on the plain prefix's probe region
+// lies on a probe. The same for every candidate of the prefix, so a
+// triangle a candidate leaves alone weighs the same in the plain and the
+// candidate's measurement, and the cost is bounded by the probes, not the
+// mesh (a large prefix's subdivision is never measured, nor held in a
+// hierarchy, whole).
+struct Probes {
+  enum : uint8_t { kOutside = 0, kNeighbour = 1, kProbe = 2 };
+  std::vector<uint8_t> kind;   // per prefix face
+  std::vector<uint32_t> kept;  // indices of the original's samples measured
+  bool whole = true;           // every face a probe (a small prefix)
+};
+
+// The original, prepared once for every prefix and candidate: area samples
+// with their face normals, a hierarchy, and the sampling density.
+class GuidanceMeasure {
+ public:
+  GuidanceMeasure(const Mesh& original, uint32_t samples, uint32_t probe_faces, unsigned threads)
+      : threads_(threads), probe_faces_(std::max<uint32_t>(probe_faces, 1)) {
+    samples = std::max<uint32_t>(samples, 1);
+    const SurfaceSamples area = sample_surface_area(original, samples, 1);
+    cell_area_ = area.area / samples;
+    points_.assign(area.points.begin(), area.points.begin() + area.area_count);
+    bvh_ = TriangleBvh::build(original);
+    diagonal_ = bounding_box(original).diagonal();
+    normals_.resize(points_.size());
+    for_blocks((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
+      for (size_t i = b * kBlock; i < std::min(points_.size(), (b + 1) * kBlock); ++i)
+        normals_[i] = face_normal(original, bvh_.closest(points_[i]).triangle);
+    });
+  }
+
+  Probes probes(const Mesh& prefix) const {
+    Probes p;
+    const uint32_t faces = prefix.face_count();
+    const uint32_t stride = faces / probe_faces_;
+    p.whole = stride <= 1;
+    p.kind.assign(faces, Probes::kProbe);
+    if (p.whole) {
+      p.kept.resize(points_.size());
+      for (uint32_t i = 0; i < p.kept.size(); ++i) p.kept[i] = i;
+      return p;
+    }
+    std::vector<uint8_t> near(prefix.vertex_count(), 0);
+    for (uint32_t f = 0; f < faces; ++f) {
+      p.kind[f] = is_probe(f, stride) ? Probes::kProbe : Probes::kOutside;
+      if (p.kind[f] == Probes::kProbe)
+        for (uint32_t v : prefix.triangles[f]) near[v] = 1;
+    }
+    for (uint32_t f = 0; f < faces; ++f) {
+      const Triangle& t = prefix.triangles[f];
+      if (p.kind[f] == Probes::kOutside && (near[t[0]] || near[t[1]] || near[t[2]]))
+        p.kind[f] = Probes::kNeighbour;
+    }
+    const Mesh region = region_of(prefix, p, nullptr);
+    const TriangleBvh bvh = TriangleBvh::build(region);
+    std::vector<uint8_t> on_probe(points_.size(), 0);
+    for_blocks((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
+      uint32_t hint = TriangleBvh::kNoHint;
+      for (size_t i = b * kBlock; i < std::min(points_.size(), (b + 1) * kBlock); ++i) {
+        const ClosestHit hit = bvh.closest(points_[i], hint);
+        hint = hit.triangle;
+        on_probe[i] = region_kind_[hit.triangle] == Probes::kProbe;
+      }
+    });
+    for (uint32_t i = 0; i < on_probe.size(); ++i)
+      if (on_probe[i]) p.kept.push_back(i);
+    return p;
+  }
+
+  // The distances of `shown` (the prefix, or a candidate's subdivision of
+  // it with its source faces) to the original, at `probes` of the prefix.
+  // When the shown-to-original direction alone already reaches
+  // `give_up_at` (relative), the candidate cannot win: the other direction
+  // is not measured and rms is that lower bound (normal is then 0).
+  Distances measure(const Mesh& shown, const Probes& probes,
+                    const std::vector<uint32_t>* source_face,
+                    double give_up_at = std::numeric_limits<double>::infinity()) const {
+    auto kind_of = [&](uint32_t f) { return probes.kind[source_face ? (*source_face)[f] : f]; };
+    std::vector<uint32_t> probed;
+    for (uint32_t f = 0; f < shown.triangles.size(); ++f)
+      if (kind_of(f) == Probes::kProbe) probed.push_back(f);
+    const WeightedSamples from_shown = quadrature_samples(shown, cell_area_, probed);
+    probed = {};
+    const double to_original = weighted_rms_distance(from_shown, bvh_, threads_);
+    if (diagonal_ > 0 && to_original / diagonal_ >= give_up_at) return {to_original / diagonal_, 0};
+
+    const Mesh region = probes.whole ? Mesh{} : region_of(shown, probes, source_face);
+    const Mesh& target = probes.whole ? shown : region;
+    const TriangleBvh shown_bvh = TriangleBvh::build(target);
+    const std::vector<uint32_t>& kept = probes.kept;
+    const size_t blocks = (kept.size() + kBlock - 1) / kBlock;
+    std::vector<double> squared(blocks, 0.0), normal(blocks, 0.0);
+    for_blocks(blocks, threads_, [&](size_t b) {
+      uint32_t hint = TriangleBvh::kNoHint;
+      for (size_t j = b * kBlock; j < std::min(kept.size(), (b + 1) * kBlock); ++j) {
+        const uint32_t i = kept[j];
+        const ClosestHit hit = shown_bvh.closest(points_[i], hint);
+        hint = hit.triangle;
+        squared[b] += hit.squared_distance;
+        const Vec3f n = face_normal(target, hit.triangle);
+        const Vec3f& o = normals_[i];
+        normal[b] +=
+            1.0 - std::clamp(double(n.x) * o.x + double(n.y) * o.y + double(n.z) * o.z, -1.0, 1.0);
+      }
+    });
+    double sum_squared = 0, sum_normal = 0;
+    for (size_t b = 0; b < blocks; ++b) {
+      sum_squared += squared[b];
+      sum_normal += normal[b];
+    }
+    const double count = double(std::max<size_t>(kept.size(), 1));
+    const double to_shown = std::sqrt(sum_squared / count);
+    Distances d;
+    d.rms = diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;
+    d.normal = sum_normal / count;
+    return d;
+  }
+
+ private:
+  // The faces of `shown` in the probe region (probes and neighbours), with
+  // their kinds in region_kind_ (for probes(): the plain prefix).
+  Mesh region_of(const Mesh& shown, const Probes& probes,
+                 const std::vector<uint32_t>* source_face) const {
+    Mesh region;
+    region.positions = shown.positions;
+    region_kind_.clear();
+    for (uint32_t f = 0; f < shown.triangles.size(); ++f) {
+      const uint8_t k = probes.kind[source_face ? (*source_face)[f] : f];
+      if (k == Probes::kOutside) continue;
+      region.triangles.push_back(shown.triangles[f]);
+      region_kind_.push_back(k);
+    }
+    return region;
+  }
+
+  unsigned threads_ = 1;
+  uint32_t probe_faces_ = 1;
+  double cell_area_ = 0, diagonal_ = 0;
+  std::vector<Vec3d> points_;
+  std::vector<Vec3f> normals_;
+  TriangleBvh bvh_;
+  mutable std::vector<uint8_t> region_kind_;
+};
+
+// How a candidate's distances compare with the plain prefix's (below 1:
+// closer): the RMS ratio, times the normal-deviation ratio to the power
+// normal_weight (0: distance alone).
+double guidance_score(const Distances& plain, const Distances& d, const AsaGuidanceOptions& o) {
+  const double rms = plain.rms > 0 ? d.rms / plain.rms : (d.rms > 0 ? 2.0 : 1.0);
+  if (o.normal_weight <= 0) return rms;
+  const double normal = plain.normal > 0 ? d.normal / plain.normal : (d.normal > 0 ? 2.0 : 1.0);
+  return rms * std::pow(normal, o.normal_weight);
+}
+
+}  // namespace
+
 Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const uint8_t> stream,
                                          const AsaGuidanceOptions& options,
                                          AsaGuidanceReport* report) {
@@ -173,6 +375,8 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
   const std::vector<RecordEntry>& records = index->records;
   const uint32_t n = static_cast<uint32_t>(records.size());
   if (n == 0) return make_error(ErrorCode::kInvalidArgument, "ASA guidance: stream has no records");
+  if (original.triangles.empty())
+    return make_error(ErrorCode::kInvalidArgument, "ASA guidance: the original has no triangles");
   const double total = double(index->total_bytes());
   const int per_octave = std::max(1, options.groups_per_octave);
   const int coarsest = int(std::floor(std::log2(std::max(options.max_ratio, 1.0)) * per_octave));
@@ -199,10 +403,6 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
     i = j;
   }
 
-  RdMeasureOptions mopt;
-  mopt.samples = options.samples;
-  auto measure = RdMeasure::prepare(original, mopt);
-  if (!measure) return tl::unexpected(measure.error());
   std::vector<AsaOptions> candidate_options;
   for (uint8_t c : options.candidates) {
     auto o = asa_choice_options(c);
@@ -211,7 +411,14 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
           ErrorCode::kInvalidArgument,
           "ASA guidance: candidate " + asa_choice_label(c) + " is not an ASA setting");
     candidate_options.push_back(**o);
+    candidate_options.back().track_source_faces = true;
   }
+  const GuidanceMeasure measure(original, options.samples, options.probe_faces, options.threads);
+  // Progress by the bytes decoded and the measured prefixes' sizes (the
+  // finer a prefix, the more its measurement costs).
+  double planned_work = 0, work_done = 0;
+  for (const Planned& p : planned)
+    planned_work += double(records[p.measured].offset + records[p.measured].size);
 
   AsaGuidance guidance;
   IncrementalDecoder decoder;
@@ -227,41 +434,60 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
     if (!guidance.groups.empty() && guidance.groups.back().choice == kAsaChoiceOff &&
         report_last_ratio > 0 && report_last_ratio < options.stop_below_ratio)
       break;
+    const auto group_start = std::chrono::steady_clock::now();
     const uint64_t end = records[p.measured].offset + records[p.measured].size;
     auto applied = decoder.feed(stream.subspan(fed, end - fed));
     if (!applied) return tl::unexpected(applied.error());
     fed = end;
     const Mesh& prefix = decoder.mesh();
+    if (prefix.triangles.empty())
+      return make_error(ErrorCode::kInvalidMesh, "ASA guidance: a decoded prefix has no triangles");
+    const uint32_t prefix_faces = prefix.face_count();
     AsaGuidanceReport::Group row;
     row.first_record = p.first;
     row.measured_record = p.measured;
     row.ratio = ratio_of(p.measured);
-    const double plain = measure->relative_rms(prefix);
-    row.rms.push_back(plain);
-    double best_rms = plain * (1 - options.margin);
+    const Probes probes = measure.probes(prefix);
+    const Distances plain = measure.measure(prefix, probes, nullptr);
+    row.rms.push_back(plain.rms);
+    row.normal.push_back(plain.normal);
+    double best_score = 1 - options.margin;
     uint8_t choice = kAsaChoiceOff;
     for (size_t k = 0; k < candidate_options.size(); ++k) {
       if (auto s = subdivide_into(prefix, candidate_options[k], workspace, out); !s)
         return tl::unexpected(s.error());
-      const double rms =
-          out.mesh.face_count() == prefix.face_count() ? plain : measure->relative_rms(out.mesh);
-      row.rms.push_back(rms);
-      if (rms < best_rms) {
-        best_rms = rms;
+      // A candidate whose RMS reaches this cannot be chosen (the score
+      // is at least its RMS ratio): measure it only that far.
+      const double give_up_at = options.normal_weight > 0 ? std::numeric_limits<double>::infinity()
+                                                          : best_score * plain.rms;
+      const Distances d = out.mesh.face_count() == prefix_faces
+                              ? plain
+                              : measure.measure(out.mesh, probes, &out.source_face, give_up_at);
+      row.rms.push_back(d.rms);
+      row.normal.push_back(d.normal);
+      const double score = guidance_score(plain, d, options);
+      if (score < best_score) {
+        best_score = score;
         choice = options.candidates[k];
       }
     }
     row.choice = choice;
+    row.prefix_faces = prefix_faces;
+    row.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - group_start).count();
     report_last_ratio = row.ratio;
     if (guidance.groups.empty() || guidance.groups.back().choice != choice)
       guidance.groups.push_back({p.first, choice});
     if (report) report->groups.push_back(std::move(row));
+    work_done += double(end);
+    if (options.progress) options.progress(work_done / planned_work);
   }
   // Nothing is missing from the complete stream: show it as decoded.
   if (guidance.groups.empty())
     guidance.groups.push_back({0, kAsaChoiceOff});
   else if (guidance.groups.back().choice != kAsaChoiceOff)
     guidance.groups.push_back({n - 1, kAsaChoiceOff});
+  if (options.progress) options.progress(1.0);
   if (report)
     report->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -89,8 +90,22 @@ struct AsaGuidanceOptions {
   // Once a group measured at a ratio below this chose no ASA, the finer
   // groups get none without being measured (0: measure every group).
   double stop_below_ratio = 16;
-  // Area samples on the original (RdMeasure): noise well below the margin.
+  // Area samples on the original, and about as many quadrature points on
+  // a fixed subset of each prefix's faces: noise well below the margin.
   uint32_t samples = 16000;
+  // A prefix with more faces is measured at about this many of them (a
+  // well-spread subset, the same for each candidate) and their
+  // neighbourhoods, with the original's samples near them.
+  uint32_t probe_faces = 4000;
+  // How much the normal deviation (1 - cos, at the original's samples)
+  // counts beside the RMS distance: a candidate's score is its RMS ratio to
+  // the plain prefix times its normal-deviation ratio to this power.
+  double normal_weight = 0;
+  // Threads for the closest-point queries (0 = one per core); the choices
+  // are the same for every count.
+  unsigned threads = 1;
+  // Called with the share of the measurement done; empty = no calls.
+  std::function<void(double)> progress;
   // The settings tried, as choice bytes; off is always tried.
   std::vector<uint8_t> candidates = default_candidates();
   static std::vector<uint8_t> default_candidates();
@@ -100,9 +115,12 @@ struct AsaGuidanceOptions {
 struct AsaGuidanceReport {
   struct Group {
     uint32_t first_record = 0, measured_record = 0;
-    double ratio = 0;         // of the measured prefix
-    std::vector<double> rms;  // per candidate (off first), relative to the diagonal
+    double ratio = 0;            // of the measured prefix
+    std::vector<double> rms;     // per candidate (off first), relative to the diagonal
+    std::vector<double> normal;  // per candidate (off first): mean 1 - cos of the normals
     uint8_t choice = kAsaChoiceOff;
+    uint32_t prefix_faces = 0;
+    double seconds = 0;  // decoding up to it and measuring it
   };
   std::vector<Group> groups;
   double seconds = 0;

@@ -12,7 +12,9 @@ namespace meshstream {
 struct EncodeProgress {
   // "decimating", "coding records", "measuring" (the automatic record
   // ordering's choice), "coding the winner" (when the choice fell on a
-  // candidate not coded whole yet), "done"
+  // candidate not coded whole yet), "measuring ASA guidance" (the
+  // encoder-guided ASA's choices, asa_guidance.h; unless
+  // EncodeOptions::asa_guidance is off), "done"
   std::string_view stage;
   double fraction = 0;  // of the whole encode, 0..1, never decreasing
 };

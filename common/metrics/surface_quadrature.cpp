@@ -8,9 +8,12 @@
 
 namespace meshstream {
 
-WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area) {
+namespace {
+
+template <class EachFace>
+WeightedSamples quadrature_of(const Mesh& mesh, double cell_area, const EachFace& each_face) {
   WeightedSamples out;
-  for (const Triangle& t : mesh.triangles) {
+  each_face([&](const Triangle& t) {
     const Vec3f& fa = mesh.positions[t[0]];
     const Vec3f& fb = mesh.positions[t[1]];
     const Vec3f& fc = mesh.positions[t[2]];
@@ -19,7 +22,7 @@ WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area) {
     const Vec3d v{double(fc.x) - fa.x, double(fc.y) - fa.y, double(fc.z) - fa.z};
     const double cx = u.y * v.z - u.z * v.y, cy = u.z * v.x - u.x * v.z, cz = u.x * v.y - u.y * v.x;
     const double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-    if (!(area > 0)) continue;
+    if (!(area > 0)) return;
     const int k = static_cast<int>(std::clamp(std::ceil(std::sqrt(area / cell_area)), 1.0, 32.0));
     const double w = area / (double(k) * k);
     auto add = [&](double s, double r) {  // barycentric (1 - s - r, s, r)
@@ -34,8 +37,23 @@ WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area) {
       }
     }
     out.area += area;
-  }
+  });
   return out;
+}
+
+}  // namespace
+
+WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area) {
+  return quadrature_of(mesh, cell_area, [&](const auto& visit) {
+    for (const Triangle& t : mesh.triangles) visit(t);
+  });
+}
+
+WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area,
+                                   const std::vector<uint32_t>& faces) {
+  return quadrature_of(mesh, cell_area, [&](const auto& visit) {
+    for (uint32_t f : faces) visit(mesh.triangles[f]);
+  });
 }
 
 double weighted_rms_distance(const WeightedSamples& from, const TriangleBvh& to, unsigned threads) {

@@ -32,6 +32,9 @@ struct WeightedSamples {
 // Precondition: indices in range, cell_area > 0. Zero-area triangles get no
 // points. O(F + points).
 WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area);
+// Same, for the listed faces only (indices in range). O(faces + points).
+WeightedSamples quadrature_samples(const Mesh& mesh, double cell_area,
+                                   const std::vector<uint32_t>& faces);
 
 // sqrt(sum of weight x squared distance to `to` / total weight): the RMS
 // distance from the sampled surface to `to`. 0 for no samples. The points

@@ -62,8 +62,9 @@ TEST(EncoderThreads, ProgressAdvancesSmoothlyThroughTheStages) {
     EXPECT_LE(calls.size(), 800u);
     EXPECT_EQ(calls.back().stage, "done");
     EXPECT_DOUBLE_EQ(calls.back().fraction, 1.0);
-    const std::vector<std::string> order = {"decimating", "coding records", "measuring",
-                                            "coding the winner", "done"};
+    const std::vector<std::string> order = {
+        "decimating",        "coding records",         "measuring",
+        "coding the winner", "measuring ASA guidance", "done"};
     size_t stage = 0;
     std::vector<int> calls_in(order.size(), 0);
     for (size_t i = 0; i < calls.size(); ++i) {
@@ -77,6 +78,7 @@ TEST(EncoderThreads, ProgressAdvancesSmoothlyThroughTheStages) {
     EXPECT_GE(calls_in[0], 5) << "decimating";
     EXPECT_GE(calls_in[1], 20) << "coding records";
     EXPECT_GE(calls_in[2], 3) << "measuring";
+    EXPECT_GE(calls_in[4], 3) << "measuring ASA guidance";
     // No jump of more than a fifth of the whole between two calls.
     for (size_t i = 1; i < calls.size(); ++i)
       EXPECT_LE(calls[i].fraction - calls[i - 1].fraction, 0.2) << i << " " << calls[i].stage;
