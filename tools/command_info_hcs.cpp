@@ -54,6 +54,7 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
                           const FileCoverage& in_file) {
   uint64_t positions = 0, connectivity = 0;
   std::span<const uint8_t> base_attributes, final_attributes;
+  std::vector<std::span<const uint8_t>> values_attributes;
   for (size_t i = 0; i < index.records.size() && i < in_file.complete_records; ++i) {
     const RecordEntry& r = index.records[i];
     const char* kind = record_kind(bytes, r, i);
@@ -63,15 +64,20 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
     if (k == "plane") {
       positions += r.size;
     } else if (k == "attributes") {
-      (payload.size() > 1 && payload[1] == kAttributePartBase ? base_attributes
-                                                              : final_attributes) = payload;
+      const uint8_t part = payload.size() > 1 ? payload[1] : kAttributePartFinal;
+      if (part == kAttributePartBase)
+        base_attributes = payload;
+      else if (part == kAttributePartValues)
+        values_attributes.push_back(payload);
+      else
+        final_attributes = payload;
     } else {
       connectivity += r.size;
     }
   }
   nlohmann::json out = {{"positions", positions}, {"connectivity", connectivity}};
   if (!base_attributes.empty()) {
-    auto parts = attribute_record_parts(base_attributes, final_attributes);
+    auto parts = attribute_record_parts(base_attributes, values_attributes, final_attributes);
     if (parts) {
       for (const auto& [name, n] : *parts) out[name] = n;
     } else {

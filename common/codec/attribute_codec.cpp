@@ -14,6 +14,7 @@
 #include "common/codec/range_coder.h"
 #include "common/codec/refinement_state.h"
 #include "common/codec/stream_format.h"
+#include "common/codec/structure_record_reader.h"
 
 namespace meshstream {
 
@@ -53,10 +54,8 @@ uint32_t wedge_of_corner(const EditableMesh& m, const AttributeValues& a, uint32
 namespace {
 
 constexpr int kContexts = 4;  // parallelogram, neighbours, none, geometric
-
-struct ChannelModels {
-  AdaptiveIntModel residual[kContexts][4];
-};
+using ChannelModels = AttributeChannelModels;
+static_assert(sizeof(ChannelModels::residual) / sizeof(ChannelModels::residual[0]) == kContexts);
 
 // Values of channel `ch` at corner c.
 const int32_t* corner_value(const EditableMesh& m, const AttributeValues& a,
@@ -367,18 +366,20 @@ void put_section(std::vector<uint8_t>& out, const std::vector<uint8_t>& bytes) {
 }
 
 // Codes (or decodes) the values of vertices [first, last) of channel ch, in
-// id order, wedges in order. Encoder: `truth` holds them.
+// id order, wedges in order. Encoder: `truth` holds them. `persistent`:
+// the models to continue (values records), else fresh ones.
 struct ValueCoder {
   const AttributeLayout& layout;
   bool final_record;
   std::vector<uint32_t> ring, corners;
 
   std::vector<uint8_t> encode(const EditableMesh& m, const AttributeValues& truth, size_t ch,
-                              uint32_t first, uint32_t last) {
+                              uint32_t first, uint32_t last, ChannelModels* persistent = nullptr) {
     const AttributeChannel& c = layout.channels[ch];
     const uint32_t n = c.components();
     const int32_t max = layout.max_value(c);
-    ChannelModels models;
+    ChannelModels fresh;
+    ChannelModels& models = persistent ? *persistent : fresh;
     RangeEncoder enc;
     int32_t pred[4];
     for (uint32_t v = first; v < last; ++v) {
@@ -396,11 +397,12 @@ struct ValueCoder {
   }
 
   Status decode(const EditableMesh& m, AttributeValues& a, size_t ch, uint32_t first, uint32_t last,
-                std::span<const uint8_t> bytes) {
+                std::span<const uint8_t> bytes, ChannelModels* persistent = nullptr) {
     const AttributeChannel& c = layout.channels[ch];
     const uint32_t n = c.components();
     const int32_t max = layout.max_value(c);
-    ChannelModels models;
+    ChannelModels fresh;
+    ChannelModels& models = persistent ? *persistent : fresh;
     RangeDecoder dec(bytes);
     int32_t pred[4];
     for (uint32_t v = first; v < last; ++v) {
@@ -565,7 +567,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
                                                    std::span<const uint8_t> stream,
                                                    const std::vector<uint32_t>& to_input,
                                                    AttributeParts* parts,
-                                                   std::vector<uint32_t>* payload_sizes) {
+                                                   std::vector<AttributeRecordPlace>* places) {
   auto internal = [](const std::string& what) {
     return tl::unexpected(Error{ErrorCode::kInternal, "encoder attributes: " + what});
   };
@@ -752,11 +754,63 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     local_parts[attribute_kind_name(c.kind)] += bytes.size();
   }
 
-  // The last record: inserted vertices' values, then the extra attributes.
+  // Values records: the geometry stream replayed as the decoder reads it,
+  // and after a geometry record, once the vertices inserted since the last
+  // values are worth about kValuesRecordShare of the stream, their exact
+  // values coded on the mesh the decoder holds then. Their size per vertex
+  // is estimated from coding them all on the full mesh (version 10's last
+  // record).
+  const uint32_t inserted = n - base_n;
+  uint64_t all_inserted_bytes = 0;
+  {
+    ValueCoder estimate{layout, true, {}, {}};
+    for (size_t ch = 0; ch < layout.channels.size(); ++ch)
+      all_inserted_bytes += estimate.encode(*full, truth, ch, base_n, n).size();
+  }
+  uint64_t fixed_bytes = stream.size() + first.size();
+  for (const ExtraAttribute& e : *plan.extras) fixed_bytes += e.bytes.size() / 4;  // a guess
+  const double per_vertex = inserted ? double(all_inserted_bytes) / inserted : 0;
+  const double target = kValuesRecordShare * double(fixed_bytes + all_inserted_bytes);
+  std::vector<std::vector<uint8_t>> values_after(idx.records.size());
+  uint32_t done = base_n;
+  if (inserted > 0 && idx.records.size() > 2) {
+    auto replay = RefinementState::from_coarse_base(coarse, base_decoder.mesh().triangles,
+                                                    quant_bits, base_shift);
+    if (!replay) return tl::unexpected(replay.error());
+    if (format) replay->format = *format;
+    std::vector<ChannelModels> models(layout.channels.size());
+    ValueCoder values_coder{layout, false, {}, {}};
+    // The last geometry record's vertices go into the last record.
+    for (size_t i = 1; i + 1 < idx.records.size(); ++i) {
+      const RecordEntry& r = idx.records[i];
+      AppliedRecord applied;
+      applied.record_changes = false;
+      if (auto s =
+              apply_refinement_record(*replay, record_payload(r, stream.subspan(r.offset, r.size)),
+                                      r.vertices, r.faces, applied);
+          !s)
+        return internal("replaying record " + std::to_string(i) + ": " + s.error().message);
+      const uint32_t now = replay->mesh.vertex_count();
+      if (now <= done || double(now - done) * per_vertex < target) continue;
+      std::vector<uint8_t> payload{kRecordAttributes, kAttributePartValues};
+      put_varint(payload, now - done);
+      for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+        const std::vector<uint8_t> bytes =
+            values_coder.encode(replay->mesh, truth, ch, done, now, &models[ch]);
+        put_section(payload, bytes);
+        local_parts[attribute_kind_name(layout.channels[ch].kind)] += bytes.size();
+      }
+      values_after[i] = std::move(payload);
+      done = now;
+    }
+  }
+
+  // The last record: the values of the vertices inserted since the last
+  // values record, then the extra attributes.
   std::vector<uint8_t> last{kRecordAttributes, kAttributePartFinal};
   ValueCoder final_coder{layout, true, {}, {}};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
-    const std::vector<uint8_t> bytes = final_coder.encode(*full, truth, ch, base_n, n);
+    const std::vector<uint8_t> bytes = final_coder.encode(*full, truth, ch, done, n);
     put_section(last, bytes);
     local_parts[attribute_kind_name(layout.channels[ch].kind)] += bytes.size();
   }
@@ -781,33 +835,35 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     local_parts["extra"] += last.size() - before;
   }
 
-  // The stream again with both records.
+  // The stream again with the attribute records.
   std::vector<std::vector<uint8_t>> payloads;
   std::vector<RecordCounts> counts;
+  std::vector<AttributeRecordPlace> local_places;
+  auto add_attributes = [&](std::vector<uint8_t> payload) {
+    local_places.push_back({uint32_t(payloads.size()), uint32_t(payload.size())});
+    counts.push_back(counts.back());
+    payloads.push_back(std::move(payload));
+  };
   for (size_t i = 0; i < idx.records.size(); ++i) {
     const RecordEntry& r = idx.records[i];
     const auto bytes = record_payload(r, stream.subspan(r.offset, r.size));
     payloads.emplace_back(bytes.begin(), bytes.end());
     counts.push_back({r.vertices, r.faces});
-    if (i == 0) {
-      payloads.push_back(first);
-      counts.push_back({r.vertices, r.faces});
-    }
+    if (i == 0) add_attributes(std::move(first));
+    if (!values_after[i].empty()) add_attributes(std::move(values_after[i]));
   }
-  payloads.push_back(last);
-  counts.push_back(counts.back());
-  if (payload_sizes) {
-    payload_sizes->clear();
-    for (const auto& p : payloads) payload_sizes->push_back(uint32_t(p.size()));
-  }
+  add_attributes(std::move(last));
   auto written = write_container(idx.header, payloads, counts);
   if (!written) return tl::unexpected(written.error());
   if (parts) *parts = std::move(local_parts);
+  if (places) *places = std::move(local_places);
   return std::move(written->bytes);
 }
 
-Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payload,
-                                              std::span<const uint8_t> final_payload) {
+Result<AttributeParts> attribute_record_parts(
+    std::span<const uint8_t> base_payload,
+    std::span<const std::span<const uint8_t>> values_payloads,
+    std::span<const uint8_t> final_payload) {
   AttributeParts parts;
   if (base_payload.size() < 2 || base_payload[0] != kRecordAttributes ||
       base_payload[1] != kAttributePartBase)
@@ -822,6 +878,15 @@ Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payl
   for (const AttributeChannel& c : layout->channels)
     parts[attribute_kind_name(c.kind)] += r.section().size();
   if (!r.ok) return tl::unexpected(parse_error("base attribute record truncated"));
+  for (std::span<const uint8_t> values : values_payloads) {
+    if (values.size() < 2 || values[0] != kRecordAttributes || values[1] != kAttributePartValues)
+      return tl::unexpected(parse_error("not a values record"));
+    Reader v{values, 2};
+    v.varint();
+    for (const AttributeChannel& c : layout->channels)
+      parts[attribute_kind_name(c.kind)] += v.section().size();
+    if (!v.ok) return tl::unexpected(parse_error("values record truncated"));
+  }
   if (final_payload.empty()) return parts;
   if (final_payload.size() < 2 || final_payload[0] != kRecordAttributes ||
       final_payload[1] != kAttributePartFinal)
@@ -907,7 +972,41 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
     if (auto s = coder.decode(base, values_, ch, 0, n, bytes); !s) return s;
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the base part"));
+  exact_vertices_ = n;
+  values_models_.assign(layout_.channels.size(), ChannelModels{});
   active_ = true;
+  return {};
+}
+
+Status AttributeDecoder::read_values(std::span<const uint8_t> payload, const EditableMesh& m) {
+  if (!active_)
+    return tl::unexpected(parse_error("values record before the base attribute record"));
+  if (complete_) return tl::unexpected(parse_error("values record after the final one"));
+  Reader r{payload, 2};
+  const uint32_t count = r.varint();
+  if (!r.ok) return tl::unexpected(parse_error("values record truncated"));
+  const uint32_t now = m.vertex_count();
+  if (count == 0 || uint64_t(exact_vertices_) + count != now)
+    return tl::unexpected(parse_error(
+        "values record for " + std::to_string(count) + " vertices where " +
+        std::to_string(now - std::min(now, exact_vertices_)) + " were inserted since the last"));
+  // Room for the vertices not previewed (a decoder that keeps no output
+  // mesh previews none); every one of them is decoded below.
+  for (uint32_t v = values_.vertices(); v < now; ++v) {
+    values_.wedge_key.push_back(kNone);
+    values_.wedge_start.push_back(uint32_t(values_.wedge_key.size()));
+    for (size_t ch = 0; ch < layout_.channels.size(); ++ch)
+      values_.data[ch].resize(values_.data[ch].size() + layout_.channels[ch].components());
+  }
+  ValueCoder coder{layout_, false, {}, {}};
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    auto bytes = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
+    if (auto s = coder.decode(m, values_, ch, exact_vertices_, now, bytes, &values_models_[ch]); !s)
+      return s;
+  }
+  if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after a values record"));
+  exact_vertices_ = now;
   return {};
 }
 
@@ -936,10 +1035,11 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
     return tl::unexpected(parse_error("unknown attribute record part"));
   Reader r{payload, 2};
   const uint32_t n = full.vertex_count();
-  // Back to the base's values; every inserted vertex decoded exactly.
-  values_.wedge_start.resize(base_vertices_ + 1);
+  // Back to the exact values (the base's and the values records'); every
+  // vertex inserted after them decoded exactly.
+  values_.wedge_start.resize(exact_vertices_ + 1);
   values_.wedge_key.resize(values_.wedge_start.back());
-  for (uint32_t v = base_vertices_; v < n; ++v) {
+  for (uint32_t v = exact_vertices_; v < n; ++v) {
     values_.wedge_key.push_back(kNone);
     values_.wedge_start.push_back(uint32_t(values_.wedge_key.size()));
   }
@@ -949,7 +1049,7 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
     values_.data[ch].resize(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components());
     auto bytes = r.section();
     if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
-    if (auto s = coder.decode(full, values_, ch, base_vertices_, n, bytes); !s) return s;
+    if (auto s = coder.decode(full, values_, ch, exact_vertices_, n, bytes); !s) return s;
   }
   const uint32_t extra_count = r.varint();
   if (!r.ok || extra_count > 64) return tl::unexpected(parse_error("bad extra attribute count"));
@@ -982,6 +1082,7 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
     extras_.push_back(std::move(e));
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the final part"));
+  exact_vertices_ = n;
   complete_ = true;
   return {};
 }

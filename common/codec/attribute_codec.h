@@ -11,15 +11,21 @@
 // ends it walking around the vertex (kBoundary: the boundary ends it).
 // Inserted vertices are never seam vertices: one value each.
 //
-// Two records: record 1, right after the base, carries the layout (which
-// attributes, their grids, the material table), one seam bit per interior
-// edge of each base vertex that has more than one wedge, and the base
-// vertices' values. The last record carries the exact values of every
-// inserted vertex and the extra attributes (zstd). Between them the decoder
-// shows each inserted vertex with its prediction (from its neighbours at
-// insertion), so every prefix after record 1 has attributes. Values are
-// predicted in exact integers from what the decoder has (parallelograms over
-// the connectivity, neighbours; normals: the geometric normal of the wedge's
+// Three kinds of records: record 1, right after the base, carries the
+// layout (which attributes, their grids, the material table), one seam bit
+// per interior edge of each base vertex that has more than one wedge, and
+// the base vertices' values. Values records (encoder version 11 on) follow
+// geometry records and carry the exact values of every vertex inserted
+// since the previous one, coded on the decoder's mesh of that moment with
+// models that persist from one values record to the next; they are sized
+// like the geometry records (at most 1.5 % of the stream each). The last
+// record carries the exact values of the vertices inserted after the last
+// values record (version 10: of every inserted vertex) and the extra
+// attributes (zstd). Until its values arrive the decoder shows each
+// inserted vertex with its prediction (from its neighbours at insertion),
+// so every prefix after record 1 has attributes. Values are predicted in
+// exact integers from what the decoder has (parallelograms over the
+// connectivity, neighbours; normals: the geometric normal of the wedge's
 // faces) and the residuals range-coded with adaptive models.
 #pragma once
 
@@ -32,6 +38,7 @@
 #include "common/base/result.h"
 #include "common/codec/attribute_quantize.h"
 #include "common/codec/editable_mesh.h"
+#include "common/codec/range_coder.h"
 #include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
 
@@ -39,8 +46,12 @@ namespace meshstream {
 
 // An attribute record's first payload byte is kRecordAttributes
 // (stream_format.h); its second says which part it is.
-inline constexpr uint8_t kAttributePartBase = 0;   // record 1
-inline constexpr uint8_t kAttributePartFinal = 1;  // the last record
+inline constexpr uint8_t kAttributePartBase = 0;    // record 1
+inline constexpr uint8_t kAttributePartFinal = 1;   // the last record
+inline constexpr uint8_t kAttributePartValues = 2;  // after geometry records (version 11 on)
+// A values record is closed at about this share of the expected stream
+// (the record-size rule: no record beyond the base above 2 % of it).
+inline constexpr double kValuesRecordShare = 0.015;
 // Wedge key of the wedge the boundary ends; kNone (editable_mesh.h): the
 // vertex's only wedge.
 inline constexpr uint32_t kBoundaryKey = 0xFFFFFFFEu;
@@ -66,6 +77,12 @@ struct AttributeLayout {
       return materials.empty() ? 0 : int32_t(materials.size()) - 1;
     return (int32_t(1) << c.bits) - 1;
   }
+};
+
+// Adaptive models of one channel's residuals: by prediction context
+// (parallelogram, neighbours, none, geometric) and component.
+struct AttributeChannelModels {
+  AdaptiveIntModel residual[4][4];
 };
 
 // Integer values in decoder vertex ids. Vertex v has wedges
@@ -107,21 +124,32 @@ Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>
 // "texcoords", "colors", "materials", "extra", "layout").
 using AttributeParts = std::map<std::string, uint64_t>;
 
+// An attribute record of the rewritten stream: its record number and
+// payload bytes.
+struct AttributeRecordPlace {
+  uint32_t record = 0;
+  uint32_t bytes = 0;
+};
+
 // Rewrites `stream` (a geometry stream of encode_once, whose decoder vertex
-// i is input vertex to_input[i]) with the two attribute records added.
-// Fills `parts` when given. kInternal when the stream disagrees with the plan.
+// i is input vertex to_input[i]) with the attribute records added: record
+// 1, the values records, the last record. Fills `parts` and `places` (in
+// record order) when given. kInternal when the stream disagrees with the plan.
 Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, const Mesh& mesh,
                                                    const std::vector<Vec3i>& q,
                                                    std::span<const uint8_t> stream,
                                                    const std::vector<uint32_t>& to_input,
                                                    AttributeParts* parts,
-                                                   std::vector<uint32_t>* payload_sizes);
+                                                   std::vector<AttributeRecordPlace>* places);
 
-// The parts of a stream's two attribute records' payloads (for `meshstream
-// info`; `final_payload` may be empty when the file is cut short). kParse when
-// they are not well-formed attribute records.
-Result<AttributeParts> attribute_record_parts(std::span<const uint8_t> base_payload,
-                                              std::span<const uint8_t> final_payload);
+// The parts of a stream's attribute records' payloads (for `meshstream
+// info`; `values_payloads` are the values records', `final_payload` may be
+// empty when the file is cut short). kParse when they are not well-formed
+// attribute records.
+Result<AttributeParts> attribute_record_parts(
+    std::span<const uint8_t> base_payload,
+    std::span<const std::span<const uint8_t>> values_payloads,
+    std::span<const uint8_t> final_payload);
 
 // The decoder's side: see the file comment.
 class AttributeDecoder {
@@ -132,6 +160,12 @@ class AttributeDecoder {
   Status read_base(std::span<const uint8_t> payload, const EditableMesh& base);
   // Predicted values for the vertices of `m` beyond those known.
   void preview(const EditableMesh& m);
+  // A values record, on the decoder's mesh now: the exact values of every
+  // vertex inserted since the previous values (or record 1).
+  Status read_values(std::span<const uint8_t> payload, const EditableMesh& m);
+  // Vertices whose exact values have come (the base's and the values
+  // records').
+  uint32_t exact_vertices() const { return exact_vertices_; }
   // The last record, on the complete mesh.
   Status read_final(std::span<const uint8_t> payload, const EditableMesh& full);
   // Writes every attribute array of `out` for `m` (whose vertices all have
@@ -155,6 +189,8 @@ class AttributeDecoder {
   AttributeLayout layout_;
   AttributeValues values_;
   uint32_t base_vertices_ = 0;
+  uint32_t exact_vertices_ = 0;
+  std::vector<AttributeChannelModels> values_models_;  // the values records', persistent
   std::vector<ExtraAttribute> extras_;
 };
 

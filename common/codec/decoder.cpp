@@ -126,14 +126,21 @@ struct IncrementalDecoder::State {
   bool attributes_final = false;          // the final attribute record came
 
   // The base's attributes, before any geometry record (only texture records
-  // may come between it and the base), or the inserted vertices' values,
-  // after every geometry record (only texture records may follow).
+  // may come between it and the base); a values record, after geometry
+  // records, with the exact values of the vertices inserted since the last
+  // one; or the remaining vertices' values, after every geometry record
+  // (only texture records may follow).
   Status apply_attribute_record(std::span<const uint8_t> payload) {
     const StreamHeader& h = index->header;
-    if (payload.size() >= 2 && payload[1] == kAttributePartBase) {
+    const uint8_t part = payload.size() >= 2 ? payload[1] : 0xFF;
+    if (part == kAttributePartBase) {
       if (geometry_records > 0)
         return make_error(ErrorCode::kParse, "base attribute record after a geometry record");
       if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
+    } else if (part == kAttributePartValues) {
+      if (attributes_final)
+        return make_error(ErrorCode::kParse, "attribute values record after the final one");
+      if (auto s = attributes.read_values(payload, refine->mesh); !s) return s;
     } else {
       if (attributes_final) return make_error(ErrorCode::kParse, "a second final attribute record");
       if (refine->mesh.vertex_count() != h.vertex_count ||

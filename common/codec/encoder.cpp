@@ -320,22 +320,20 @@ Result<std::vector<uint8_t>> with_attributes(const AttributePlan& plan, const Me
     to_input[stream.to_decoder[v]] = v;
   }
   AttributeParts parts;
-  std::vector<uint32_t> sizes;
-  auto bytes = add_attribute_records(plan, mesh, q, stream.bytes, to_input, &parts, &sizes);
+  std::vector<AttributeRecordPlace> places;
+  auto bytes = add_attribute_records(plan, mesh, q, stream.bytes, to_input, &parts, &places);
   if (!bytes) return bytes;
   if (report) {
     report->attribute_bytes = parts;
     report->attribute_locked_vertices = plan.locked_count;
-    if (!report->records.empty()) {
-      EncodedRecord first = report->records[0];
-      first.bytes = sizes.size() > 1 ? sizes[1] : 0;
-      first.distortion_drop = 0;
-      report->records.insert(report->records.begin() + 1, first);
-      EncodedRecord last = report->records.back();
-      last.plane = false;
-      last.bytes = sizes.empty() ? 0 : sizes.back();
-      last.distortion_drop = 0;
-      report->records.push_back(last);
+    // Each attribute record shows the mesh of the record before it.
+    for (const AttributeRecordPlace& p : places) {
+      if (p.record == 0 || p.record > report->records.size()) break;
+      EncodedRecord r = report->records[p.record - 1];
+      r.plane = false;
+      r.bytes = p.bytes;
+      r.distortion_drop = 0;
+      report->records.insert(report->records.begin() + p.record, r);
     }
   }
   return bytes;

@@ -17,7 +17,7 @@ inline constexpr uint16_t kContainerVersion = 3;
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct. What each
 // bump changed: docs/hcs-format.md ("Encoder versions").
-inline constexpr uint32_t kEncoderVersion = 10;
+inline constexpr uint32_t kEncoderVersion = 11;
 
 // Which coder made record 0, the base mesh (header `base_coder`,
 // base_coder.h).
@@ -100,8 +100,9 @@ inline constexpr uint32_t kMaxInsertedValence = 16;
 inline constexpr uint8_t kRecordStartsLayer = 1;
 inline constexpr uint8_t kRecordPlane = 2;
 // Records beside the geometry, told apart by this first byte too: the
-// attribute records (attribute_codec.h: record 1 the base's values, the last
-// geometry-bearing record the inserted vertices') and the texture records
+// attribute records (attribute_codec.h: record 1 the base's values, values
+// records after geometry records the inserted vertices', the last record the
+// rest and the extra attributes) and the texture records
 // (texture_record.h: pyramid levels of Mesh::textures).
 inline constexpr uint8_t kRecordAttributes = 4;
 inline constexpr uint8_t kRecordTexture = 8;

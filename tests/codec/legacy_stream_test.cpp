@@ -5,11 +5,18 @@
 //                 written by the encoder just before container 3 (kEncoderVersion 4);
 //   container3_v8_* container 3, format 3, kEncoderVersion 8 (the last to
 //                 write the own base coder, id 1): an icosphere of 642
-//                 vertices, 12 bits, base shift 11, 60 base vertices.
+//                 vertices, 12 bits, base shift 11, 60 base vertices;
+//   container3_v10_* container 3, kEncoderVersion 10 (attributes in two
+//                 records: the base's values after the base, every inserted
+//                 vertex's in the last record): the attribute tests'
+//                 faceted cube (8 x 8 per face: per-corner normals and
+//                 texture coordinates with seams, per-vertex colours, three
+//                 materials, a TANGENT extra attribute, one PNG texture).
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -18,6 +25,7 @@
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
+#include "tests/codec/attribute_test_util.h"
 #include "tests/codec/stream_samples.h"
 
 namespace meshstream {
@@ -106,6 +114,51 @@ TEST(LegacyStreams, VersionTwoChecksumsAndReseal) {
   ASSERT_TRUE(resealed);
   EXPECT_TRUE(record_intact(resealed->records[3],
                             std::span<const uint8_t>(bytes).subspan(victim.offset, victim.size)));
+}
+
+// Every face's corner data (positions, normals, texture coordinates,
+// colours, material, extra attribute bytes; attribute_test_util.h), hashed.
+uint64_t attribute_hash(const Mesh& m) {
+  uint64_t h = 1469598103934665603ull;
+  for (const auto& face : testing::faces_of(m)) {
+    for (const testing::Corner& corner : face) {
+      for (float f : corner) {
+        uint32_t b;
+        std::memcpy(&b, &f, 4);
+        h ^= b;
+        h *= 1099511628211ull;
+      }
+    }
+  }
+  return h;
+}
+
+// A version-10 stream with attributes decodes, record by record and at
+// once, to the mesh (attributes, materials and texture bytes included) it
+// decoded to when written.
+TEST(LegacyStreams, VersionTenAttributesDecodeAsWhenWritten) {
+  const std::vector<uint8_t> bytes = read_sample("container3_v10_faceted_cube_attributes.hcs");
+  auto index = read_stream_index(bytes);
+  ASSERT_TRUE(index) << index.error().message;
+  IncrementalDecoder dec;
+  for (const RecordEntry& r : index->records) {
+    const uint64_t from = r.offset == index->payload_offset ? 0 : r.offset;
+    auto fed = dec.feed(std::span<const uint8_t>(bytes).subspan(from, r.offset + r.size - from));
+    ASSERT_TRUE(fed) << fed.error().message;
+    ASSERT_TRUE(check_attribute_counts(dec.mesh()));
+  }
+  ASSERT_TRUE(dec.finished());
+  constexpr uint64_t kHash = 0x52ce8058599d568full;
+  EXPECT_EQ(attribute_hash(dec.mesh()), kHash)
+      << "hash 0x" << std::hex << attribute_hash(dec.mesh());
+  auto whole = decode_hcs(bytes);
+  ASSERT_TRUE(whole) << whole.error().message;
+  EXPECT_EQ(attribute_hash(*whole), kHash);
+  EXPECT_EQ(whole->materials.size(), 3u);
+  ASSERT_EQ(whole->textures.size(), 1u);
+  EXPECT_EQ(whole->textures[0].mime_type, "image/png");
+  ASSERT_EQ(whole->extra_attributes.size(), 1u);
+  EXPECT_EQ(whole->extra_attributes[0].name, "TANGENT");
 }
 
 }  // namespace
