@@ -349,12 +349,7 @@ uint32_t IncrementalSubdivider::grow_region(const Mesh& input, uint32_t attempt)
 // O(rim x valence).
 void IncrementalSubdivider::close_region_fans(const Mesh& input) {
   const uint32_t gen = generation_;
-  const std::vector<uint32_t>& opposite = table_.opposite();
   auto in_region = [&](uint32_t f) { return region_stamp_[f] == gen; };
-  auto corner_at = [&](uint32_t f, uint32_t v) {
-    const Triangle& t = input.triangles[f];
-    return 3 * f + (t[0] == v ? 0u : t[1] == v ? 1u : 2u);
-  };
   // The region's faces around v form one contiguous run (or all of them).
   auto one_fan = [&](uint32_t v) {
     const std::vector<uint32_t>& around = table_.faces_around(v);
@@ -365,29 +360,8 @@ void IncrementalSubdivider::close_region_fans(const Mesh& input) {
         if (first == kNone) first = f;
       }
     if (inside == 0 || inside == around.size()) return true;
-    const uint32_t start = corner_at(first, v);
-    uint32_t reached = 1, c = start;
-    bool closed = false;
-    for (size_t step = 0; step < around.size(); ++step) {
-      const uint32_t o = opposite[asa::next_corner(c)];
-      if (o == kNone || !in_region(o / 3)) break;
-      c = corner_at(o / 3, v);
-      if (c == start) {
-        closed = true;
-        break;
-      }
-      ++reached;
-    }
-    if (!closed) {
-      c = start;
-      for (size_t step = 0; step < around.size(); ++step) {
-        const uint32_t o = opposite[asa::prev_corner(c)];
-        if (o == kNone || !in_region(o / 3)) break;
-        c = corner_at(o / 3, v);
-        ++reached;
-      }
-    }
-    return reached == inside;
+    return asa::faces_reached_around(input, table_.opposite().data(), v, first, around.size(),
+                                     in_region) == inside;
   };
   std::vector<uint32_t>& work = frontier_;
   while (!work.empty()) {
