@@ -55,8 +55,8 @@ inline uint32_t corner_at(const Mesh& mesh, uint32_t f, uint32_t v) {
 // equals their number: LiveCornerTable checks a vertex's whole fan this
 // way, the incremental subdivider the part of it inside its region.
 template <class Enter>
-size_t faces_reached_around(const Mesh& mesh, const uint32_t* opposite, uint32_t v,
-                            uint32_t first, size_t limit, Enter&& enter) {
+size_t faces_reached_around(const Mesh& mesh, const uint32_t* opposite, uint32_t v, uint32_t first,
+                            size_t limit, Enter&& enter) {
   const uint32_t start = corner_at(mesh, first, v);
   size_t reached = 1;
   uint32_t c = start;
