@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numbers>
+#include <optional>
 
 #include "common/asa/flatness.h"
 #include "common/asa/view.h"
@@ -58,8 +60,92 @@ bool IncrementalSubdivider::rebuild_level0(const Mesh& input) {
   asa::compute_face_normals(view, face_normal_);
   changed_vertex_.assign(input.vertex_count(), 0);
   changed_list_.clear();
+  bent_valid_ = false;
+  if (options_.view.enabled && !options_.uniform) rebuild_bent(input);
   level0_valid_ = true;
   return true;
+}
+
+namespace {
+
+// A corner's feature tag as asa::tag_feature_edges computes it (the same
+// expression, so the same bits).
+uint8_t feature_of(const std::vector<uint32_t>& opposite, const std::vector<Vec3f>& normals,
+                   uint32_t c, bool creases, float cos_limit) {
+  const uint32_t o = opposite[c];
+  if (o == kNone) return 1;
+  return creases && dot(normals[c / 3], normals[o / 3]) < cos_limit;
+}
+
+float crease_cosine(float crease_degrees) {
+  return std::cos(crease_degrees * static_cast<float>(std::numbers::pi) / 180.0f);
+}
+
+}  // namespace
+
+// Bits of face f's corners whose edges are bent, as asa::mark_targets
+// tests them before asking the view.
+uint8_t IncrementalSubdivider::bent_bits(uint32_t f) const {
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  const Vec3f n = face_normal_[f];
+  uint8_t bits = 0;
+  for (uint32_t i = 0; i < 3; ++i) {
+    const uint32_t c = 3 * f + i, o = opposite[c];
+    if (o == kNone || feature_[c]) continue;
+    if (dot(n, face_normal_[o / 3]) <= options_.flatness) bits |= uint8_t(1u << i);
+  }
+  return bits;
+}
+
+void IncrementalSubdivider::set_bent(uint32_t f, uint8_t bits) {
+  bent_mask_[f] = bits;
+  uint32_t& slot = bent_slot_[f];
+  if (bits && slot == kNone) {
+    slot = static_cast<uint32_t>(bent_faces_.size());
+    bent_faces_.push_back(f);
+  } else if (!bits && slot != kNone) {
+    const uint32_t last = bent_faces_.back();
+    bent_faces_[slot] = last;
+    bent_slot_[last] = slot;
+    bent_faces_.pop_back();
+    slot = kNone;
+  }
+}
+
+// From scratch: the feature tags and the bent faces. O(F).
+void IncrementalSubdivider::rebuild_bent(const Mesh& input) {
+  const uint32_t Fn = input.face_count();
+  asa::tag_feature_edges(level0(input), options_.crease_degrees, face_normal_, feature_);
+  bent_mask_.assign(Fn, 0);
+  bent_slot_.assign(Fn, kNone);
+  bent_faces_.clear();
+  for (uint32_t f = 0; f < Fn; ++f) set_bent(f, bent_bits(f));
+  bent_valid_ = true;
+}
+
+// After a record: the faces whose normals were recomputed (every face
+// around a changed vertex, which includes every face whose corners or
+// neighbours changed) get their feature tags again, mirrored to the
+// corners across, and they and their neighbours their bent bits.
+// O(refreshed faces).
+void IncrementalSubdivider::refresh_bent(const Mesh& input) {
+  const uint32_t Fn = input.face_count();
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  const bool creases = options_.crease_degrees > 0;
+  const float cos_limit = crease_cosine(options_.crease_degrees);
+  feature_.resize(3 * static_cast<size_t>(Fn), 0);
+  bent_mask_.resize(Fn, 0);
+  bent_slot_.resize(Fn, kNone);
+  for (uint32_t f : refreshed_faces_)
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
+      feature_[c] = feature_of(opposite, face_normal_, c, creases, cos_limit);
+      if (opposite[c] != kNone) feature_[opposite[c]] = feature_[c];
+    }
+  for (uint32_t f : refreshed_faces_) {
+    set_bent(f, bent_bits(f));
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c)
+      if (opposite[c] != kNone) set_bent(opposite[c] / 3, bent_bits(opposite[c] / 3));
+  }
 }
 
 asa::LevelView IncrementalSubdivider::level0(const Mesh& input) {
@@ -271,10 +357,12 @@ void IncrementalSubdivider::refresh_face_normals(const Mesh& input) {
   face_normal_.resize(Fn);
   face_seen_.resize(Fn, 0);
   next_generation(Fn, input.vertex_count());
+  refreshed_faces_.clear();
   for (uint32_t v : changed_list_) {
     for (uint32_t f : table_.faces_around(v)) {
       if (face_seen_[f] == generation_) continue;
       face_seen_[f] = generation_;
+      refreshed_faces_.push_back(f);
       const Triangle& t = input.triangles[f];
       const Vec3f p0 = input.positions[t[0]], p1 = input.positions[t[1]],
                   p2 = input.positions[t[2]];
@@ -581,6 +669,7 @@ class QuietFaces {
 // number of such faces. Two target passes over the faces (flatness first,
 // the view only for bent edges) and one sphere test per refined face.
 uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
+  if (bent_valid_ && options_.levels == 1) return mark_view_changes_of_bent_faces(input);
   const uint32_t Fn = input.face_count();
   asa::LevelView view = level0(input);
   asa::tag_feature_edges(view, options_.crease_degrees, face_normal_, feature_);
@@ -616,6 +705,35 @@ uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
   return faces;
 }
 
+// 1b with one level: only a face with a bent edge can be a target in
+// either view, so only those are asked, with the same test as
+// asa::mark_targets. O(bent faces).
+uint32_t IncrementalSubdivider::mark_view_changes_of_bent_faces(const Mesh& input) {
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  const asa::ViewTest test_after(options_.view);
+  const std::optional<asa::ViewTest> test_before =
+      previous_view_.enabled ? std::optional<asa::ViewTest>(previous_view_) : std::nullopt;
+  auto target = [&](uint32_t f, const asa::ViewTest* test) {
+    const uint8_t bits = bent_mask_[f];
+    if (test == nullptr) return bits != 0;
+    for (uint32_t i = 0; i < 3; ++i) {
+      if (!(bits & (1u << i))) continue;
+      const uint32_t c = 3 * f + i;
+      const Vec3f a = input.positions[input.triangles[f][(i + 1) % 3]];
+      const Vec3f b = input.positions[input.triangles[f][(i + 2) % 3]];
+      if (test->matters(a, b, face_normal_[f], face_normal_[opposite[c] / 3])) return true;
+    }
+    return false;
+  };
+  uint32_t faces = 0;
+  for (uint32_t f : bent_faces_) {
+    if (target(f, test_before ? &*test_before : nullptr) == target(f, &test_after)) continue;
+    ++faces;
+    for (uint32_t v : input.triangles[f]) mark_vertex(v);
+  }
+  return faces;
+}
+
 Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* changes) {
   stats_ = {};
   const bool view_changed = view_changed_;
@@ -640,6 +758,7 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
   const uint32_t previous_vertices = previous_.vertex_count();
   bring_previous_up_to_date(input);
   refresh_face_normals(input);
+  if (bent_valid_) refresh_bent(input);
   if (view_changed && options_.view.enabled && !options_.uniform)
     stats_.view_faces = mark_view_changes(input);
   stats_.changed_vertices = static_cast<uint32_t>(changed_list_.size());
