@@ -99,17 +99,39 @@ uint8_t IncrementalSubdivider::bent_bits(uint32_t f) const {
 
 void IncrementalSubdivider::set_bent(uint32_t f, uint8_t bits) {
   bent_mask_[f] = bits;
-  uint32_t& slot = bent_slot_[f];
-  if (bits && slot == kNone) {
-    slot = static_cast<uint32_t>(bent_faces_.size());
-    bent_faces_.push_back(f);
-  } else if (!bits && slot != kNone) {
-    const uint32_t last = bent_faces_.back();
-    bent_faces_[slot] = last;
-    bent_slot_[last] = slot;
-    bent_faces_.pop_back();
-    slot = kNone;
+  const uint32_t block = f / kBentBlock;
+  if (block >= bent_blocks_.size()) bent_blocks_.resize(block + 1);
+  if (!bent_blocks_[block].stale) {
+    bent_blocks_[block].stale = true;
+    stale_blocks_.push_back(block);
   }
+}
+
+void IncrementalSubdivider::refresh_bent_block(const Mesh& input, uint32_t block) {
+  BentBlock& b = bent_blocks_[block];
+  b = {};
+  b.stale = false;
+  const uint32_t first = block * kBentBlock;
+  const uint32_t end = std::min<uint32_t>(first + kBentBlock, input.face_count());
+  Vec3f lo{}, hi{};
+  for (uint32_t f = first; f < end; ++f) {
+    if (!bent_mask_[f]) continue;
+    if (b.bent_faces == 0) lo = hi = input.positions[input.triangles[f][0]];
+    for (uint32_t v : input.triangles[f]) {
+      const Vec3f p = input.positions[v];
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    for (uint32_t i = 0; i < 3; ++i)
+      if (bent_mask_[f] & (1u << i))
+        b.longest = std::max(b.longest, length(input.positions[input.triangles[f][(i + 2) % 3]] -
+                                               input.positions[input.triangles[f][(i + 1) % 3]]));
+    ++b.bent_faces;
+  }
+  if (b.bent_faces == 0) return;
+  b.centre = (lo + hi) * 0.5f;
+  // Half the box's diagonal, a little over: every edge midpoint is inside the box.
+  b.radius = 1.0001f * length(hi - lo) * 0.5f + 1e-6f * length(b.centre);
 }
 
 // From scratch: the feature tags and the bent faces. O(F).
@@ -117,9 +139,10 @@ void IncrementalSubdivider::rebuild_bent(const Mesh& input) {
   const uint32_t Fn = input.face_count();
   asa::tag_feature_edges(level0(input), options_.crease_degrees, face_normal_, feature_);
   bent_mask_.assign(Fn, 0);
-  bent_slot_.assign(Fn, kNone);
-  bent_faces_.clear();
-  for (uint32_t f = 0; f < Fn; ++f) set_bent(f, bent_bits(f));
+  bent_blocks_.assign((Fn + kBentBlock - 1) / kBentBlock, BentBlock{});
+  stale_blocks_.clear();
+  for (uint32_t f = 0; f < Fn; ++f) bent_mask_[f] = bent_bits(f);
+  for (uint32_t b = 0; b < bent_blocks_.size(); ++b) refresh_bent_block(input, b);
   bent_valid_ = true;
 }
 
@@ -135,7 +158,6 @@ void IncrementalSubdivider::refresh_bent(const Mesh& input) {
   const float cos_limit = crease_cosine(options_.crease_degrees);
   feature_.resize(3 * static_cast<size_t>(Fn), 0);
   bent_mask_.resize(Fn, 0);
-  bent_slot_.resize(Fn, kNone);
   for (uint32_t f : refreshed_faces_)
     for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
       feature_[c] = feature_of(opposite, face_normal_, c, creases, cos_limit);
@@ -725,11 +747,24 @@ uint32_t IncrementalSubdivider::mark_view_changes_of_bent_faces(const Mesh& inpu
     }
     return false;
   };
+  for (uint32_t b : stale_blocks_) refresh_bent_block(input, b);
+  stale_blocks_.clear();
+  const uint32_t Fn = input.face_count();
   uint32_t faces = 0;
-  for (uint32_t f : bent_faces_) {
-    if (target(f, test_before ? &*test_before : nullptr) == target(f, &test_after)) continue;
-    ++faces;
-    for (uint32_t v : input.triangles[f]) mark_vertex(v);
+  for (uint32_t b = 0; b < bent_blocks_.size(); ++b) {
+    const BentBlock& block = bent_blocks_[b];
+    if (block.bent_faces == 0) continue;
+    // No edge of the block matters in either view: no target flips.
+    if (test_before && !test_before->may_matter(block.centre, block.radius, block.longest) &&
+        !test_after.may_matter(block.centre, block.radius, block.longest))
+      continue;
+    const uint32_t end = std::min<uint32_t>((b + 1) * kBentBlock, Fn);
+    for (uint32_t f = b * kBentBlock; f < end; ++f) {
+      if (!bent_mask_[f]) continue;
+      if (target(f, test_before ? &*test_before : nullptr) == target(f, &test_after)) continue;
+      ++faces;
+      for (uint32_t v : input.triangles[f]) mark_vertex(v);
+    }
   }
   return faces;
 }
