@@ -227,6 +227,7 @@ OrbitStats orbit(const Mesh& mesh, int width, int height, int steps) {
   auto shared = std::make_shared<const Mesh>(mesh);
   DisplayBuilder builder;
   builder.set_max_faces(4'000'000);
+  builder.set_changes_exact(true);  // as the pipeline: no change is no change
   OrbitStats out;
   BuildReport report;
   MeshChanges none;

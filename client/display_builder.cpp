@@ -1,6 +1,7 @@
 #include "client/display_builder.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 
 #include "common/asa/corner_attributes.h"
@@ -34,6 +35,12 @@ struct DisplayBuilder::State {
   float dirty_fraction = 0.25f;
   double full_ms_per_face = 0;  // measured on the last full run
   std::vector<uint8_t> seen;    // scratch: changed faces counted once
+  // The incremental path's display meshes: copies of its result, handed to
+  // frames. One no frame holds any more is copied into again, so the copy
+  // reuses its memory (a fresh 100 MB mesh costs more in page faults than
+  // in copying).
+  std::vector<std::shared_ptr<Mesh>> display_pool;
+  std::vector<std::shared_ptr<std::vector<FaceKind>>> kind_pool;
 };
 
 DisplayBuilder::DisplayBuilder() : state_(std::make_unique<State>()) {}
@@ -50,6 +57,22 @@ std::shared_ptr<const Mesh> with_surface(Mesh display, const Mesh& decoded) {
   display.materials = decoded.materials;
   display.textures = decoded.textures;
   return std::make_shared<const Mesh>(std::move(display));
+}
+
+// An entry of `pool` no one else holds (a new one when all are held; the
+// pool keeps at most three).
+template <class T>
+std::shared_ptr<T> free_entry(std::vector<std::shared_ptr<T>>& pool) {
+  for (auto& entry : pool) {
+    if (entry.use_count() != 1) continue;
+    // The last holder's release (a frame on another thread) comes before
+    // our writes (as in frame_mesh_pool.cpp).
+    std::atomic_thread_fence(std::memory_order_acquire);
+    return entry;
+  }
+  auto entry = std::make_shared<T>();
+  if (pool.size() < 3) pool.push_back(entry);
+  return entry;
 }
 
 }  // namespace
@@ -175,8 +198,12 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   const IncrementalStats& stats = s.incremental->last_update();
   const AsaResult& result = s.incremental->result();
   if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();
-  auto display = with_surface(result.mesh, mesh);
-  auto kinds = std::make_shared<const std::vector<FaceKind>>(result.face_kind);
+  std::shared_ptr<Mesh> display = free_entry(s.display_pool);
+  *display = result.mesh;  // into the memory it had: no page faults
+  display->materials = mesh.materials;
+  display->textures = mesh.textures;
+  std::shared_ptr<std::vector<FaceKind>> kinds = free_entry(s.kind_pool);
+  *kinds = result.face_kind;
   report.asa_ms = ms_since(start);
   report.incremental = !stats.full;
   report.region_faces = stats.region_faces;

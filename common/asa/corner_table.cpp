@@ -353,35 +353,9 @@ Status LiveCornerTable::link_corner(const Mesh& mesh, uint32_t c) {
 Status LiveCornerTable::check_fan(const Mesh& mesh, uint32_t v) const {
   const std::vector<uint32_t>& around = vertex_faces_[v];
   if (around.size() <= 1) return {};
-  auto corner_at = [&](uint32_t f) {
-    const Triangle& t = mesh.triangles[f];
-    return 3 * f + (t[0] == v ? 0u : t[1] == v ? 1u : 2u);
-  };
-  const uint32_t start = corner_at(around.front());
   const size_t n = around.size();
-  size_t reached = 1;
-  // Forward: across the edge (v, vertex(prev)) faced by next(corner).
-  uint32_t c = start;
-  bool closed = false;
-  for (size_t step = 0; step < n; ++step) {
-    const uint32_t o = opposite_[next_corner(c)];
-    if (o == kNone) break;
-    c = corner_at(o / 3);
-    if (c == start) {
-      closed = true;
-      break;
-    }
-    ++reached;
-  }
-  if (!closed) {
-    c = start;
-    for (size_t step = 0; step < n; ++step) {
-      const uint32_t o = opposite_[prev_corner(c)];
-      if (o == kNone) break;
-      c = corner_at(o / 3);
-      ++reached;
-    }
-  }
+  const size_t reached = faces_reached_around(mesh, opposite_.data(), v, around.front(), n,
+                                              [](uint32_t) { return true; });
   if (reached != n) {
     return make_error(ErrorCode::kNonManifold, "vertex " + std::to_string(v) +
                                                    " joins more than one fan of faces "

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/asa/level_mesh.h"
 #include "common/base/result.h"
 #include "common/mesh/mesh.h"
 
@@ -39,6 +40,42 @@ Status build_opposites(const Mesh& mesh, std::vector<uint32_t>& opposite,
 // After a successful build_opposites: the number of faces around each vertex
 // (the valence of an interior vertex), read from the buckets. O(V).
 void faces_per_vertex(const CornerTableScratch& scratch, std::vector<uint32_t>& faces);
+
+// The corner of face f at vertex v (v must be one of f's corners).
+inline uint32_t corner_at(const Mesh& mesh, uint32_t f, uint32_t v) {
+  const Triangle& t = mesh.triangles[f];
+  return 3 * f + (t[0] == v ? 0u : t[1] == v ? 1u : 2u);
+}
+
+// How many faces of v's fan a walk from face `first` reaches across v's
+// edges, entering only faces `enter(f)` accepts: forward (across the edge
+// faced by next(corner)), then, unless that closed the loop, backward from
+// `first`. At most `limit` steps each way (v's face count bounds a fan).
+// The faces around v are one fan of accepted faces exactly when the count
+// equals their number: LiveCornerTable checks a vertex's whole fan this
+// way, the incremental subdivider the part of it inside its region.
+template <class Enter>
+size_t faces_reached_around(const Mesh& mesh, const uint32_t* opposite, uint32_t v, uint32_t first,
+                            size_t limit, Enter&& enter) {
+  const uint32_t start = corner_at(mesh, first, v);
+  size_t reached = 1;
+  uint32_t c = start;
+  for (size_t step = 0; step < limit; ++step) {
+    const uint32_t o = opposite[next_corner(c)];
+    if (o == kNone || !enter(o / 3)) break;
+    c = corner_at(mesh, o / 3, v);
+    if (c == start) return reached;  // closed: the forward walk saw the whole loop
+    ++reached;
+  }
+  c = start;
+  for (size_t step = 0; step < limit; ++step) {
+    const uint32_t o = opposite[prev_corner(c)];
+    if (o == kNone || !enter(o / 3)) break;
+    c = corner_at(mesh, o / 3, v);
+    ++reached;
+  }
+  return reached;
+}
 
 // The level-0 adjacency of a mesh that changes a record at a time (the
 // client's decoded mesh): opposite corners and the faces around every

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numbers>
+#include <optional>
 
 #include "common/asa/flatness.h"
 #include "common/asa/view.h"
@@ -58,8 +60,114 @@ bool IncrementalSubdivider::rebuild_level0(const Mesh& input) {
   asa::compute_face_normals(view, face_normal_);
   changed_vertex_.assign(input.vertex_count(), 0);
   changed_list_.clear();
+  bent_valid_ = false;
+  if (options_.view.enabled && !options_.uniform) rebuild_bent(input);
   level0_valid_ = true;
   return true;
+}
+
+namespace {
+
+// A corner's feature tag as asa::tag_feature_edges computes it (the same
+// expression, so the same bits).
+uint8_t feature_of(const std::vector<uint32_t>& opposite, const std::vector<Vec3f>& normals,
+                   uint32_t c, bool creases, float cos_limit) {
+  const uint32_t o = opposite[c];
+  if (o == kNone) return 1;
+  return creases && dot(normals[c / 3], normals[o / 3]) < cos_limit;
+}
+
+float crease_cosine(float crease_degrees) {
+  return std::cos(crease_degrees * static_cast<float>(std::numbers::pi) / 180.0f);
+}
+
+}  // namespace
+
+// Bits of face f's corners whose edges are bent, as asa::mark_targets
+// tests them before asking the view.
+uint8_t IncrementalSubdivider::bent_bits(uint32_t f) const {
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  const Vec3f n = face_normal_[f];
+  uint8_t bits = 0;
+  for (uint32_t i = 0; i < 3; ++i) {
+    const uint32_t c = 3 * f + i, o = opposite[c];
+    if (o == kNone || feature_[c]) continue;
+    if (dot(n, face_normal_[o / 3]) <= options_.flatness) bits |= uint8_t(1u << i);
+  }
+  return bits;
+}
+
+void IncrementalSubdivider::set_bent(uint32_t f, uint8_t bits) {
+  bent_mask_[f] = bits;
+  const uint32_t block = f / kBentBlock;
+  if (block >= bent_blocks_.size()) bent_blocks_.resize(block + 1);
+  if (!bent_blocks_[block].stale) {
+    bent_blocks_[block].stale = true;
+    stale_blocks_.push_back(block);
+  }
+}
+
+void IncrementalSubdivider::refresh_bent_block(const Mesh& input, uint32_t block) {
+  BentBlock& b = bent_blocks_[block];
+  b = {};
+  b.stale = false;
+  const uint32_t first = block * kBentBlock;
+  const uint32_t end = std::min<uint32_t>(first + kBentBlock, input.face_count());
+  Vec3f lo{}, hi{};
+  for (uint32_t f = first; f < end; ++f) {
+    if (!bent_mask_[f]) continue;
+    if (b.bent_faces == 0) lo = hi = input.positions[input.triangles[f][0]];
+    for (uint32_t v : input.triangles[f]) {
+      const Vec3f p = input.positions[v];
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    for (uint32_t i = 0; i < 3; ++i)
+      if (bent_mask_[f] & (1u << i))
+        b.longest = std::max(b.longest, length(input.positions[input.triangles[f][(i + 2) % 3]] -
+                                               input.positions[input.triangles[f][(i + 1) % 3]]));
+    ++b.bent_faces;
+  }
+  if (b.bent_faces == 0) return;
+  b.centre = (lo + hi) * 0.5f;
+  // Half the box's diagonal, a little over: every edge midpoint is inside the box.
+  b.radius = 1.0001f * length(hi - lo) * 0.5f + 1e-6f * length(b.centre);
+}
+
+// From scratch: the feature tags and the bent faces. O(F).
+void IncrementalSubdivider::rebuild_bent(const Mesh& input) {
+  const uint32_t Fn = input.face_count();
+  asa::tag_feature_edges(level0(input), options_.crease_degrees, face_normal_, feature_);
+  bent_mask_.assign(Fn, 0);
+  bent_blocks_.assign((Fn + kBentBlock - 1) / kBentBlock, BentBlock{});
+  stale_blocks_.clear();
+  for (uint32_t f = 0; f < Fn; ++f) bent_mask_[f] = bent_bits(f);
+  for (uint32_t b = 0; b < bent_blocks_.size(); ++b) refresh_bent_block(input, b);
+  bent_valid_ = true;
+}
+
+// After a record: the faces whose normals were recomputed (every face
+// around a changed vertex, which includes every face whose corners or
+// neighbours changed) get their feature tags again, mirrored to the
+// corners across, and they and their neighbours their bent bits.
+// O(refreshed faces).
+void IncrementalSubdivider::refresh_bent(const Mesh& input) {
+  const uint32_t Fn = input.face_count();
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  const bool creases = options_.crease_degrees > 0;
+  const float cos_limit = crease_cosine(options_.crease_degrees);
+  feature_.resize(3 * static_cast<size_t>(Fn), 0);
+  bent_mask_.resize(Fn, 0);
+  for (uint32_t f : refreshed_faces_)
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c) {
+      feature_[c] = feature_of(opposite, face_normal_, c, creases, cos_limit);
+      if (opposite[c] != kNone) feature_[opposite[c]] = feature_[c];
+    }
+  for (uint32_t f : refreshed_faces_) {
+    set_bent(f, bent_bits(f));
+    for (uint32_t c = 3 * f; c < 3 * f + 3; ++c)
+      if (opposite[c] != kNone) set_bent(opposite[c] / 3, bent_bits(opposite[c] / 3));
+  }
 }
 
 asa::LevelView IncrementalSubdivider::level0(const Mesh& input) {
@@ -271,10 +379,12 @@ void IncrementalSubdivider::refresh_face_normals(const Mesh& input) {
   face_normal_.resize(Fn);
   face_seen_.resize(Fn, 0);
   next_generation(Fn, input.vertex_count());
+  refreshed_faces_.clear();
   for (uint32_t v : changed_list_) {
     for (uint32_t f : table_.faces_around(v)) {
       if (face_seen_[f] == generation_) continue;
       face_seen_[f] = generation_;
+      refreshed_faces_.push_back(f);
       const Triangle& t = input.triangles[f];
       const Vec3f p0 = input.positions[t[0]], p1 = input.positions[t[1]],
                   p2 = input.positions[t[2]];
@@ -349,12 +459,7 @@ uint32_t IncrementalSubdivider::grow_region(const Mesh& input, uint32_t attempt)
 // O(rim x valence).
 void IncrementalSubdivider::close_region_fans(const Mesh& input) {
   const uint32_t gen = generation_;
-  const std::vector<uint32_t>& opposite = table_.opposite();
   auto in_region = [&](uint32_t f) { return region_stamp_[f] == gen; };
-  auto corner_at = [&](uint32_t f, uint32_t v) {
-    const Triangle& t = input.triangles[f];
-    return 3 * f + (t[0] == v ? 0u : t[1] == v ? 1u : 2u);
-  };
   // The region's faces around v form one contiguous run (or all of them).
   auto one_fan = [&](uint32_t v) {
     const std::vector<uint32_t>& around = table_.faces_around(v);
@@ -365,29 +470,8 @@ void IncrementalSubdivider::close_region_fans(const Mesh& input) {
         if (first == kNone) first = f;
       }
     if (inside == 0 || inside == around.size()) return true;
-    const uint32_t start = corner_at(first, v);
-    uint32_t reached = 1, c = start;
-    bool closed = false;
-    for (size_t step = 0; step < around.size(); ++step) {
-      const uint32_t o = opposite[asa::next_corner(c)];
-      if (o == kNone || !in_region(o / 3)) break;
-      c = corner_at(o / 3, v);
-      if (c == start) {
-        closed = true;
-        break;
-      }
-      ++reached;
-    }
-    if (!closed) {
-      c = start;
-      for (size_t step = 0; step < around.size(); ++step) {
-        const uint32_t o = opposite[asa::prev_corner(c)];
-        if (o == kNone || !in_region(o / 3)) break;
-        c = corner_at(o / 3, v);
-        ++reached;
-      }
-    }
-    return reached == inside;
+    return asa::faces_reached_around(input, table_.opposite().data(), v, first, around.size(),
+                                     in_region) == inside;
   };
   std::vector<uint32_t>& work = frontier_;
   while (!work.empty()) {
@@ -607,6 +691,7 @@ class QuietFaces {
 // number of such faces. Two target passes over the faces (flatness first,
 // the view only for bent edges) and one sphere test per refined face.
 uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
+  if (bent_valid_ && options_.levels == 1) return mark_view_changes_of_bent_faces(input);
   const uint32_t Fn = input.face_count();
   asa::LevelView view = level0(input);
   asa::tag_feature_edges(view, options_.crease_degrees, face_normal_, feature_);
@@ -642,6 +727,48 @@ uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
   return faces;
 }
 
+// 1b with one level: only a face with a bent edge can be a target in
+// either view, so only those are asked, with the same test as
+// asa::mark_targets. O(bent faces).
+uint32_t IncrementalSubdivider::mark_view_changes_of_bent_faces(const Mesh& input) {
+  const std::vector<uint32_t>& opposite = table_.opposite();
+  const asa::ViewTest test_after(options_.view);
+  const std::optional<asa::ViewTest> test_before =
+      previous_view_.enabled ? std::optional<asa::ViewTest>(previous_view_) : std::nullopt;
+  auto target = [&](uint32_t f, const asa::ViewTest* test) {
+    const uint8_t bits = bent_mask_[f];
+    if (test == nullptr) return bits != 0;
+    for (uint32_t i = 0; i < 3; ++i) {
+      if (!(bits & (1u << i))) continue;
+      const uint32_t c = 3 * f + i;
+      const Vec3f a = input.positions[input.triangles[f][(i + 1) % 3]];
+      const Vec3f b = input.positions[input.triangles[f][(i + 2) % 3]];
+      if (test->matters(a, b, face_normal_[f], face_normal_[opposite[c] / 3])) return true;
+    }
+    return false;
+  };
+  for (uint32_t b : stale_blocks_) refresh_bent_block(input, b);
+  stale_blocks_.clear();
+  const uint32_t Fn = input.face_count();
+  uint32_t faces = 0;
+  for (uint32_t b = 0; b < bent_blocks_.size(); ++b) {
+    const BentBlock& block = bent_blocks_[b];
+    if (block.bent_faces == 0) continue;
+    // No edge of the block matters in either view: no target flips.
+    if (test_before && !test_before->may_matter(block.centre, block.radius, block.longest) &&
+        !test_after.may_matter(block.centre, block.radius, block.longest))
+      continue;
+    const uint32_t end = std::min<uint32_t>((b + 1) * kBentBlock, Fn);
+    for (uint32_t f = b * kBentBlock; f < end; ++f) {
+      if (!bent_mask_[f]) continue;
+      if (target(f, test_before ? &*test_before : nullptr) == target(f, &test_after)) continue;
+      ++faces;
+      for (uint32_t v : input.triangles[f]) mark_vertex(v);
+    }
+  }
+  return faces;
+}
+
 Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* changes) {
   stats_ = {};
   const bool view_changed = view_changed_;
@@ -666,6 +793,7 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
   const uint32_t previous_vertices = previous_.vertex_count();
   bring_previous_up_to_date(input);
   refresh_face_normals(input);
+  if (bent_valid_) refresh_bent(input);
   if (view_changed && options_.view.enabled && !options_.uniform)
     stats_.view_faces = mark_view_changes(input);
   stats_.changed_vertices = static_cast<uint32_t>(changed_list_.size());

@@ -107,6 +107,12 @@ class IncrementalSubdivider {
   bool rebuild_level0(const Mesh& input);
   asa::LevelView level0(const Mesh& input);
   uint32_t mark_view_changes(const Mesh& input);
+  uint32_t mark_view_changes_of_bent_faces(const Mesh& input);
+  void rebuild_bent(const Mesh& input);
+  void refresh_bent(const Mesh& input);
+  uint8_t bent_bits(uint32_t f) const;
+  void set_bent(uint32_t f, uint8_t bits);
+  void refresh_bent_block(const Mesh& input, uint32_t block);
   void next_generation(uint32_t faces, uint32_t vertices);
   bool is_dirty(uint32_t f) const { return dirty_stamp_[f] == generation_; }
   uint32_t grow_region(const Mesh& input, uint32_t attempt);
@@ -130,6 +136,27 @@ class IncrementalSubdivider {
   asa::LiveCornerTable table_;
   std::vector<Vec3f> face_normal_;
   std::vector<uint8_t> feature_, target_before_, target_after_;
+  // With a camera: the part of the level-0 targets no camera changes, kept
+  // up to date with the records: per face a bit per corner whose edge is
+  // bent (interior, not a feature, N1.N2 <= t), so that a camera move asks
+  // the view only about bent edges. feature_ is kept up to date alongside.
+  bool bent_valid_ = false;
+  std::vector<uint8_t> bent_mask_;
+  // The bent edges by blocks of kBentBlock consecutive faces: a sphere
+  // holding their midpoints and their longest length, so that a camera
+  // move skips a block whose edges no view can ask for (ViewTest::
+  // may_matter) without looking at its faces. A block is recomputed when
+  // one of its faces' bits are set again (stale).
+  static constexpr uint32_t kBentBlock = 64;
+  struct BentBlock {
+    uint32_t bent_faces = 0;
+    Vec3f centre{};
+    float radius = 0, longest = 0;
+    bool stale = false;  // listed in stale_blocks_
+  };
+  std::vector<BentBlock> bent_blocks_;
+  std::vector<uint32_t> stale_blocks_;
+  std::vector<uint32_t> refreshed_faces_;  // faces whose normals this update recomputed
   // What changed this update: vertex marks (all zero between updates) and
   // their list; changed faces with their previous corners.
   std::vector<uint8_t> changed_vertex_;

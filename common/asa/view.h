@@ -82,6 +82,29 @@ class ViewTest {
 
   // The edge a-b, between faces with unit normals n1 and n2 (n2 = n1 on a
   // boundary), is worth splitting on screen.
+  // False only when no edge of length at most `longest` whose midpoint
+  // lies within `radius` of `centre` can matter (size or frustum; facing
+  // is left to the edges): matters() would say false for every one of
+  // them. Conservative by a margin above the tests' rounding, so a group
+  // of edges (incremental.h's blocks) can be skipped at once.
+  bool may_matter(Vec3f centre, float radius, float longest) const {
+    const float h = 0.5f * longest;
+    const Vec3f rel = centre - eye_;
+    const float dist = length(rel);
+    const float eps = 1e-5f * (dist + radius + h);  // far above float rounding of the terms
+    const float reach = radius + h + eps;
+    const float near = dist - reach;
+    if (!(near > 0)) return true;
+    if (longest * focal_px_ * 1.0001f <= tolerance_ * near) return false;
+    const float z = dot(rel, forward_), x = dot(rel, right_), y = dot(rel, up_);
+    if (z + reach < 0) return false;
+    // The side distances are 1-Lipschitz: no midpoint is nearer by more
+    // than the radius.
+    if ((std::fabs(x) - z * tan_x_) * inv_x_ > reach) return false;
+    if ((std::fabs(y) - z * tan_y_) * inv_y_ > reach) return false;
+    return true;
+  }
+
   bool matters(Vec3f a, Vec3f b, Vec3f n1, Vec3f n2) const {
     const Vec3f c{(a.x + b.x) * 0.5f, (a.y + b.y) * 0.5f, (a.z + b.z) * 0.5f};
     const float r = 0.5f * length(b - a);
