@@ -1,14 +1,13 @@
 #include "common/codec/asa_guidance.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <thread>
 
 #include "common/asa/settings_check.h"
+#include "common/base/parallel_blocks.h"
 #include "common/codec/byte_io.h"
 #include "common/codec/crc32.h"
 #include "common/codec/decoder.h"
@@ -169,26 +168,6 @@ Result<std::optional<AsaGuidance>> read_asa_guidance(const StreamHeader& header,
 
 namespace {
 
-// Runs body(b) for b in [0, blocks) on `threads` threads (0 = one per core).
-// Each block writes only its own slot, so results do not depend on the count.
-template <class Body>
-void for_blocks(size_t blocks, unsigned threads, const Body& body) {
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<size_t>(threads, blocks));
-  if (threads <= 1) {
-    for (size_t b = 0; b < blocks; ++b) body(b);
-    return;
-  }
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t b = next++; b < blocks; b = next++) body(b);
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-}
-
 constexpr size_t kBlock = 4096;
 
 // A well-spread subset of a prefix's faces, about one in `stride`: a
@@ -235,7 +214,7 @@ class GuidanceMeasure {
     bvh_ = TriangleBvh::build(original);
     diagonal_ = bounding_box(original).diagonal();
     normals_.resize(points_.size());
-    for_blocks((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
+    for_each_block((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
       for (size_t i = b * kBlock; i < std::min(points_.size(), (b + 1) * kBlock); ++i)
         normals_[i] = face_normal(original, bvh_.closest(points_[i]).triangle);
     });
@@ -266,7 +245,7 @@ class GuidanceMeasure {
     const Mesh region = region_of(prefix, p, nullptr);
     const TriangleBvh bvh = TriangleBvh::build(region);
     std::vector<uint8_t> on_probe(points_.size(), 0);
-    for_blocks((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
+    for_each_block((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
       uint32_t hint = TriangleBvh::kNoHint;
       for (size_t i = b * kBlock; i < std::min(points_.size(), (b + 1) * kBlock); ++i) {
         const ClosestHit hit = bvh.closest(points_[i], hint);
@@ -302,7 +281,7 @@ class GuidanceMeasure {
     const std::vector<uint32_t>& kept = probes.kept;
     const size_t blocks = (kept.size() + kBlock - 1) / kBlock;
     std::vector<double> squared(blocks, 0.0), normal(blocks, 0.0);
-    for_blocks(blocks, threads_, [&](size_t b) {
+    for_each_block(blocks, threads_, [&](size_t b) {
       uint32_t hint = TriangleBvh::kNoHint;
       for (size_t j = b * kBlock; j < std::min(kept.size(), (b + 1) * kBlock); ++j) {
         const uint32_t i = kept[j];

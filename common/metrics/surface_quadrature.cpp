@@ -1,10 +1,10 @@
 #include "common/metrics/surface_quadrature.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <thread>
 #include <vector>
+
+#include "common/base/parallel_blocks.h"
 
 namespace meshstream {
 
@@ -72,20 +72,7 @@ double weighted_rms_distance(const WeightedSamples& from, const TriangleBvh& to,
       weights[b] += from.weights[i];
     }
   };
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  threads = static_cast<unsigned>(std::min<size_t>(threads, blocks));
-  if (threads <= 1) {
-    for (size_t b = 0; b < blocks; ++b) run_block(b);
-  } else {
-    std::atomic<size_t> next{0};
-    auto worker = [&] {
-      for (size_t b = next++; b < blocks; b = next++) run_block(b);
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
-  }
+  for_each_block(blocks, threads, run_block);
   double sum = 0, weight = 0;
   for (size_t b = 0; b < blocks; ++b) {
     sum += sums[b];
