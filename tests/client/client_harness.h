@@ -136,14 +136,19 @@ inline int run(const std::vector<std::string>& argv, const std::string& out,
 // written by the offline tool to DIR/demo.ply and encoded by it to
 // DIR/models/demo.hcs, the peer the client is checked against. Empty when
 // both commands succeeded, else what failed and its stderr.
-inline std::string make_demo_model(const std::string& dir) {
+// Suites that do not test the encoder's ASA guidance pass
+// with_asa_guidance = false: measuring it makes the encode about four times
+// slower, and SetUpTestSuite runs once per test process.
+inline std::string make_demo_model(const std::string& dir, bool with_asa_guidance = true) {
   std::filesystem::create_directories(dir + "/models");
   if (run({tool_bin(), "generate", "demo", "--size", "20000", "-o", dir + "/demo.ply"},
           dir + "/gen.out", dir + "/gen.err") != 0) {
     return "generate: " + read_text(dir + "/gen.err");
   }
-  if (run({tool_bin(), "encode", dir + "/demo.ply", "-o", dir + "/models/demo.hcs"},
-          dir + "/enc.out", dir + "/enc.err") != 0) {
+  std::vector<std::string> encode{tool_bin(), "encode", dir + "/demo.ply", "-o",
+                                  dir + "/models/demo.hcs"};
+  if (!with_asa_guidance) encode.push_back("--no-asa-guidance");
+  if (run(encode, dir + "/enc.out", dir + "/enc.err") != 0) {
     return "encode: " + read_text(dir + "/enc.err");
   }
   return "";

@@ -22,7 +22,9 @@ class ClientStreamTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TempDir();
-    ASSERT_EQ(make_demo_model(dir_->path()), "");  // the peer the client is checked against
+    // The peer the client is checked against. Every test here names its ASA
+    // settings (or --no-asa), so the stream needs no guidance.
+    ASSERT_EQ(make_demo_model(dir_->path(), /*with_asa_guidance=*/false), "");
     server_ = new Server();
     ASSERT_TRUE(
         server_->start({"--models", *dir_ / "models", "--cache", *dir_ / "cache"}, dir_->path()))
@@ -377,7 +379,9 @@ TEST_F(ClientStreamTest, RealMeshFinalMeshesEqualOfflineDecodeAndSubdivide) {
   if (!fs::exists(input)) GTEST_SKIP() << input << " not found";
   TempDir models, out;
   const std::string hcs = models / "bunny.hcs";
-  ASSERT_EQ(run({tool_bin(), "encode", input, "-o", hcs}, out / "enc.out", out / "enc.err"), 0)
+  ASSERT_EQ(run({tool_bin(), "encode", input, "-o", hcs, "--no-asa-guidance"}, out / "enc.out",
+                out / "enc.err"),
+            0)
       << read_text(out / "enc.err");
   Server server;
   ASSERT_TRUE(server.start({"--models", models.path(), "--cache", out / "cache"}, out.path()))

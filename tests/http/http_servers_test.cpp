@@ -27,7 +27,8 @@ class HttpServersTest : public ::testing::Test {
     dir_ = new TempDir();
     fs::create_directories(*dir_ / "www/models");
     fs::create_directories(*dir_ / "ref");
-    ASSERT_EQ(make_demo_model(dir_->path()), "");
+    // Every test here streams with --no-asa: no ASA guidance needed.
+    ASSERT_EQ(make_demo_model(dir_->path(), /*with_asa_guidance=*/false), "");
     fs::copy_file(*dir_ / "models/demo.hcs", *dir_ / "www/models/demo.hcs");
     models_ = new std::vector<std::string>{"demo"};
     // A second procedural model, and real meshes when they are here.
@@ -54,7 +55,8 @@ class HttpServersTest : public ::testing::Test {
     delete dir_;
   }
   static void encode(const std::string& mesh, const std::string& name) {
-    ASSERT_EQ(run({tool_bin(), "encode", mesh, "-o", hcs(name)}, *dir_ / "e.out", *dir_ / "e.err"),
+    ASSERT_EQ(run({tool_bin(), "encode", mesh, "-o", hcs(name), "--no-asa-guidance"},
+                  *dir_ / "e.out", *dir_ / "e.err"),
               0)
         << read_text(*dir_ / "e.err");
     models_->push_back(name);

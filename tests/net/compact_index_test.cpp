@@ -61,6 +61,7 @@ class CompactIndexTest : public ::testing::Test {
     fs::create_directories(m.dir + "/models");
     EncodeOptions options;
     options.plane_calibration = 1.0;  // one encode: the test needs a stream, not the best one
+    options.asa_guidance = false;
     auto encoded = encode_hcs(make_demo_mesh(20000), options);
     ASSERT_TRUE(encoded) << encoded.error().message;
     m.demo = std::move(*encoded);

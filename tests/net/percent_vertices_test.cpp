@@ -114,6 +114,7 @@ class PercentVerticesServerTest : public ::testing::Test {
     fs::create_directories(*dir_ + "/models");
     EncodeOptions options;
     options.plane_calibration = 1.0;  // one encode: the test needs a stream, not the best one
+    options.asa_guidance = false;
     auto encoded = encode_hcs(make_demo_mesh(20000), options);
     ASSERT_TRUE(encoded) << encoded.error().message;
     stream_ = new std::vector<uint8_t>(std::move(*encoded));

@@ -18,7 +18,7 @@ TEST(ClientInterrupt, CtrlCClosesTheWindowAndEndsTheStreamCleanly) {
   const std::string display = xvfb.start();
   ASSERT_FALSE(display.empty()) << "Xvfb did not start";
   TempDir dir;
-  ASSERT_EQ(make_demo_model(dir.path()), "");
+  ASSERT_EQ(make_demo_model(dir.path(), /*with_asa_guidance=*/false), "");  // ASA not tested
   Server server;  // ~31 KB at 8 kB/s: about four seconds
   ASSERT_TRUE(server.start({"--models", dir / "models", "--cache", "none", "--rate", "8000",
                             "--max-chunk-bytes", "1024"},
