@@ -238,6 +238,9 @@ struct IncrementalDecoder::State {
       refine->vertices.reserve(nv);
       refine->vertex_layer.reserve(nv);
       refine->vertex_shift.reserve(nv);
+      // The successive-approximation state (28 bytes a vertex): growing it
+      // by doubling copied it about twice over and faulted in fresh pages.
+      if (format.embedded) refine->geometry.reserve(nv);
       mesh = Mesh{};
       if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
         mesh.positions.reserve(nv);
