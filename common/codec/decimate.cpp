@@ -279,8 +279,11 @@ class LayerBuilder {
     return best_apex;
   }
 
-  // Tries to remove v; returns true and fills `removal` on success.
-  bool try_remove(uint32_t v, Removal& removal) {
+  // Tries to remove v; returns true, fills `removal` and appends its ring
+  // (apex first) to `ring_pool` on success. removal.ring is left empty:
+  // the pool may still grow (decimate_layers points the rings into it once
+  // the layer is done).
+  bool try_remove(uint32_t v, Removal& removal, std::vector<uint32_t>& ring_pool) {
     double error = 0;
     const uint32_t best_apex = this->best_apex(v, error);
     if (best_apex == kNone) return false;
@@ -289,8 +292,7 @@ class LayerBuilder {
     const auto& p = m_.positions();
     removal.vertex = v;
     removal.position = p[v];
-    removal.ring.resize(k);
-    for (uint32_t i = 0; i < k; ++i) removal.ring[i] = ring_[(best_apex + i) % k];
+    for (uint32_t i = 0; i < k; ++i) ring_pool.push_back(ring_[(best_apex + i) % k]);
     removal.open = boundary ? (2 * k - 1 - best_apex) % k : kNone;
     m_.remove_vertex(v, ring_, corners_, best_apex);
     if (!quadrics.empty()) quadrics[ring_[best_apex]].add(quadrics[v]);
@@ -355,7 +357,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
       options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   std::vector<double> cost(n, -1);
   std::vector<Candidate> candidates;
-  std::vector<uint32_t> ring, corners;
+  std::vector<uint32_t> ring, corners, ring_start;
   while (alive_count > target && result.layers.size() < options.max_layers) {
     update_costs(mesh, field, alive, cost, threads);
     candidates.clear();
@@ -368,6 +370,8 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     });
     std::fill(blocked.begin(), blocked.end(), 0);
     std::vector<Removal> layer;
+    std::vector<uint32_t> pool;
+    ring_start.clear();
     // The cheapest share first; all candidates when none of those is removable.
     const size_t share = static_cast<size_t>(kCandidateShare * double(candidates.size()));
     for (size_t limit : {std::max<size_t>(share, 1), candidates.size()}) {
@@ -376,17 +380,27 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
         const uint32_t v = candidates[i].vertex;
         if (blocked[v]) continue;
         Removal r;
-        if (!builder.try_remove(v, r)) continue;
+        const size_t start = pool.size();
+        if (!builder.try_remove(v, r, pool)) continue;
         blocked[v] = 1;
-        for (uint32_t u : r.ring) blocked[u] = 1;
+        for (size_t k = start; k < pool.size(); ++k) blocked[pool[k]] = 1;
         alive[v] = 0;
-        layer.push_back(std::move(r));
+        ring_start.push_back(static_cast<uint32_t>(start));
+        layer.push_back(r);
       }
       if (!layer.empty()) break;
     }
     if (layer.empty()) break;
     alive_count -= static_cast<uint32_t>(layer.size());
-    layer.shrink_to_fit();  // kept until the encode ends: no growth slack
+    // Kept until the encode ends: no growth slack.
+    layer.shrink_to_fit();
+    pool.shrink_to_fit();
+    ring_start.push_back(static_cast<uint32_t>(pool.size()));
+    for (size_t i = 0; i < layer.size(); ++i) {
+      layer[i].ring =
+          std::span<const uint32_t>(pool.data() + ring_start[i], ring_start[i + 1] - ring_start[i]);
+    }
+    result.ring_pools.push_back(std::move(pool));
     result.layers.push_back(std::move(layer));
     if (options.progress) options.progress(double(n - alive_count) / double(n - target));
   }

@@ -41,6 +41,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "common/codec/editable_mesh.h"
@@ -50,19 +51,32 @@ namespace meshstream {
 inline constexpr uint32_t kMaxRemovalValence = 16;
 
 struct Removal {
-  uint32_t vertex = 0;         // id in the input mesh
-  std::vector<uint32_t> ring;  // ring[0] is the fan apex; CCW around vertex
+  uint32_t vertex = 0;  // id in the input mesh
   Vec3i position;
   // kNone for an interior vertex; for a boundary vertex the index i of the
   // ring edge (ring[i], ring[i+1]) that its removal turned into a boundary edge.
   uint32_t open = kNone;
+  // ring[0] is the fan apex; CCW around vertex. A view into its layer's
+  // ring pool (DecimationResult::ring_pools): one flat array a layer
+  // instead of a heap block a removal (80 bytes a removed vertex with the
+  // vector; 40 + 4 a ring vertex now).
+  std::span<const uint32_t> ring;
 };
 
+// Move-only: the removals' rings point into ring_pools (moving the vectors
+// keeps their buffers; a copy would point into the original's).
 struct DecimationResult {
+  DecimationResult() = default;
+  DecimationResult(DecimationResult&&) = default;
+  DecimationResult& operator=(DecimationResult&&) = default;
+  DecimationResult(const DecimationResult&) = delete;
+  DecimationResult& operator=(const DecimationResult&) = delete;
+
   // layers[0] was removed first (finest); the decoder restores the last first.
   std::vector<std::vector<Removal>> layers;
-  std::vector<uint32_t> base_vertices;  // input ids of the vertices left, ascending
-  std::vector<Triangle> base_faces;     // in input ids
+  std::vector<std::vector<uint32_t>> ring_pools;  // layer i's rings, back to back
+  std::vector<uint32_t> base_vertices;            // input ids of the vertices left, ascending
+  std::vector<Triangle> base_faces;               // in input ids
 };
 
 struct DecimateOptions {

@@ -1,7 +1,11 @@
-// Binary STL and .drc through Draco's io (PLY and OBJ have their own
+// .drc through Draco's io (PLY, OBJ and STL have their own
 // readers: Draco's PLY reader merges equal positions and drops texture
 // coordinates; its OBJ reader writes outside a heap block on malformed face
-// tokens — see ply_reader.cpp, obj_reader.cpp).
+// tokens — see ply_reader.cpp, obj_reader.cpp; its STL reader builds a
+// whole mesh of its own first — see stl_binary_reader.cpp).
+//
+// Draco's StlDecoder stays here, behind read_stl_with_draco, as the peer
+// tests/mesh/stl_reader_test.cpp compares read_stl with.
 //
 // Draco's ObjDecoder is still here, behind read_trusted_obj_with_draco, as
 // the peer tests/mesh/obj_reader_test.cpp and the benchmarks compare our OBJ
@@ -215,7 +219,12 @@ Result<RawMesh> read_draco_mesh(const std::string& path, const std::string& ext)
 Result<RawMesh> read_with_draco(const std::string& path) {
   const std::string ext = lower_extension(path);
   if (ext == "obj") return read_obj(path);
+  if (ext == "stl") return read_stl(path);
   return read_draco_mesh(path, ext);
+}
+
+Result<RawMesh> read_stl_with_draco(const std::string& path) {
+  return read_draco_mesh(path, "stl");
 }
 
 Result<RawMesh> read_trusted_obj_with_draco(const std::string& path) {

@@ -32,8 +32,8 @@ struct EdgeGroups {
 // Groups the sides of every face by undirected edge. Faces with an index out
 // of range or a repeated index are skipped (callers validate first).
 // O(V + F) plus a sort per vertex of its outgoing edges (small). Allocates
-// about 42 bytes per face for the result and 8 per vertex while building;
-// no other temporary.
+// about 42 bytes per face for the result and, while building, 8 per vertex
+// and 12 per face (the larger vertex of every side).
 EdgeGroups build_edge_groups(const Mesh& mesh);
 
 }  // namespace meshstream

@@ -1,5 +1,5 @@
-// Reading mesh files: binary STL and Draco .drc through Draco's io; OBJ,
-// OFF, PLY and ASCII STL through our own readers (Draco has no OFF or ASCII
+// Reading mesh files: Draco .drc through Draco's io; OBJ,
+// OFF, PLY and STL (binary and ASCII) through our own readers (Draco has no OFF or ASCII
 // STL reader, its PLY reader merges equal positions and drops texture
 // coordinates, and its OBJ reader corrupts the heap on malformed corners —
 // see mesh_readers.h). Import cleans the mesh into what the

@@ -40,21 +40,31 @@ struct Join {
   bool cut = false;
 };
 
+// Joins the corners of uses a and b of `edge` at both of its endpoints.
+void join_across(const Mesh& mesh, const EdgeGroups& groups, uint32_t edge, uint32_t a, uint32_t b,
+                 UnionFind& sets) {
+  const uint32_t fa = groups.uses[a].face, fb = groups.uses[b].face;
+  sets.unite(corner_at(mesh, fa, groups.lo[edge]), corner_at(mesh, fb, groups.lo[edge]));
+  sets.unite(corner_at(mesh, fa, groups.hi[edge]), corner_at(mesh, fb, groups.hi[edge]));
+}
+
+// Adds the given joins (not cut) to corner sets.
+void add_joins(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins,
+               UnionFind& sets) {
+  for (const Join& j : joins) {
+    if (!j.cut) join_across(mesh, groups, j.edge, j.a, j.b, sets);
+  }
+}
+
 // Corner sets joined across every two-face edge and the given joins (not
 // cut) at each shared endpoint; each set is one fan of faces around one vertex.
 UnionFind fans_through(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
   UnionFind sets(3 * mesh.face_count());
-  auto join = [&](uint32_t edge, uint32_t a, uint32_t b) {
-    const uint32_t fa = groups.uses[a].face, fb = groups.uses[b].face;
-    sets.unite(corner_at(mesh, fa, groups.lo[edge]), corner_at(mesh, fb, groups.lo[edge]));
-    sets.unite(corner_at(mesh, fa, groups.hi[edge]), corner_at(mesh, fb, groups.hi[edge]));
-  };
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) == 2) join(e, groups.begin[e], groups.begin[e] + 1);
+    if (groups.use_count(e) == 2)
+      join_across(mesh, groups, e, groups.begin[e], groups.begin[e] + 1, sets);
   }
-  for (const Join& j : joins) {
-    if (!j.cut) join(j.edge, j.a, j.b);
-  }
+  add_joins(mesh, groups, joins, sets);
   return sets;
 }
 
@@ -99,9 +109,10 @@ void match_nonmanifold_edge(const Mesh& mesh, const EdgeGroups& groups, uint32_t
 }
 
 // The pairings at non-manifold edges (the two-face edges are joined anyway).
-std::vector<Join> choose_joins(const Mesh& mesh, const EdgeGroups& groups) {
+// `fans`: the corner sets through the two-face edges alone (fans_through
+// with no joins); the matching reads them and leaves them as they are.
+std::vector<Join> choose_joins(const Mesh& mesh, const EdgeGroups& groups, UnionFind& fans) {
   std::vector<Join> joins;
-  UnionFind fans = fans_through(mesh, groups, joins);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     if (groups.use_count(e) > 2) match_nonmanifold_edge(mesh, groups, e, fans, joins);
   }
@@ -167,8 +178,10 @@ class ParityUnionFind {
 // Step 2. Orients patches through required joins (a contradiction there is a
 // non-orientable surface: error), then glues patches through optional joins
 // where they agree and cuts the ones that contradict. Returns the number of
-// flipped faces; marks cut joins.
-Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups, std::vector<Join>& joins) {
+// flipped faces; marks cut joins and sets to_flip[f] for every face to
+// flip (apply_flips does it, after the fan split).
+Result<uint32_t> orient(const Mesh& mesh, const EdgeGroups& groups, std::vector<Join>& joins,
+                        std::vector<uint8_t>& to_flip) {
   const uint32_t f_count = mesh.face_count();
   ParityUnionFind faces(f_count);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
@@ -190,32 +203,50 @@ Result<uint32_t> orient(Mesh& mesh, const EdgeGroups& groups, std::vector<Join>&
     if (!faces.unite(a.face, b.face, a.forward == b.forward ? 1 : 0)) j.cut = true;
   }
   // Keep the majority's orientation in every glued set: flip the fewest.
-  std::vector<uint8_t> flip(f_count);
-  std::vector<uint32_t> root(f_count), flipped_in(f_count, 0), size_of(f_count, 0);
+  // balance[root] = faces to flip minus faces to keep relative to the root
+  // (> 0 exactly when 2 * flipped > size). The second find is O(1): the
+  // first pass compressed every path.
+  std::vector<int32_t> balance(f_count, 0);
   for (uint32_t f = 0; f < f_count; ++f) {
-    root[f] = faces.find(f, flip[f]);
-    flipped_in[root[f]] += flip[f];
-    ++size_of[root[f]];
+    uint8_t flip = 0;
+    balance[faces.find(f, flip)] += flip ? 1 : -1;
   }
   uint32_t flipped = 0;
+  to_flip.assign(f_count, 0);
   for (uint32_t f = 0; f < f_count; ++f) {
-    const bool invert = 2 * flipped_in[root[f]] > size_of[root[f]];
-    if ((flip[f] != 0) != invert) {
-      reverse_face(mesh, f);  // its corner data follows
+    uint8_t flip = 0;
+    const bool invert = balance[faces.find(f, flip)] > 0;
+    if ((flip != 0) != invert) {
+      to_flip[f] = 1;
       ++flipped;
     }
   }
   return flipped;
 }
 
-// Step 3. Returns the number of vertex copies made.
-uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
-  UnionFind sets = fans_through(mesh, groups, joins);
+void apply_flips(Mesh& mesh, const std::vector<uint8_t>& to_flip) {
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    if (to_flip[f]) reverse_face(mesh, f);  // its corner data follows
+  }
+}
+
+// Step 3, before the faces orient() chose are flipped. `sets`: the fans
+// through the two-face edges (as choose_joins had them); the joins not cut
+// are added here, so that pass over every edge is not made twice. Corners
+// are visited in the order they will have once `to_flip` is applied (a
+// flipped face's corners 1 and 2 trade places), so the copies are made in
+// the same order as splitting after the flips would. Returns the number of
+// vertex copies made.
+uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins,
+                    UnionFind sets, const std::vector<uint8_t>& to_flip) {
+  add_joins(mesh, groups, joins, sets);
   const uint32_t corner_count = 3 * mesh.face_count();
   std::vector<uint32_t> owner(mesh.vertex_count(), kNone);  // fan keeping the original
   std::vector<uint32_t> root_vertex(corner_count, kNone);
   uint32_t copies = 0;
-  for (uint32_t c = 0; c < corner_count; ++c) {
+  for (uint32_t visit = 0; visit < corner_count; ++visit) {
+    const uint32_t local = visit % 3;
+    const uint32_t c = to_flip[visit / 3] && local != 0 ? visit - local + (3 - local) : visit;
     const uint32_t v = mesh.triangles[c / 3][c % 3];
     const uint32_t root = sets.find(c);
     if (root_vertex[root] == kNone) {
@@ -330,13 +361,19 @@ Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups) {
       groups = {};
       groups = build_edge_groups(mesh);
     }
-    std::vector<Join> joins = choose_joins(mesh, groups);
-    auto flipped = orient(mesh, groups, joins);
+    UnionFind fans = fans_through(mesh, groups, {});
+    std::vector<Join> joins = choose_joins(mesh, groups, fans);
+    std::vector<uint8_t> to_flip;
+    auto flipped = orient(mesh, groups, joins, to_flip);
     if (!flipped) return tl::unexpected(flipped.error());
     counts.flipped_faces += *flipped;
-    // Flipping changes no vertex of any face, so groups and joins stay valid
-    // for the fan split (only the directions recorded in them are stale).
-    const uint32_t split = split_fans(mesh, groups, joins);
+    // The split works on the faces as they are (so the fans' corner numbers
+    // still hold), the flips come after it. Flipping changes no vertex of
+    // any face, so groups and joins stay valid afterwards too (only the
+    // directions recorded in them are stale).
+    const uint32_t split = split_fans(mesh, groups, joins, std::move(fans), to_flip);
+    apply_flips(mesh, to_flip);
+    to_flip = {};
     counts.split_vertices += split;
     if (split > 0) {
       groups = {};

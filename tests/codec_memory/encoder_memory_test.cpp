@@ -98,10 +98,12 @@ namespace {
 // layers, the replay, the surface hierarchy); 696 with two candidate
 // replays at once, over 1 KB with the whole-mesh copies. The ASA guidance
 // (asa_guidance.h, on by default since encoder version 10) measures its
-// prefixes against the original after the records are coded, and lifts the
-// peak to 918 bytes a vertex: the next thing to cut. The 300-byte
-// target is not met; this bound catches anything worse than today.
-constexpr double kBoundBytesPerVertex = 960;
+// prefixes against the original after the records are coded, and lifted the
+// peak to 918 bytes a vertex. Measured again after the decimation layers'
+// flat ring pools (decimate.h) and the merges before them: 586. The issue's
+// 300-byte target is not met; this bound (a fifth above) catches anything
+// worse than today.
+constexpr double kBoundBytesPerVertex = 700;
 
 // The counter sees this binary's allocations.
 TEST(EncoderMemory, TheCounterCountsAllocations) {
