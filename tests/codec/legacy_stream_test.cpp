@@ -156,7 +156,8 @@ void expect_attributes_decode_as_when_written(const char* sample, uint64_t hash,
   }
   ASSERT_TRUE(dec.finished());
   EXPECT_EQ(attribute_records, values_records + 2) << "base, values records, final";
-  EXPECT_EQ(attribute_hash(dec.mesh()), hash) << "hash 0x" << std::hex << attribute_hash(dec.mesh());
+  EXPECT_EQ(attribute_hash(dec.mesh()), hash)
+      << "hash 0x" << std::hex << attribute_hash(dec.mesh());
   auto whole = decode_hcs(bytes);
   ASSERT_TRUE(whole) << whole.error().message;
   EXPECT_EQ(attribute_hash(*whole), hash);
