@@ -264,6 +264,8 @@ class StreamingRun {
         const fs::path dir(o_.out_dir);
         keep_error(write_mesh(*frame.display, (dir / o_.out_file("final")).string()));
         keep_error(write_mesh(*frame.decoded, (dir / o_.out_file("final.decoded")).string()));
+        for (const std::string& lost : export_losses(*frame.display, o_.out_file("final")))
+          log_.note("warning: " + o_.out_file("final") + ": not stored: " + lost);
       }
       if (!o_.snapshot_png.empty() && !o_.snapshot_at && hooks_.snapshot) {
         keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),
