@@ -63,9 +63,8 @@ Mesh square_with_extras() {
   m.extra_attributes.push_back(
       extra<uint16_t>("TEXCOORD_1", Type::kUint16, 2, corners,
                       [](size_t c, uint32_t i) { return uint16_t(60000 + 7 * (c / 3) + i); }));
-  m.extra_attributes.push_back(extra<int8_t>("x", Type::kInt8, 1, corners, [](size_t c, uint32_t) {
-    return int8_t(-100 + int(c / 3));
-  }));
+  m.extra_attributes.push_back(extra<int8_t>(
+      "x", Type::kInt8, 1, corners, [](size_t c, uint32_t) { return int8_t(-100 + int(c / 3)); }));
   m.extra_attributes.push_back(extra<uint32_t>("_ID", Type::kUint32, 1, corners,
                                                [](size_t, uint32_t) { return 4000000000u; }));
   return m;
@@ -167,10 +166,21 @@ TEST(PlyExtraAttributes, EveryCornerReadsBackByteForByteInBinaryAndAscii) {
     const PlyFile file = read_ply_file(path);
     std::vector<std::string> names, types;
     for (const PlyProperty& p : file.properties) names.push_back(p.name), types.push_back(p.type);
-    const std::vector<std::string> expected_names{
-        "x",         "y",         "z",         "red",          "green",        "blue",
-        "alpha",     "TANGENT_0", "TANGENT_1", "TANGENT_2",    "TANGENT_3",    "TEXCOORD_1_0",
-        "TEXCOORD_1_1", "extra_x", "_ID"};
+    const std::vector<std::string> expected_names{"x",
+                                                  "y",
+                                                  "z",
+                                                  "red",
+                                                  "green",
+                                                  "blue",
+                                                  "alpha",
+                                                  "TANGENT_0",
+                                                  "TANGENT_1",
+                                                  "TANGENT_2",
+                                                  "TANGENT_3",
+                                                  "TEXCOORD_1_0",
+                                                  "TEXCOORD_1_1",
+                                                  "extra_x",
+                                                  "_ID"};
     EXPECT_EQ(names, expected_names);
     EXPECT_EQ(types[7], "float");
     EXPECT_EQ(types[11], "ushort");
