@@ -71,16 +71,18 @@ int run_list(const ClientOptions& o) {
   return 0;
 }
 
-std::string record_file(const std::string& dir, uint32_t record) {
-  char name[32];
-  std::snprintf(name, sizeof name, "%04u.ply", record);
-  return (fs::path(dir) / name).string();
+std::string record_file(const ClientOptions& o, uint32_t record) {
+  char stem[32];
+  std::snprintf(stem, sizeof stem, "%04u", record);
+  return (fs::path(o.out_dir) / o.out_file(stem)).string();
 }
 
 // The files --out writes: NNNN.ply (four digits or more), final.ply and
-// final.decoded.ply. --overwrite deletes these and nothing else.
+// final.decoded.ply, or the same names ending in .glb (an earlier run may
+// have used the other --out-format). --overwrite deletes these and nothing
+// else.
 bool written_by_this_program(const std::string& name) {
-  static const std::regex pattern(R"(\d{4,}\.ply|final\.ply|final\.decoded\.ply)");
+  static const std::regex pattern(R"((\d{4,}|final|final\.decoded)\.(ply|glb))");
   return std::regex_match(name, pattern);
 }
 
@@ -249,7 +251,7 @@ class StreamingRun {
       log_.refinement(frame, info, elapsed(), client_->rate_bytes_per_s());
       const uint32_t record = frame.records_decoded - 1;
       if (!o_.out_dir.empty() && o_.saves_record(record))
-        keep_error(write_mesh(*frame.display, record_file(o_.out_dir, record)));
+        keep_error(write_mesh(*frame.display, record_file(o_, record)));
       if (o_.snapshot_at && !snapshot_done_ && record == *o_.snapshot_at && hooks_.snapshot) {
         keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),
                                    frame.camera ? &*frame.camera : nullptr, o_, o_.snapshot_png));
@@ -259,9 +261,11 @@ class StreamingRun {
     if (frame.final && !final_frame_) {
       final_frame_ = frame;
       if (!o_.out_dir.empty()) {
-        keep_error(write_mesh(*frame.display, (fs::path(o_.out_dir) / "final.ply").string()));
-        keep_error(
-            write_mesh(*frame.decoded, (fs::path(o_.out_dir) / "final.decoded.ply").string()));
+        const fs::path dir(o_.out_dir);
+        keep_error(write_mesh(*frame.display, (dir / o_.out_file("final")).string()));
+        keep_error(write_mesh(*frame.decoded, (dir / o_.out_file("final.decoded")).string()));
+        for (const std::string& lost : export_losses(*frame.display, o_.out_file("final")))
+          log_.note("warning: " + o_.out_file("final") + ": not stored: " + lost);
       }
       if (!o_.snapshot_png.empty() && !o_.snapshot_at && hooks_.snapshot) {
         keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),

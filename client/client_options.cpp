@@ -18,6 +18,10 @@ bool ClientOptions::saves_record(uint32_t index) const {
   return std::find(out_at.begin(), out_at.end(), index) != out_at.end();
 }
 
+std::string ClientOptions::out_file(const std::string& stem) const {
+  return stem + "." + out_format;
+}
+
 namespace {
 
 // Lower-case extension with its dot ("" when there is none).
@@ -46,7 +50,13 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_flag("--list", o.list, "list the server's models and exit");
   app.add_option("--out", o.out_dir,
                  "write final.ply (the last display mesh) and final.decoded.ply into DIR, a new "
-                 "or empty folder (see --overwrite)");
+                 "or empty folder (see --overwrite; .glb instead with --out-format glb)");
+  app.add_option("--out-format", o.out_format,
+                 "with --out: ply (binary PLY with colours, normals and texture coordinates, seam "
+                 "vertices split) or glb (binary glTF: attributes, materials and textures in one "
+                 "file)")
+      ->check(CLI::IsMember({"ply", "glb"}))
+      ->capture_default_str();
   app.add_option("--out-every", o.out_every,
                  "with --out: also write NNNN.ply, the display mesh after record NNNN, for every "
                  "N-th record (0, N, 2N, ...), whatever the timing (default: none)")
@@ -57,7 +67,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
       ->delimiter(',');
   app.add_flag("--overwrite", o.overwrite,
                "let --out use a folder that is not empty: first delete the files this program "
-               "writes there (NNNN.ply, final.ply, final.decoded.ply), nothing else");
+               "writes there (NNNN.ply, final.ply, final.decoded.ply, or the same .glb), "
+               "nothing else");
   std::string asa_mode = "auto";
   app.add_option("--asa", asa_mode,
                  "auto: the post-processing the stream's encoder measured closest to the "
@@ -188,8 +199,9 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                  ": only PNG is written, so the name must end in " +
                  (ext.empty() ? std::string(".png") : ".png, not " + ext));
   }
-  if (o.out_dir.empty() && (o.out_every || !o.out_at.empty() || o.overwrite))
-    return usage("--out-every, --out-at and --overwrite need --out DIR");
+  if (o.out_dir.empty() &&
+      (o.out_every || !o.out_at.empty() || o.overwrite || app.count("--out-format")))
+    return usage("--out-every, --out-at, --out-format and --overwrite need --out DIR");
   if (!camera_text.empty()) {
     AsaCamera camera;
     if (auto parsed = parse_camera(camera_text, camera); !parsed)

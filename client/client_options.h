@@ -1,7 +1,7 @@
 // The `meshstream-client` command line (contract in docs/design.md;
 // every flag in docs/usage.md):
 //   meshstream-client HOST:PORT [MODEL] | http://HOST[:PORT]/PATH/MODEL.hcs [--list] [--out DIR
-//   [--out-every N]
+//   [--out-every N] [--out-format ply|glb]
 //     [--out-at LIST] [--overwrite]] [--asa-levels L]
 //     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa] [--asa-complete]
 //     [--camera EX,EY,EZ,TX,TY,TZ[,FOV]] [--pixel-tolerance PX] [--view-independent]
@@ -34,7 +34,10 @@ struct ClientOptions {
   uint32_t out_every = 0;        // --out-every: NNNN.ply at every N-th record (0 = none)
   std::vector<uint32_t> out_at;  // --out-at: NNNN.ply at these records
   bool overwrite = false;        // --overwrite: reuse a folder of an earlier run
-  bool asa_enabled = true;       // --no-asa (--asa off) turns it off
+  // --out-format: the files' format and extension, "ply" (default) or "glb"
+  // (one file each: attributes, materials and textures inside).
+  std::string out_format = "ply";
+  bool asa_enabled = true;  // --no-asa (--asa off) turns it off
   // --asa auto (the default): follow the stream's ASA guidance (guided_asa.h);
   // --asa on, or any of --asa-levels, --flatness, --rule, --crease: the
   // fixed settings in `asa`.
@@ -57,6 +60,8 @@ struct ClientOptions {
   std::optional<uint32_t> snapshot_at;  // record index (0 = base mesh)
   // True when record `index` is saved as NNNN.ply (--out-every, --out-at).
   bool saves_record(uint32_t index) const;
+  // The name --out gives a file: STEM.ply or STEM.glb by --out-format.
+  std::string out_file(const std::string& stem) const;
   uint64_t exit_after_frames = 0;
   uint32_t exit_after_records = 0;
   uint32_t max_chunk_bytes = 0;

@@ -52,6 +52,9 @@ int run_decode(const DecodeArgs& args) {
   auto mesh = decoder.release_mesh();
   if (!mesh) return report_failure(std::move(mesh.error()).with_context(args.input));
   if (auto s = write_mesh(*mesh, args.output); !s) return report_failure(s.error());
+  for (const std::string& lost : export_losses(*mesh, args.output))
+    std::fprintf(stderr, "meshstream decode: %s: warning: not stored: %s\n", args.output.c_str(),
+                 lost.c_str());
   std::printf("%s: decoded %u of %zu records (%llu of %llu bytes): %u vertices, %u faces -> %s\n",
               args.input.c_str(), records, index->records.size(),
               static_cast<unsigned long long>(decoded_bytes),

@@ -69,6 +69,9 @@ int run_subdivide(SubdivideArgs& args) {
   if (auto written = write_mesh(result->mesh, args.output); !written) {
     return report_failure(std::move(written.error()).with_context(args.output));
   }
+  for (const std::string& lost : export_losses(result->mesh, args.output))
+    std::fprintf(stderr, "meshstream subdivide: %s: warning: not stored: %s\n", args.output.c_str(),
+                 lost.c_str());
   std::map<FaceKind, uint32_t> kinds;
   for (FaceKind k : result->face_kind) ++kinds[k];
   std::printf(

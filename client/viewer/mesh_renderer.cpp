@@ -2,6 +2,7 @@
 
 #include <stb_image.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -35,13 +36,13 @@ uint64_t bytes_key(const std::vector<uint8_t>& bytes) {
   return h | 1;  // never 0 (0: no texture)
 }
 
-// The texture the mesh's surface shows: the base colour texture of the
-// material of face 0 (or of material 0), else texture 0 when there is no
+// The texture face f shows: the base colour texture of its material (of
+// material 0 when faces have none), else texture 0 when there is no
 // material; -1 for none or an index out of range.
-int32_t shown_texture(const Mesh& mesh) {
+int32_t face_texture(const Mesh& mesh, uint32_t f) {
   int32_t t = -1;
   if (!mesh.materials.empty()) {
-    uint32_t m = mesh.face_materials.empty() ? 0 : mesh.face_materials[0];
+    uint32_t m = f < mesh.face_materials.size() ? mesh.face_materials[f] : 0;
     if (m < mesh.materials.size()) t = mesh.materials[m].base_color_texture;
   } else if (!mesh.textures.empty()) {
     t = 0;
@@ -107,6 +108,7 @@ Result<MeshRenderer> MeshRenderer::create(const GlFunctions& gl) {
   u.has_texture = gl.GetUniformLocation(program, "u_has_texture");
   u.surface = gl.GetUniformLocation(program, "u_surface");
   u.base_texture = gl.GetUniformLocation(program, "u_base_texture");
+  u.first_face = gl.GetUniformLocation(program, "u_first_face");
 
   gl.GenVertexArrays(1, &r.vao_);
   GLuint buffers[7];
@@ -119,7 +121,6 @@ Result<MeshRenderer> MeshRenderer::create(const GlFunctions& gl) {
   r.color_buffer_ = buffers[5];
   r.uv_buffer_ = buffers[6];
   gl.GenTextures(1, &r.face_kind_texture_);
-  gl.GenTextures(1, &r.base_texture_);
 
   gl.BindVertexArray(r.vao_);
   const GLuint per_vertex[5] = {r.position_buffer_, r.normal_buffer_, r.distance_buffer_,
@@ -153,11 +154,11 @@ MeshRenderer& MeshRenderer::operator=(MeshRenderer&& other) noexcept {
     face_kind_texture_ = other.face_kind_texture_;
     color_buffer_ = other.color_buffer_;
     uv_buffer_ = other.uv_buffer_;
-    base_texture_ = other.base_texture_;
+    textures_ = std::move(other.textures_);
+    groups_ = std::move(other.groups_);
     has_colors_ = other.has_colors_;
     has_texture_ = other.has_texture_;
     corner_vertex_ = std::move(other.corner_vertex_);
-    texture_key_ = other.texture_key_;
     vertex_count_ = other.vertex_count_;
     copied_from_ = std::move(other.copied_from_);
     triangle_count_ = other.triangle_count_;
@@ -176,7 +177,8 @@ void MeshRenderer::release() {
                        face_kind_buffer_, color_buffer_,  uv_buffer_};
   gl_.DeleteBuffers(7, buffers);
   gl_.DeleteTextures(1, &face_kind_texture_);
-  gl_.DeleteTextures(1, &base_texture_);
+  for (const GpuTexture& t : textures_) gl_.DeleteTextures(1, &t.id);
+  textures_.clear();
   gl_.DeleteVertexArrays(1, &vao_);
   gl_.DeleteProgram(program_);
 }
@@ -251,25 +253,48 @@ void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_ki
        shading.normals.data());
   send(GL_ARRAY_BUFFER, color_buffer_, drawn_colors.size() * sizeof(Vec4f), drawn_colors.data());
   send(GL_ARRAY_BUFFER, uv_buffer_, drawn_uvs.size() * sizeof(Vec2f), drawn_uvs.data());
+  // Faces grouped by the texture they show (stable: each group keeps the
+  // mesh's face order), one draw call per group.
   const bool uvs = !mesh.texcoords.empty() || !mesh.corner_texcoords.empty();
+  std::vector<int32_t> shown(F, -1);
   if (uvs) {
-    upload_texture(mesh);
-  } else {
-    has_texture_ = false;
+    std::vector<int8_t> decoded(mesh.textures.size(), -1);  // -1 not tried, 0 no, 1 yes
+    for (uint32_t f = 0; f < F; ++f) {
+      const int32_t t = face_texture(mesh, f);
+      if (t < 0) continue;
+      if (decoded[size_t(t)] < 0) decoded[size_t(t)] = upload_texture(mesh, size_t(t)) ? 1 : 0;
+      if (decoded[size_t(t)] == 1) shown[f] = t;
+    }
   }
+  std::vector<uint32_t> order(F);
+  for (uint32_t f = 0; f < F; ++f) order[f] = f;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return shown[a] < shown[b]; });
+  groups_.clear();
+  has_texture_ = false;
+  for (uint32_t i = 0; i < F; ++i) {
+    const int32_t t = shown[order[i]];
+    if (groups_.empty() || groups_.back().texture != t) groups_.push_back({i, 0, t});
+    ++groups_.back().faces;
+    has_texture_ = has_texture_ || t >= 0;
+  }
+  std::vector<Triangle> drawn_triangles(F);
+  for (uint32_t i = 0; i < F; ++i) drawn_triangles[i] = shading.triangles[order[i]];
   std::vector<float> zeros(shading.positions.size(), 0.0f);
   send(GL_ARRAY_BUFFER, distance_buffer_, zeros.size() * sizeof(float), zeros.data());
   has_distances_ = false;
   gl_.BindBuffer(GL_ARRAY_BUFFER, 0);
   gl_.BindVertexArray(vao_);
-  send(GL_ELEMENT_ARRAY_BUFFER, index_buffer_, shading.triangles.size() * sizeof(Triangle),
-       shading.triangles.data());
+  send(GL_ELEMENT_ARRAY_BUFFER, index_buffer_, drawn_triangles.size() * sizeof(Triangle),
+       drawn_triangles.data());
   gl_.BindVertexArray(0);
 
   // A texture buffer may not be empty on every driver: keep at least one texel.
   std::vector<uint8_t> kinds(std::max<size_t>(triangle_count_, 1), 0);
   if (face_kind != nullptr && face_kind->size() == triangle_count_) {
-    for (size_t f = 0; f < face_kind->size(); ++f) kinds[f] = static_cast<uint8_t>((*face_kind)[f]);
+    // In drawn order: the shader reads the label at u_first_face + primitive.
+    for (size_t i = 0; i < face_kind->size(); ++i)
+      kinds[i] = static_cast<uint8_t>((*face_kind)[order[i]]);
   }
   send(GL_TEXTURE_BUFFER, face_kind_buffer_, kinds.size(), kinds.data());
   gl_.BindTexture(GL_TEXTURE_BUFFER, face_kind_texture_);
@@ -278,18 +303,12 @@ void MeshRenderer::upload(const Mesh& mesh, const std::vector<FaceKind>* face_ki
   gl_.BindBuffer(GL_TEXTURE_BUFFER, 0);
 }
 
-void MeshRenderer::upload_texture(const Mesh& mesh) {
-  const int32_t t = shown_texture(mesh);
-  if (t < 0) {
-    has_texture_ = false;
-    return;
-  }
-  const std::vector<uint8_t>& bytes = mesh.textures[size_t(t)].bytes;
+bool MeshRenderer::upload_texture(const Mesh& mesh, size_t t) {
+  if (textures_.size() < mesh.textures.size()) textures_.resize(mesh.textures.size());
+  GpuTexture& gpu = textures_[t];
+  const std::vector<uint8_t>& bytes = mesh.textures[t].bytes;
   const uint64_t key = bytes_key(bytes);
-  if (key == texture_key_) {
-    has_texture_ = true;
-    return;
-  }
+  if (key == gpu.key) return true;
   int w = 0, h = 0, n = 0;
   std::unique_ptr<uint8_t, void (*)(void*)> pixels(
       bytes.size() < size_t(INT32_MAX)
@@ -298,12 +317,12 @@ void MeshRenderer::upload_texture(const Mesh& mesh) {
       stbi_image_free);
   // An image that does not decode shows untextured (the decoder has
   // checked its headers; a broken body is the only way here).
-  has_texture_ = pixels != nullptr;
-  texture_key_ = has_texture_ ? key : 0;
-  if (!has_texture_) return;
+  gpu.key = pixels ? key : 0;
+  if (!pixels) return false;
+  if (gpu.id == 0) gl_.GenTextures(1, &gpu.id);
   // Rows top first in the file, texture coordinate v = 0 at the bottom
   // (glTF's v points down: its importers flip v when they read it).
-  gl_.BindTexture(GL_TEXTURE_2D, base_texture_);
+  gl_.BindTexture(GL_TEXTURE_2D, gpu.id);
   gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
   std::vector<uint8_t> flipped(size_t(w) * h * 4);
   for (int y = 0; y < h; ++y)
@@ -316,6 +335,7 @@ void MeshRenderer::upload_texture(const Mesh& mesh) {
   gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   gl_.BindTexture(GL_TEXTURE_2D, 0);
+  return true;
 }
 
 void MeshRenderer::upload_distances(const std::vector<float>& distances) {
@@ -361,15 +381,19 @@ void MeshRenderer::draw(const OrbitCamera& camera, int width, int height,
   gl_.BindTexture(GL_TEXTURE_BUFFER, face_kind_texture_);
   gl_.Uniform1i(uniforms_.face_kind, 0);
   gl_.Uniform1i(uniforms_.has_color, has_colors_ ? 1 : 0);
-  gl_.Uniform1i(uniforms_.has_texture, has_texture_ ? 1 : 0);
   gl_.Uniform1i(uniforms_.surface, static_cast<int>(style.surface));
-  gl_.ActiveTexture(GL_TEXTURE1);
-  gl_.BindTexture(GL_TEXTURE_2D, base_texture_);
   gl_.Uniform1i(uniforms_.base_texture, 1);
-  gl_.ActiveTexture(GL_TEXTURE0);
   gl_.BindVertexArray(vao_);
-  gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(triangle_count_ * 3), GL_UNSIGNED_INT,
-                   nullptr);
+  for (const DrawGroup& g : groups_) {
+    const bool textured = g.texture >= 0;
+    gl_.Uniform1i(uniforms_.has_texture, textured ? 1 : 0);
+    gl_.Uniform1i(uniforms_.first_face, static_cast<GLint>(g.first_face));
+    gl_.ActiveTexture(GL_TEXTURE1);
+    gl_.BindTexture(GL_TEXTURE_2D, textured ? textures_[size_t(g.texture)].id : 0);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    gl_.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(g.faces * 3), GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(size_t(g.first_face) * sizeof(Triangle)));
+  }
   gl_.BindVertexArray(0);
   gl_.BindTexture(GL_TEXTURE_BUFFER, 0);
   gl_.ActiveTexture(GL_TEXTURE1);

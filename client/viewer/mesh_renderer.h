@@ -70,15 +70,18 @@ class MeshRenderer {
   void upload(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
               float crease_degrees = 0.0f);
 
-  // Colours and texture (ColorMode::kShaded): per-vertex or per-corner
+  // Colours and textures (ColorMode::kShaded): per-vertex or per-corner
   // colours times the material's base colour factor, per-vertex or
-  // per-corner texture coordinates, and the base colour texture of the
-  // material of face 0 (one texture per mesh: a mesh whose materials use
-  // several shows the first one's), decoded with stb_image and kept while
-  // its bytes stay the same. With any per-corner attribute or several
-  // materials every corner gets its own drawn vertex.
+  // per-corner texture coordinates, and each face's material's base colour
+  // texture: faces are drawn in groups, one draw call per texture (faces
+  // whose material has none in a group without), each image decoded with
+  // stb_image and kept while its bytes stay the same. With any per-corner
+  // attribute or several materials every corner gets its own drawn vertex.
+  // has_texture: some face shows a texture; texture_groups: the draw calls.
+  // O(F) to group the faces.
   bool has_colors() const { return has_colors_; }
   bool has_texture() const { return has_texture_; }
+  size_t texture_groups() const { return groups_.size(); }
 
   // Per-vertex distances for ColorMode::kDistance; ignored unless the size
   // equals the uploaded mesh's vertex count (copies made at creases take
@@ -106,21 +109,36 @@ class MeshRenderer {
   GLuint vao_ = 0;
   GLuint position_buffer_ = 0, normal_buffer_ = 0, distance_buffer_ = 0, index_buffer_ = 0;
   GLuint face_kind_buffer_ = 0, face_kind_texture_ = 0;
-  GLuint color_buffer_ = 0, uv_buffer_ = 0, base_texture_ = 0;
+  GLuint color_buffer_ = 0, uv_buffer_ = 0;
   bool has_colors_ = false, has_texture_ = false;
+  // One GL texture per mesh texture (by index), with the hash of the bytes
+  // it holds (0: none or an image that does not decode).
+  struct GpuTexture {
+    GLuint id = 0;
+    uint64_t key = 0;
+  };
+  std::vector<GpuTexture> textures_;
+  // Consecutive faces of the index buffer (faces sorted by the texture they
+  // show) drawn with one texture; texture -1: none.
+  struct DrawGroup {
+    uint32_t first_face = 0, faces = 0;
+    int32_t texture = -1;
+  };
+  std::vector<DrawGroup> groups_;
   // Per drawn vertex, the mesh vertex it shows, when corners are drawn
   // apart (empty otherwise: the drawn vertices are the mesh's, then the
   // crease copies).
   std::vector<uint32_t> corner_vertex_;
-  uint64_t texture_key_ = 0;  // hash of the texture bytes now in base_texture_ (0: none)
-  void upload_texture(const Mesh& mesh);
+  // Decodes texture t of `mesh` into textures_[t] unless its bytes are
+  // already there; whether it holds an image.
+  bool upload_texture(const Mesh& mesh, size_t t);
   uint32_t vertex_count_ = 0, triangle_count_ = 0;
   std::vector<uint32_t> copied_from_;  // the vertex each crease copy repeats
   bool has_distances_ = false;
   struct Uniforms {
     GLint view = -1, projection = -1, viewport = -1, coloring = -1, wireframe = -1, wire_width = -1,
           distance_max = -1, face_kind = -1, has_color = -1, has_texture = -1, surface = -1,
-          base_texture = -1;
+          base_texture = -1, first_face = -1;
   } uniforms_;
 };
 

@@ -39,6 +39,9 @@ in float v_distance[];
 in vec4 v_color[];
 in vec2 v_uv[];
 uniform vec2 u_viewport;
+// The first face of this draw call in the face-label buffer (faces are drawn
+// in groups by texture, gl_PrimitiveIDIn counts from each group's start).
+uniform int u_first_face;
 out vec3 g_view_pos;
 out vec3 g_view_normal;
 out float g_distance;
@@ -66,7 +69,7 @@ void main() {
     g_color = v_color[i];
     g_uv = v_uv[i];
     g_edge_px = vec3(i == 0 ? heights.x : 0.0, i == 1 ? heights.y : 0.0, i == 2 ? heights.z : 0.0);
-    g_face = gl_PrimitiveIDIn;
+    g_face = u_first_face + gl_PrimitiveIDIn;
     gl_Position = gl_in[i].gl_Position;
     EmitVertex();
   }

@@ -207,6 +207,43 @@ Result<std::string> write_material_files(const Mesh& mesh, const std::string& ob
 
 namespace {
 
+// PLY's name of an extra attribute's component type.
+const char* ply_type(ExtraAttribute::ComponentType type) {
+  switch (type) {
+    case ExtraAttribute::ComponentType::kInt8:
+      return "char";
+    case ExtraAttribute::ComponentType::kUint8:
+      return "uchar";
+    case ExtraAttribute::ComponentType::kInt16:
+      return "short";
+    case ExtraAttribute::ComponentType::kUint16:
+      return "ushort";
+    case ExtraAttribute::ComponentType::kUint32:
+      return "uint";
+    case ExtraAttribute::ComponentType::kFloat32:
+      return "float";
+  }
+  return "float";
+}
+
+}  // namespace
+
+std::vector<std::string> ply_extra_property_names(const ExtraAttribute& e) {
+  // A property name is one token; the ones PLY readers take for positions,
+  // normals, colours and texture coordinates are not reused.
+  static const char* const kTaken[] = {"x",     "y",    "z",     "nx", "ny", "nz", "red",
+                                       "green", "blue", "alpha", "u",  "v",  "s",  "t"};
+  std::string stem = safe_name(e.name, "extra");
+  if (std::find(std::begin(kTaken), std::end(kTaken), stem) != std::end(kTaken))
+    stem = "extra_" + stem;
+  std::vector<std::string> names;
+  for (uint32_t i = 0; i < e.components; ++i)
+    names.push_back(e.components == 1 ? stem : stem + "_" + std::to_string(i));
+  return names;
+}
+
+namespace {
+
 // What a per-vertex format loses of `mesh`, for its header comment: the
 // seam splits and what it cannot store at all.
 std::string per_vertex_comment(const Mesh& original, const SplitMesh* split) {
@@ -214,18 +251,26 @@ std::string per_vertex_comment(const Mesh& original, const SplitMesh* split) {
   if (split != nullptr && split->split_copies > 0)
     c += "comment " + std::to_string(split->split_copies) +
          " vertices added: per-corner attributes (seams) split into per-vertex copies\n";
-  if (!original.extra_attributes.empty()) {
-    c += "comment not stored (PLY has no such property):";
-    for (const ExtraAttribute& e : original.extra_attributes) c += " " + e.name;
-    c += "\n";
+  for (const ExtraAttribute& e : original.extra_attributes) {
+    const auto names = ply_extra_property_names(e);
+    c += "comment extra attribute " + e.name + ": properties " + names.front() +
+         (names.size() > 1 ? ".." + names.back() : std::string()) +
+         (e.normalized ? " (normalized integers)" : "") + "\n";
   }
   if (!original.materials.empty())
     c += "comment materials and textures not stored (use OBJ or glTF)\n";
   return c;
 }
 
+// The extra attributes as per-vertex bytes (split_seams' vertex_extras).
+struct VertexExtras {
+  const std::vector<ExtraAttribute>* attributes = nullptr;
+  const std::vector<std::vector<uint8_t>>* bytes = nullptr;
+  size_t count() const { return attributes ? attributes->size() : 0; }
+};
+
 Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding encoding,
-                          const std::string& comment);
+                          const std::string& comment, VertexExtras extras = {});
 
 }  // namespace
 
@@ -234,13 +279,50 @@ Status write_ply(const Mesh& mesh, const std::string& path, PlyEncoding encoding
   if (!has_corner_data(mesh))
     return write_ply_vertices(mesh, path, encoding, per_vertex_comment(mesh, nullptr));
   const SplitMesh split = split_seams(mesh);
-  return write_ply_vertices(split.mesh, path, encoding, per_vertex_comment(mesh, &split));
+  return write_ply_vertices(split.mesh, path, encoding, per_vertex_comment(mesh, &split),
+                            {&mesh.extra_attributes, &split.vertex_extras});
 }
 
 namespace {
 
+// One component of an extra attribute as PLY text.
+void write_component(Writer& out, ExtraAttribute::ComponentType type, const uint8_t* bytes) {
+  switch (type) {
+    case ExtraAttribute::ComponentType::kInt8:
+      out.text(std::to_string(int(int8_t(bytes[0]))));
+      return;
+    case ExtraAttribute::ComponentType::kUint8:
+      out.number(uint32_t{bytes[0]});
+      return;
+    case ExtraAttribute::ComponentType::kInt16: {
+      int16_t x;
+      std::memcpy(&x, bytes, 2);
+      out.text(std::to_string(int(x)));
+      return;
+    }
+    case ExtraAttribute::ComponentType::kUint16: {
+      uint16_t x;
+      std::memcpy(&x, bytes, 2);
+      out.number(uint32_t{x});
+      return;
+    }
+    case ExtraAttribute::ComponentType::kUint32: {
+      uint32_t x;
+      std::memcpy(&x, bytes, 4);
+      out.number(x);
+      return;
+    }
+    case ExtraAttribute::ComponentType::kFloat32: {
+      float x;
+      std::memcpy(&x, bytes, 4);
+      out.number(x);
+      return;
+    }
+  }
+}
+
 Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding encoding,
-                          const std::string& comment) {
+                          const std::string& comment, VertexExtras extras) {
   File file;
   if (auto status = open_for_writing(path, file); !status) return status;
   Writer out(file.get());
@@ -259,6 +341,11 @@ Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding
         "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n");
   }
   if (texcoords) out.text("property float u\nproperty float v\n");
+  for (size_t e = 0; e < extras.count(); ++e) {
+    const ExtraAttribute& attribute = (*extras.attributes)[e];
+    for (const std::string& name : ply_extra_property_names(attribute))
+      out.text(std::string("property ") + ply_type(attribute.component_type) + " " + name + "\n");
+  }
   out.text("element face " + std::to_string(mesh.face_count()) + "\n");
   out.text("property list uchar int vertex_indices\nend_header\n");
 
@@ -300,6 +387,10 @@ Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding
         out.raw(rgba, 4);
       }
       if (texcoords) out.raw(&mesh.texcoords[v], 8);
+      for (size_t e = 0; e < extras.count(); ++e) {
+        const size_t size = element_size((*extras.attributes)[e]);
+        out.raw((*extras.bytes)[e].data() + size_t(v) * size, size);
+      }
       continue;
     }
     out.numbers(mesh.positions[v]);
@@ -309,6 +400,15 @@ Status write_ply_vertices(const Mesh& mesh, const std::string& path, PlyEncoding
       for (float x : {c.x, c.y, c.z, c.w}) out.put(' '), out.number(uint32_t{to_byte(x)});
     }
     if (texcoords) out.put(' '), out.numbers(mesh.texcoords[v]);
+    for (size_t e = 0; e < extras.count(); ++e) {
+      const ExtraAttribute& attribute = (*extras.attributes)[e];
+      const size_t size = component_size(attribute.component_type);
+      const uint8_t* element = (*extras.bytes)[e].data() + size_t(v) * element_size(attribute);
+      for (uint32_t i = 0; i < attribute.components; ++i) {
+        out.put(' ');
+        write_component(out, attribute.component_type, element + i * size);
+      }
+    }
     out.put('\n');
     out.maybe_flush();
   }
@@ -471,6 +571,33 @@ Status check_mesh_output_path(const std::string& path) {
   return make_error(
       ErrorCode::kInvalidArgument,
       path + ": cannot write '." + ext + "' files (use .ply, .obj, .off, .stl, .glb or .gltf)");
+}
+
+std::vector<std::string> export_losses(const Mesh& mesh, const std::string& path) {
+  const std::string ext = lower_extension(path);
+  const bool stl = ext == "stl";
+  const bool obj = ext == "obj";
+  const bool off = ext == "off";
+  const bool ply = ext == "ply";
+  std::vector<std::string> lost;
+  if (!stl && !obj && !off && !ply) return lost;  // glTF holds everything, other names fail
+  const char* format = stl ? "STL" : obj ? "OBJ" : off ? "OFF" : "PLY";
+  if (stl && (!mesh.normals.empty() || !mesh.corner_normals.empty())) lost.push_back("normals");
+  if (stl && (!mesh.texcoords.empty() || !mesh.corner_texcoords.empty()))
+    lost.push_back("texture coordinates");
+  if ((stl || obj) && (!mesh.colors.empty() || !mesh.corner_colors.empty()))
+    lost.push_back("vertex colours");
+  if (!ply && !mesh.extra_attributes.empty()) {
+    std::string names;
+    for (const ExtraAttribute& e : mesh.extra_attributes)
+      names += (names.empty() ? "" : ", ") + e.name;
+    lost.push_back("extra attribute" + std::string(mesh.extra_attributes.size() > 1 ? "s " : " ") +
+                   names + " (" + format + " has no such attribute)");
+  }
+  if (!obj && !mesh.materials.empty())
+    lost.push_back(std::string("materials and textures (") + format +
+                   " has none: use OBJ or glTF)");
+  return lost;
 }
 
 Status write_mesh(const Mesh& mesh, const std::string& path) {

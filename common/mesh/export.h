@@ -16,8 +16,10 @@ namespace meshstream {
 enum class PlyEncoding { kBinary, kAscii };
 
 // Per-vertex formats (PLY, OFF) split seam vertices (per-corner values)
-// into copies and say so in the header comment; PLY also names what it
-// cannot store (extra attributes, materials). OBJ keeps seams (vt/vn per
+// into copies and say so in the header comment. PLY stores the extra
+// attributes (tangents, a second UV set, custom ones) as vertex properties
+// of their own type, named by ply_extra_property_names, and names what it
+// cannot store (materials and textures). OBJ keeps seams (vt/vn per
 // corner), writes usemtl groups and, beside the OBJ, STEM.mtl (Kd, d,
 // map_Kd) and the texture images (STEM_NAME.png/.jpg, original bytes).
 Status write_ply(const Mesh& mesh, const std::string& path,
@@ -47,6 +49,18 @@ std::string material_file_name(const Mesh& mesh, uint32_t material);
 std::vector<std::string> texture_file_names(const Mesh& mesh, const std::string& prefix);
 Status write_file_bytes(const std::string& path, const void* data, size_t size);
 Result<std::string> write_material_files(const Mesh& mesh, const std::string& obj_path);
+
+// The PLY vertex properties of an extra attribute: its name made one safe
+// token ("extra_" first when it is a name readers take for positions,
+// normals, colours or texture coordinates), then "_i" per component when it
+// has more than one (TANGENT -> TANGENT_0 .. TANGENT_3).
+std::vector<std::string> ply_extra_property_names(const ExtraAttribute& e);
+
+// What writing `mesh` to `path` (the format write_mesh picks by extension)
+// cannot store, one phrase each ("extra attributes TANGENT, TEXCOORD_1 (OBJ has no such
+// attribute)", "vertex colours"), for the commands' warnings: nothing is
+// dropped without a word. Empty when the format holds everything.
+std::vector<std::string> export_losses(const Mesh& mesh, const std::string& path);
 
 // By extension (any case): .ply (binary), .obj, .off, .stl (binary), .glb, .gltf.
 // kInvalidArgument for anything else (the same error as

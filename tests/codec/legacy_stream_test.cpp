@@ -11,7 +11,10 @@
 //                 vertex's in the last record): the attribute tests'
 //                 faceted cube (8 x 8 per face: per-corner normals and
 //                 texture coordinates with seams, per-vertex colours, three
-//                 materials, a TANGENT extra attribute, one PNG texture).
+//                 materials, a TANGENT extra attribute, one PNG texture);
+//   container3_v11_* the same cube at kEncoderVersion 11 (four values
+//                 records after geometry records): pinned so that a later
+//                 format keeps version-11 streams decoding.
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -133,32 +136,46 @@ uint64_t attribute_hash(const Mesh& m) {
   return h;
 }
 
-// A version-10 stream with attributes decodes, record by record and at
-// once, to the mesh (attributes, materials and texture bytes included) it
-// decoded to when written.
-TEST(LegacyStreams, VersionTenAttributesDecodeAsWhenWritten) {
-  const std::vector<uint8_t> bytes = read_sample("container3_v10_faceted_cube_attributes.hcs");
+// A stream with attributes of an earlier encoder decodes, record by record
+// and at once, to the mesh (attributes, materials and texture bytes
+// included) it decoded to when written.
+void expect_attributes_decode_as_when_written(const char* sample, uint64_t hash,
+                                              size_t values_records) {
+  const std::vector<uint8_t> bytes = read_sample(sample);
   auto index = read_stream_index(bytes);
   ASSERT_TRUE(index) << index.error().message;
   IncrementalDecoder dec;
+  size_t attribute_records = 0;
   for (const RecordEntry& r : index->records) {
     const uint64_t from = r.offset == index->payload_offset ? 0 : r.offset;
     auto fed = dec.feed(std::span<const uint8_t>(bytes).subspan(from, r.offset + r.size - from));
     ASSERT_TRUE(fed) << fed.error().message;
     ASSERT_TRUE(check_attribute_counts(dec.mesh()));
+    const auto payload = record_payload(r, {bytes.data() + r.offset, r.size});
+    attribute_records += !payload.empty() && payload[0] == kRecordAttributes;
   }
   ASSERT_TRUE(dec.finished());
-  constexpr uint64_t kHash = 0x52ce8058599d568full;
-  EXPECT_EQ(attribute_hash(dec.mesh()), kHash)
+  EXPECT_EQ(attribute_records, values_records + 2) << "base, values records, final";
+  EXPECT_EQ(attribute_hash(dec.mesh()), hash)
       << "hash 0x" << std::hex << attribute_hash(dec.mesh());
   auto whole = decode_hcs(bytes);
   ASSERT_TRUE(whole) << whole.error().message;
-  EXPECT_EQ(attribute_hash(*whole), kHash);
+  EXPECT_EQ(attribute_hash(*whole), hash);
   EXPECT_EQ(whole->materials.size(), 3u);
   ASSERT_EQ(whole->textures.size(), 1u);
   EXPECT_EQ(whole->textures[0].mime_type, "image/png");
   ASSERT_EQ(whole->extra_attributes.size(), 1u);
   EXPECT_EQ(whole->extra_attributes[0].name, "TANGENT");
+}
+
+TEST(LegacyStreams, VersionTenAttributesDecodeAsWhenWritten) {
+  expect_attributes_decode_as_when_written("container3_v10_faceted_cube_attributes.hcs",
+                                           0x52ce8058599d568full, 0);
+}
+
+TEST(LegacyStreams, VersionElevenValuesRecordsDecodeAsWhenWritten) {
+  expect_attributes_decode_as_when_written("container3_v11_faceted_cube_attributes.hcs",
+                                           0x52ce8058599d568full, 4);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "common/mesh/procedural.h"
 #include "common/mesh/texture_files.h"
 #include "common/mesh/topology.h"
+#include "tests/gltf_validator.h"
 #include "tests/test_meshes.h"
 
 namespace meshstream {
@@ -463,19 +464,6 @@ TEST(GltfImport, HostileFilesAreErrorsNamingTheReason) {
 
 // ---- The Khronos validator on our glTF output.
 
-// Runs tests/tools/gltf_validate.mjs on `path`: exit status (0: no errors)
-// and its output.
-std::pair<int, std::string> validate(const std::string& modules, const std::string& path) {
-  const std::string script = std::string(MESHSTREAM_SOURCE_DIR) + "/tests/tools/gltf_validate.mjs";
-  const std::string command = "node '" + script + "' '" + modules + "' '" + path + "' 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  std::string out;
-  char buffer[4096];
-  while (pipe && fgets(buffer, sizeof buffer, pipe)) out += buffer;
-  const int status = pipe ? ::pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
 TEST(GltfExport, KhronosValidatorFindsNoErrors) {
   const std::string modules = testing::gltf_validator_modules();
   if (modules.empty()) {
@@ -498,7 +486,7 @@ TEST(GltfExport, KhronosValidatorFindsNoErrors) {
     for (const char* extension : {".glb", ".gltf"}) {
       const std::string path = dir.file(name + extension);
       ASSERT_TRUE(write_gltf(mesh, path)) << path;
-      const auto [status, out] = validate(modules, path);
+      const auto [status, out] = testing::run_gltf_validator(modules, path);
       EXPECT_EQ(status, 0) << out;
       EXPECT_THAT(out, HasSubstr(": 0 errors")) << out;
     }

@@ -2,7 +2,9 @@
 // meshstream-client: the client's off-screen snapshot (--snapshot) of a
 // procedural textured sphere is textured (the checker's colours, not
 // grey), at the end of the stream and right after the texture's preview
-// (record 1: the first display is already textured).
+// (record 1: the first display is already textured); and what the client's
+// --out --out-format glb writes is the textured mesh and passes the Khronos
+// glTF validator.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -19,7 +21,10 @@
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/codec/texture_record.h"
+#include "common/mesh/import.h"
 #include "common/mesh/textured_sphere.h"
+#include "tests/gltf_validator.h"
+#include "tests/test_meshes.h"
 #include "tests/viewer/child_process.h"
 #include "tests/viewer/image_checks.h"
 #include "tests/viewer/saturated_pixels.h"
@@ -105,8 +110,38 @@ TEST(TexturedStream, ClientSnapshotOfATexturedSphereIsTextured) {
   EXPECT_GT(testing::saturated_total(first_hues), 256 * 256 / 16)
       << "the first texture level after the preview (record " << first_level
       << ") is textured when it arrives";
+
+  // --out DIR --out-format glb: final.glb and final.decoded.glb, textured.
+  {
+    testing::ChildProcess client;
+    EXPECT_TRUE(client.start({client_bin, address, "sphere", "--quiet", "--no-asa", "--out",
+                              (dir / "glb").string(), "--out-format", "glb"},
+                             (dir / "client.log").string()));
+    EXPECT_EQ(client.wait(60s).value_or(-1), 0);
+  }
+  EXPECT_FALSE(fs::exists(dir / "glb" / "final.ply")) << "--out-format glb writes no PLY";
+  const std::string modules = meshstream::testing::gltf_validator_modules();
+  for (const char* name : {"final.glb", "final.decoded.glb"}) {
+    const std::string path = (dir / "glb" / name).string();
+    auto back = import_mesh(path);
+    ASSERT_TRUE(back) << name << ": " << back.error().message;
+    EXPECT_EQ(back->mesh.face_count(), decoded->face_count()) << name;
+    EXPECT_EQ(back->mesh.textures.size(), 1u) << name << " carries the stream's texture";
+    EXPECT_EQ(back->mesh.textures.empty() ? std::vector<uint8_t>{} : back->mesh.textures[0].bytes,
+              decoded->textures[0].bytes)
+        << name << ": the original image bytes";
+    EXPECT_FALSE(back->mesh.texcoords.empty() && back->mesh.corner_texcoords.empty()) << name;
+    if (modules.empty()) continue;
+    const auto [status, out] = meshstream::testing::run_gltf_validator(modules, path);
+    EXPECT_EQ(status, 0) << out;
+    EXPECT_NE(out.find(": 0 errors"), std::string::npos) << out;
+  }
   std::error_code ignored;
   fs::remove_all(dir, ignored);
+  if (modules.empty())
+    GTEST_SKIP()
+        << "final.glb read back; the Khronos gltf-validator is not installed (scripts/test "
+           "installs it into build/gltf-validator; set MESHSTREAM_GLTF_VALIDATOR)";
 }
 
 }  // namespace
