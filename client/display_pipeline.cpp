@@ -10,23 +10,43 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
+// What the view options need of one decoded mesh, each O(V) or O(F): the
+// snapshot camera fitted on it and its facing sign.
+struct MeshViewFacts {
+  std::shared_ptr<const Mesh> mesh;
+  std::optional<AsaCamera> fit;
+  std::optional<float> facing_sign;
+};
+
 // The camera and tolerance of this update into the ASA options. The
 // snapshot camera is fitted on this very mesh, so the display of a record
 // does not depend on which updates were merged before it (--out files are
 // the same on any link); it is snapped (fit_camera) so that records that
 // barely move the framing do not move the camera. O(V + F): the fit and
 // the facing sign.
-AsaOptions options_with_view(const PipelineSettings& settings, const Mesh& decoded,
+// `facts` keeps both for the mesh they were computed on: a re-run without
+// new records (the viewer's camera moved, the tolerance changed) reuses
+// them instead of two more passes over a mesh that did not change.
+AsaOptions options_with_view(const PipelineSettings& settings,
+                             const std::shared_ptr<const Mesh>& decoded, MeshViewFacts& facts,
                              std::optional<AsaCamera>& camera) {
-  camera = settings.view.camera
-               ? *settings.view.camera
-               : fit_camera(decoded, settings.view.width, settings.view.height, /*snap=*/true);
+  if (facts.mesh != decoded) facts = MeshViewFacts{decoded};
+  if (settings.view.camera) {
+    camera = *settings.view.camera;
+  } else {
+    if (!facts.fit || facts.fit->width != settings.view.width ||
+        facts.fit->height != settings.view.height)
+      facts.fit = fit_camera(*decoded, settings.view.width, settings.view.height, /*snap=*/true);
+    camera = *facts.fit;
+  }
   AsaOptions options = settings.asa;
   options.view.enabled = settings.view.dependent;
   options.view.camera = *camera;
   options.view.pixel_tolerance = settings.view.pixel_tolerance;
-  if (options.view.enabled && settings.asa_enabled)
-    options.view.facing_sign = facing_sign_of(decoded);
+  if (options.view.enabled && settings.asa_enabled) {
+    if (!facts.facing_sign) facts.facing_sign = facing_sign_of(*decoded);
+    options.view.facing_sign = *facts.facing_sign;
+  }
   return options;
 }
 
@@ -107,6 +127,7 @@ void DisplayPipeline::loop() {
   bool outcome_seen = false;
   std::optional<DisplayFrame> last;      // the newest published frame
   std::optional<PipelineSettings> used;  // the settings of the last build
+  MeshViewFacts view_facts;              // of the newest decoded mesh (it holds it, as `last` does)
   while (decoded_.wait(seen_pokes, outcome_seen, std::chrono::milliseconds(200))) {
     const uint64_t pokes = decoded_.pokes();
     const bool rerun = pokes != seen_pokes;
@@ -189,7 +210,8 @@ void DisplayPipeline::loop() {
     effective.asa_enabled = effective.asa_enabled && (!complete || settings.asa_on_complete);
     const bool options_changed = !used || asa_settings_changed(effective, *used);
     used = effective;
-    const AsaOptions options = options_with_view(effective, *frame.decoded, frame.camera);
+    const AsaOptions options =
+        options_with_view(effective, frame.decoded, view_facts, frame.camera);
     auto display = builder_.build(frame.decoded, changes, effective.asa_enabled, options,
                                   options_changed || !last, info.build);
     changes.clear();
