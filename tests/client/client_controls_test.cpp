@@ -231,6 +231,21 @@ TEST_F(ClientControlsTest, NetworkNeverWaitsForASlowPipeline) {
   // Fewer frames than records: the records that arrived during a run of
   // ASA were merged into the next frame.
   EXPECT_LT(last->sequence, last->records_decoded);
+  // The complete mesh is shown as decoded, without waiting for a run of ASA
+  // on an older prefix (dropped when the last record came during one).
+  EXPECT_EQ(last->display, last->decoded);
+  EXPECT_EQ(last->records_decoded, last->records_total);
+  // Whatever was dropped, ASA asked for afterwards is exact.
+  s.pipeline->set_asa(true, settings.asa);
+  auto after = s.mailbox.wait_newer(last->sequence);
+  ASSERT_TRUE(after && after->camera);
+  AsaOptions expected = settings.asa;
+  expected.view.enabled = true;
+  expected.view.camera = *after->camera;
+  expected.view.facing_sign = facing_sign_of(*after->decoded);
+  auto full = subdivide(*after->decoded, expected);
+  ASSERT_TRUE(full);
+  EXPECT_TRUE(same_faces(*after->display, full->mesh));
 }
 
 }  // namespace
