@@ -77,7 +77,9 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                  "of them implies on); off: the decoded mesh (as --no-asa)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  app.add_option("--asa-levels", o.asa.levels, "ASA subdivision levels (0 = none)")
+  app.add_option("--asa-levels", o.asa.levels,
+                 "ASA subdivision levels (0 = none); view-dependent ASA goes only as deep as the "
+                 "screen asks, up to this")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
   app.add_option("--flatness", o.asa.flatness, "ASA flatness t: an edge is flat when t < N1.N2")

@@ -1,6 +1,9 @@
 #include "client/display_pipeline.h"
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
 
 #include "client/frame_mesh_pool.h"
 
@@ -10,23 +13,47 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
+// What the view options need of one decoded mesh, each O(V) or O(F): the
+// snapshot camera fitted on it and its facing sign.
+struct MeshViewFacts {
+  std::shared_ptr<const Mesh> mesh;
+  std::optional<AsaCamera> fit;
+  float facing_sign = 0;  // 0: not computed yet (else +1 or -1)
+};
+
 // The camera and tolerance of this update into the ASA options. The
 // snapshot camera is fitted on this very mesh, so the display of a record
 // does not depend on which updates were merged before it (--out files are
 // the same on any link); it is snapped (fit_camera) so that records that
 // barely move the framing do not move the camera. O(V + F): the fit and
 // the facing sign.
-AsaOptions options_with_view(const PipelineSettings& settings, const Mesh& decoded,
+// `facts` keeps both for the mesh they were computed on: a re-run without
+// new records (the viewer's camera moved, the tolerance changed) reuses
+// them instead of two more passes over a mesh that did not change.
+AsaOptions options_with_view(const PipelineSettings& settings,
+                             const std::shared_ptr<const Mesh>& decoded, MeshViewFacts& facts,
                              std::optional<AsaCamera>& camera) {
-  camera = settings.view.camera
-               ? *settings.view.camera
-               : fit_camera(decoded, settings.view.width, settings.view.height, /*snap=*/true);
+  if (facts.mesh != decoded) {
+    facts.mesh = decoded;
+    facts.fit.reset();
+    facts.facing_sign = 0;
+  }
+  if (settings.view.camera) {
+    camera = *settings.view.camera;
+  } else {
+    if (!facts.fit || facts.fit->width != settings.view.width ||
+        facts.fit->height != settings.view.height)
+      facts.fit = fit_camera(*decoded, settings.view.width, settings.view.height, /*snap=*/true);
+    camera = *facts.fit;
+  }
   AsaOptions options = settings.asa;
   options.view.enabled = settings.view.dependent;
   options.view.camera = *camera;
   options.view.pixel_tolerance = settings.view.pixel_tolerance;
-  if (options.view.enabled && settings.asa_enabled)
-    options.view.facing_sign = facing_sign_of(decoded);
+  if (options.view.enabled && settings.asa_enabled) {
+    if (facts.facing_sign == 0) facts.facing_sign = facing_sign_of(*decoded);
+    options.view.facing_sign = facts.facing_sign;
+  }
   return options;
 }
 
@@ -48,10 +75,44 @@ DisplayPipeline::DisplayPipeline(DecodedStream& decoded, StreamSource* client,
       mailbox_(mailbox),
       observer_(std::move(observer)),
       settings_(std::move(settings)) {
-  builder_.set_path(settings_.path);
-  builder_.set_max_faces(settings_.view.max_display_faces);
-  builder_.set_changes_exact(true);  // decoded_stream's changes come from the record deltas
+  builder_ = new_builder();
 }
+
+std::shared_ptr<DisplayBuilder> DisplayPipeline::new_builder() const {
+  auto builder = std::make_shared<DisplayBuilder>();
+  builder->set_path(settings_.path);
+  builder->set_max_faces(settings_.view.max_display_faces);
+  builder->set_changes_exact(true);  // decoded_stream's changes come from the record deltas
+  return builder;
+}
+
+bool DisplayPipeline::complete_without_asa_waiting(const PipelineSettings& settings) const {
+  uint32_t records_total;
+  {
+    std::lock_guard lock(mutex_);
+    records_total = records_total_;
+  }
+  return settings.drop_stale_asa_at_end && !settings.asa_on_complete && records_total > 0 &&
+         decoded_.records_decoded() >= records_total && decoded_.has_pending();
+}
+
+namespace {
+
+// One run of the display builder on its own thread, with everything it
+// reads and writes owned here, so that the pipeline can stop waiting for it.
+struct BuildJob {
+  std::shared_ptr<DisplayBuilder> builder;
+  std::shared_ptr<const Mesh> mesh;
+  MeshChanges changes;
+  bool asa_enabled = false, options_changed = false;
+  AsaOptions options;
+  BuildReport report;
+  std::optional<Result<DisplayMesh>> result;
+  std::mutex mutex;
+  std::condition_variable done;
+};
+
+}  // namespace
 
 DisplayPipeline::~DisplayPipeline() { stop(); }
 
@@ -107,6 +168,8 @@ void DisplayPipeline::loop() {
   bool outcome_seen = false;
   std::optional<DisplayFrame> last;      // the newest published frame
   std::optional<PipelineSettings> used;  // the settings of the last build
+  bool fresh_builder = false;            // the builder was replaced: its first build is a full one
+  MeshViewFacts view_facts;              // of the newest decoded mesh (it holds it, as `last` does)
   while (decoded_.wait(seen_pokes, outcome_seen, std::chrono::milliseconds(200))) {
     const uint64_t pokes = decoded_.pokes();
     const bool rerun = pokes != seen_pokes;
@@ -187,12 +250,60 @@ void DisplayPipeline::loop() {
       }
     }
     effective.asa_enabled = effective.asa_enabled && (!complete || settings.asa_on_complete);
-    const bool options_changed = !used || asa_settings_changed(effective, *used);
+    const bool options_changed = !used || fresh_builder || asa_settings_changed(effective, *used);
+    fresh_builder = false;
     used = effective;
-    const AsaOptions options = options_with_view(effective, *frame.decoded, frame.camera);
-    auto display = builder_.build(frame.decoded, changes, effective.asa_enabled, options,
-                                  options_changed || !last, info.build);
-    changes.clear();
+    const AsaOptions options =
+        options_with_view(effective, frame.decoded, view_facts, frame.camera);
+    std::optional<Result<DisplayMesh>> built;
+    if (effective.asa_enabled && !complete && settings.drop_stale_asa_at_end &&
+        !settings.asa_on_complete && records_total > 0) {
+      // ASA on a prefix: on a thread of its own, so that if the last record
+      // arrives meanwhile the final frame (the decoded mesh) need not wait
+      // for a result it would replace at once.
+      auto job = std::make_shared<BuildJob>();
+      job->builder = builder_;
+      job->mesh = frame.decoded;
+      job->changes = std::move(changes);
+      job->asa_enabled = effective.asa_enabled;
+      job->options_changed = options_changed || !last;
+      job->options = options;
+      std::thread([job] {
+        auto r = job->builder->build(job->mesh, job->changes, job->asa_enabled, job->options,
+                                     job->options_changed, job->report);
+        std::lock_guard lock(job->mutex);
+        job->result = std::move(r);
+        job->done.notify_all();
+      }).detach();
+      bool dropped = false;
+      {
+        std::unique_lock lock(job->mutex);
+        while (!job->result) {
+          if (job->done.wait_for(lock, std::chrono::milliseconds(5)) == std::cv_status::timeout &&
+              !job->result && complete_without_asa_waiting(settings)) {
+            dropped = true;
+            break;
+          }
+        }
+        if (!dropped) {
+          built = std::move(*job->result);
+          info.build = job->report;
+        }
+      }
+      changes.clear();
+      if (dropped) {
+        // The old builder stays with the job; the next build starts afresh
+        // (options_changed), and the final update is taken at once.
+        builder_ = new_builder();
+        fresh_builder = true;
+        continue;
+      }
+    } else {
+      built = builder_->build(frame.decoded, changes, effective.asa_enabled, options,
+                              options_changed || !last, info.build);
+      changes.clear();
+    }
+    auto& display = *built;
     if (!display) {
       decoded_.stop();
       if (client_) client_->stop();

@@ -57,6 +57,12 @@ struct PipelineSettings {
   bool asa_guided = false;
   AsaPath path = AsaPath::kAuto;
   ViewSettings view;
+  // When the last record arrives while ASA still runs on an older prefix
+  // and the complete mesh is shown as decoded (no asa_on_complete), publish
+  // the final frame at once and drop that run's result (it would be
+  // replaced at once). Off when particular records must each be shown
+  // (--out-every, --out-at, --snapshot-at).
+  bool drop_stale_asa_at_end = true;
 };
 
 class DisplayPipeline : public StreamControls {
@@ -91,6 +97,10 @@ class DisplayPipeline : public StreamControls {
 
  private:
   void loop();
+  std::shared_ptr<DisplayBuilder> new_builder() const;
+  // The stream's last record is decoded and waiting, and the complete mesh
+  // is shown without ASA: what runs now on an older prefix can be dropped.
+  bool complete_without_asa_waiting(const PipelineSettings& settings) const;
   void publish(DisplayFrame frame, const FrameInfo& info);
   void mark_finished(std::optional<Error> error);
 
@@ -98,7 +108,9 @@ class DisplayPipeline : public StreamControls {
   StreamSource* client_;
   LatestFrameMailbox& mailbox_;
   FrameObserver observer_;
-  DisplayBuilder builder_;
+  // Shared with a run of ASA that was dropped at the end (it owns the old
+  // builder and finishes on its own thread; the pipeline takes a new one).
+  std::shared_ptr<DisplayBuilder> builder_;
   GuidedAsa guided_;  // the pipeline thread's
 
   mutable std::mutex mutex_;  // guards settings_, finished_, error_, totals

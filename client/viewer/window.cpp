@@ -221,6 +221,7 @@ class ViewerLoop {
       const bool last_frame = draw_model(g);
       const PanelActions actions = draw_panel_and_swap(g, last_frame);
       apply_panel_actions(actions);
+      count_frame(frame_start);
       if (last_frame) break;
       wait_for_next_frame(frame_start, activity);
     }
@@ -473,6 +474,16 @@ class ViewerLoop {
     return actions;
   }
 
+  // What the report says of each frame: was a mesh on screen, how long
+  // the frame's own work took.
+  void count_frame(Clock::time_point frame_start) {
+    if (!has_shown_)
+      ++report_.frames_before_first_mesh;
+    else if (renderer_.triangle_count() == 0)
+      ++report_.frames_without_mesh;
+    report_.max_frame_ms = std::max(report_.max_frame_ms, ms_since(frame_start));
+  }
+
   // 4. What the panel asked for.
   void apply_panel_actions(const PanelActions& actions) {
     if (actions.asa_changed) controls_.set_asa(panel_.asa_enabled, panel_.asa);
@@ -592,6 +603,19 @@ Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,
     options.orbit_degrees_per_frame = std::strtof(env("MESHSTREAM_VIEWER_ORBIT").c_str(), nullptr);
   auto report = run_viewer_with_report(options, frames, controls);
   if (!report) return tl::unexpected(report.error());
+  if (options.orbit_degrees_per_frame != 0) {
+    // The scripted orbit is a benchmark (bench/REPORT.md, view-dependent
+    // ASA): say whether the window ever lacked a mesh and how long frames took.
+    std::fprintf(stderr,
+                 "viewer: %llu frames (mean %.1f ms, longest %.1f ms of work), %llu without a "
+                 "mesh once one was shown, %llu before the first; %llu cameras sent, %llu meshes "
+                 "uploaded (longest upload %.1f ms)\n",
+                 static_cast<unsigned long long>(report->frames_drawn), report->mean_frame_ms,
+                 report->max_frame_ms, static_cast<unsigned long long>(report->frames_without_mesh),
+                 static_cast<unsigned long long>(report->frames_before_first_mesh),
+                 static_cast<unsigned long long>(report->cameras_sent),
+                 static_cast<unsigned long long>(report->meshes_uploaded), report->max_upload_ms);
+  }
   return {};
 }
 

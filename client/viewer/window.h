@@ -33,13 +33,19 @@ struct ScriptedCommand {
 
 struct ViewerReport {
   uint64_t frames_drawn = 0;
-  uint64_t meshes_uploaded = 0;          // display meshes sent to the GPU
-  uint64_t last_sequence_shown = 0;      // DisplayFrame::sequence of the newest upload
-  double max_upload_ms = 0;              // longest single upload (normals + buffers)
-  double mean_frame_ms = 0;              // wall time per frame, including waits
-  uint64_t distance_uploads = 0;         // per-vertex distances to the final mesh shown
-  uint64_t rejected_meshes = 0;          // frames whose mesh failed validate_arrays
-  uint64_t cameras_sent = 0;             // camera moves handed to view-dependent ASA
+  uint64_t meshes_uploaded = 0;      // display meshes sent to the GPU
+  uint64_t last_sequence_shown = 0;  // DisplayFrame::sequence of the newest upload
+  double max_upload_ms = 0;          // longest single upload (normals + buffers)
+  double mean_frame_ms = 0;          // wall time per frame, including waits
+  uint64_t distance_uploads = 0;     // per-vertex distances to the final mesh shown
+  uint64_t rejected_meshes = 0;      // frames whose mesh failed validate_arrays
+  uint64_t cameras_sent = 0;         // camera moves handed to view-dependent ASA
+  // Frames drawn once a mesh had been shown but with none on the GPU (the
+  // renderer keeps the last upload, so a re-run of ASA never blanks the
+  // window), and frames drawn before the first mesh arrived.
+  uint64_t frames_without_mesh = 0;
+  uint64_t frames_before_first_mesh = 0;
+  double max_frame_ms = 0;  // longest frame's own work (input, upload, draw, swap), no waiting
   std::vector<std::string> screenshots;  // PNGs written by kScreenshot
   int final_coloring = 0;                // ColorMode at exit
   bool final_wireframe = false;

@@ -192,7 +192,7 @@ asa::LevelView IncrementalSubdivider::level0(const Mesh& input) {
 bool IncrementalSubdivider::view_region_update(const Mesh& input) {
   const uint32_t Fn = input.face_count();
   if (!validate_arrays(input)) return false;
-  if (!rebuild_level0(input)) return false;
+  if (!ensure_level0(input)) return false;
   asa::LevelView view = level0(input);
   asa::tag_feature_edges(view, options_.crease_degrees, face_normal_, feature_);
   view.feature_edge = feature_.data();
@@ -236,8 +236,20 @@ bool IncrementalSubdivider::view_region_update(const Mesh& input) {
   return false;
 }
 
-Status IncrementalSubdivider::full_update(const Mesh& input) {
-  level0_valid_ = false;
+// The level-0 state (adjacency, face normals, bent bits) of `input`: kept
+// when it is already up to date with it, else rebuilt. False as
+// rebuild_level0.
+bool IncrementalSubdivider::ensure_level0(const Mesh& input) {
+  if (!level0_valid_) return rebuild_level0(input);
+  if (options_.view.enabled && !options_.uniform && !bent_valid_) rebuild_bent(input);
+  return true;
+}
+
+Status IncrementalSubdivider::full_update(const Mesh& input, bool level0_current) {
+  // A region that grew too large leaves the level-0 state up to date with
+  // `input` (the live table equals a rebuild, tests/client/live_adjacency_
+  // test.cpp): keep it rather than rebuild the adjacency of the whole mesh.
+  level0_valid_ = level0_valid_ && level0_current;
   clear_vertex_marks();
   if (options_.view.enabled && !options_.uniform && options_.levels > 0) {
     stats_.full = false;
@@ -254,7 +266,7 @@ Status IncrementalSubdivider::full_update(const Mesh& input) {
     return done;
   }
   remember(input);
-  if (!level0_valid_) rebuild_level0(input);  // (view_region_update may have built it)
+  ensure_level0(input);  // (view_region_update may have built it)
   return {};
 }
 
@@ -802,7 +814,8 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
   for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
     stats_.attempts = attempt + 1;
     stats_.dirty_faces = grow_region(input, attempt);
-    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn) return full_update(input);
+    if (stats_.dirty_faces > incremental_.max_dirty_fraction * Fn)
+      return full_update(input, /*level0_current=*/true);
     extract_region(input);
     stats_.region_faces = region_.face_count();
     if (!subdivide_into(region_, options_, workspace_, region_result_)) {
@@ -816,7 +829,7 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
     clear_vertex_marks();
     return {};
   }
-  return full_update(input);
+  return full_update(input, /*level0_current=*/true);
 }
 
 }  // namespace meshstream

@@ -94,7 +94,8 @@ class IncrementalSubdivider {
   const AsaOptions& options() const { return options_; }
 
  private:
-  Status full_update(const Mesh& input);
+  Status full_update(const Mesh& input, bool level0_current = false);
+  bool ensure_level0(const Mesh& input);
   bool view_region_update(const Mesh& input);
   void remember(const Mesh& input);
   // The phases of update(), in order (see incremental.cpp).

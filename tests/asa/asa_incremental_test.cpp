@@ -3,6 +3,8 @@
 #include <random>
 
 #include "common/asa/incremental.h"
+#include "common/asa/view.h"
+#include "common/mesh/procedural.h"
 #include "tests/asa/asa_test_support.h"
 
 namespace meshstream {
@@ -75,6 +77,43 @@ TEST(AsaIncremental, AdaptiveAndCreasesMatchFullSubdivision) {
   o.levels = 3;
   o.flatness = 0.9f;
   run_records(asa_test::load("bunny.off"), o, 6, "bunny ASA L3");
+}
+
+// A batch of records too large for a region (many merged updates) falls
+// back to a full run that keeps the live level-0 adjacency instead of
+// rebuilding it; the single records after it are partial again, and every
+// result equals a full run, with and without a camera.
+TEST(AsaIncremental, BatchesTooLargeForARegionStayExact) {
+  const Mesh start = make_demo_mesh(8000);
+  for (bool camera : {false, true}) {
+    AsaOptions o;
+    o.levels = 2;
+    if (camera) {
+      o.view.enabled = true;
+      o.view.camera = fit_camera(start, 320, 240);
+      o.view.facing_sign = facing_sign_of(start);
+    }
+    IncrementalSubdivider inc(o);
+    ASSERT_TRUE(inc.update(start).has_value());
+    Mesh m = start;
+    std::mt19937 rng(3);
+    int partial_after_batch = 0;
+    for (int round = 0; round < 3; ++round) {
+      for (int i = 0; i < 600; ++i) insert_vertex(m, rng() % m.face_count(), 0.15f);
+      ASSERT_TRUE(inc.update(m).has_value());
+      EXPECT_GT(inc.last_update().dirty_faces, m.face_count() / 4) << "the batch fit a region";
+      EXPECT_TRUE(same_output(inc.result(), *subdivide(m, o))) << camera << " batch " << round;
+      for (int r = 0; r < 3; ++r) {
+        insert_vertex(m, rng() % m.face_count(), r % 2 ? 0.2f : -0.1f);
+        ASSERT_TRUE(inc.update(m).has_value());
+        partial_after_batch += !inc.last_update().full && inc.last_update().dirty_faces > 0 &&
+                               inc.last_update().dirty_faces < m.face_count() / 4;
+        EXPECT_TRUE(same_output(inc.result(), *subdivide(m, o)))
+            << camera << " batch " << round << " record " << r;
+      }
+    }
+    EXPECT_GT(partial_after_batch, 4) << camera;
+  }
 }
 
 TEST(AsaIncremental, ColorsFollowAndNothingChangedIsFree) {

@@ -10,6 +10,7 @@
 #include "client/decoded_stream.h"
 #include "client/display_pipeline.h"
 #include "client/stream_client.h"
+#include "common/asa/view.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
 #include "common/mesh/procedural.h"
@@ -53,7 +54,9 @@ struct Session {
 class ClientControlsTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto stream = encode_hcs(make_demo_mesh(20000));
+    EncodeOptions options;
+    options.asa_guidance = false;  // no test here follows the guidance
+    auto stream = encode_hcs(make_demo_mesh(20000), options);
     ASSERT_TRUE(stream);
     bytes_ = *stream;
     std::filesystem::create_directories(dir_ / "models");
@@ -136,6 +139,73 @@ TEST_F(ClientControlsTest, SetAsaReRunsOnTheCurrentMesh) {
   EXPECT_GT(on->display->face_count(), asked->display->face_count());
 }
 
+// The viewer's live controls (issue 16): a new camera or pixel tolerance
+// re-runs view-dependent ASA on the current mesh for that view, face for face
+// what subdivide() gives at that camera and tolerance, and the frame says
+// which camera and tolerance it was refined for.
+::testing::AssertionResult same_faces(const Mesh& a, const Mesh& b) {
+  if (a.face_count() != b.face_count())
+    return ::testing::AssertionFailure() << a.face_count() << " faces against " << b.face_count();
+  for (uint32_t f = 0; f < a.face_count(); ++f)
+    for (int i = 0; i < 3; ++i)
+      if (!(a.positions[a.triangles[f][i]] == b.positions[b.triangles[f][i]]))
+        return ::testing::AssertionFailure() << "face " << f << " corner " << i << " differs";
+  return ::testing::AssertionSuccess();
+}
+
+TEST_F(ClientControlsTest, ViewerCameraAndToleranceReRunForThatView) {
+  Server server;
+  ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache"}, dir_.path()))
+      << server.log();
+  PipelineSettings settings;  // view-dependent ASA, 1 level, tolerance 2
+  settings.asa_on_complete = true;
+  Session s(server, settings);
+  ASSERT_TRUE(s.pipeline->wait_finished());
+  auto done = s.mailbox.take_newer(0);
+  ASSERT_TRUE(done && done->final && done->camera);
+  EXPECT_EQ(done->pixel_tolerance, 2.0f);
+  EXPECT_EQ(s.pipeline->pixel_tolerance(), 2.0f);
+  const Mesh& decoded = *done->decoded;
+  auto expected_for = [&](const AsaCamera& camera, float tolerance) {
+    AsaOptions o;
+    o.view.enabled = true;
+    o.view.camera = camera;
+    o.view.pixel_tolerance = tolerance;
+    o.view.facing_sign = facing_sign_of(decoded);
+    auto r = subdivide(decoded, o);
+    EXPECT_TRUE(r.has_value());
+    return r ? r->mesh : Mesh{};
+  };
+  EXPECT_TRUE(same_faces(*done->display, expected_for(*done->camera, 2)));
+
+  // The window's camera, close up and turned: the display follows it.
+  AsaCamera close = *done->camera;
+  close.eye =
+      close.target + Vec3f{close.eye.z - close.target.z, 0.2f * (close.eye.y - close.target.y),
+                           close.target.x - close.eye.x} *
+                         0.4f;
+  s.pipeline->set_view_camera(close);
+  auto moved = s.mailbox.wait_newer(done->sequence);
+  ASSERT_TRUE(moved && moved->camera);
+  EXPECT_EQ(moved->camera->eye, close.eye);
+  EXPECT_EQ(moved->decoded, done->decoded) << "a camera move is no new record";
+  const Mesh at_close = expected_for(close, 2);
+  EXPECT_NE(at_close.face_count(), done->display->face_count()) << "the camera made no difference";
+  EXPECT_TRUE(same_faces(*moved->display, at_close));
+
+  // A coarser tolerance (the panel's slider): fewer faces, the same as subdivide().
+  s.pipeline->set_pixel_tolerance(12);
+  EXPECT_EQ(s.pipeline->pixel_tolerance(), 12.0f);
+  auto coarse = s.mailbox.wait_newer(moved->sequence);
+  ASSERT_TRUE(coarse);
+  EXPECT_EQ(coarse->pixel_tolerance, 12.0f);
+  EXPECT_LT(coarse->display->face_count(), moved->display->face_count());
+  EXPECT_TRUE(same_faces(*coarse->display, expected_for(close, 12)));
+  // A tolerance at or below 0 is ignored (the panel cannot send one).
+  s.pipeline->set_pixel_tolerance(0);
+  EXPECT_EQ(s.pipeline->pixel_tolerance(), 12.0f);
+}
+
 // Network reads never wait for ASA: with ASA far slower than the stream,
 // the network side has every record long before the pipeline is done, and
 // the pipeline shows the newest mesh, merging the records in between.
@@ -161,6 +231,21 @@ TEST_F(ClientControlsTest, NetworkNeverWaitsForASlowPipeline) {
   // Fewer frames than records: the records that arrived during a run of
   // ASA were merged into the next frame.
   EXPECT_LT(last->sequence, last->records_decoded);
+  // The complete mesh is shown as decoded, without waiting for a run of ASA
+  // on an older prefix (dropped when the last record came during one).
+  EXPECT_EQ(last->display, last->decoded);
+  EXPECT_EQ(last->records_decoded, last->records_total);
+  // Whatever was dropped, ASA asked for afterwards is exact.
+  s.pipeline->set_asa(true, settings.asa);
+  auto after = s.mailbox.wait_newer(last->sequence);
+  ASSERT_TRUE(after && after->camera);
+  AsaOptions expected = settings.asa;
+  expected.view.enabled = true;
+  expected.view.camera = *after->camera;
+  expected.view.facing_sign = facing_sign_of(*after->decoded);
+  auto full = subdivide(*after->decoded, expected);
+  ASSERT_TRUE(full);
+  EXPECT_TRUE(same_faces(*after->display, full->mesh));
 }
 
 }  // namespace

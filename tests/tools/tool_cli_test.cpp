@@ -277,6 +277,67 @@ TEST_F(ToolCli, BadBudgetsAreTheSameUsageErrorInTheToolAndTheClient) {
   EXPECT_NE(ratio.err.find("--ratio: '0.5' is out of range (a ratio CR >= 1)"), std::string::npos);
 }
 
+// Issue 16: a malformed camera or a tolerance at or below 0 is a usage
+// error (exit 2, one line naming the value) in `meshstream subdivide` and
+// the client alike; the client's display budget of 0 too. The client
+// refuses before it connects.
+TEST_F(ToolCli, BadCamerasAreTheSameUsageErrorInSubdivideAndTheClient) {
+  const std::string ply = scratch_ / "cam.ply";
+  ASSERT_EQ(run_program({tool_bin(), "generate", "icosphere", "-o", ply}, scratch_).status, 0);
+  const struct {
+    std::vector<std::string> args;
+    const char* message;
+  } cases[] = {
+      {{"--camera", "1,2,3,0,0"}, "--camera 1,2,3,0,0: expected EX,EY,EZ,TX,TY,TZ[,FOV_DEG]"},
+      {{"--camera", "1,2,3,0,0,0,45,1"}, "(6 or 7 numbers), got 8"},
+      {{"--camera", "1,2,x,0,0,0"}, "--camera 1,2,x,0,0,0: 'x' is not a number"},
+      {{"--camera", "1,1,1,1,1,1"}, "--camera 1,1,1,1,1,1: camera eye and target are the same"},
+      {{"--camera", "0,0,3,0,0,0,180"}, "field of view must be in (0, 180) degrees (got 180)"},
+      {{"--camera", "0,0,3,0,0,0,0"}, "field of view must be in (0, 180) degrees (got 0)"},
+      {{"--camera", "0,0,3,0,0,0", "--pixel-tolerance", "0"},
+       "--pixel-tolerance 0: must be above 0"},
+      {{"--camera", "0,0,3,0,0,0", "--pixel-tolerance", "-2"},
+       "--pixel-tolerance -2: must be above 0"},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> tool{tool_bin(), "subdivide", ply, "-o", scratch_ / "cam_out.ply"};
+    tool.insert(tool.end(), c.args.begin(), c.args.end());
+    const Ran sub = run_program(tool, scratch_);
+    EXPECT_EQ(sub.status, 2) << c.args[1] << ": " << sub.err;
+    EXPECT_EQ(lines_of(sub.err).size(), 1u) << sub.err;
+    EXPECT_NE(sub.err.find(c.message), std::string::npos) << sub.err;
+    std::vector<std::string> client{client_bin(), "127.0.0.1:9", "demo"};
+    client.insert(client.end(), c.args.begin(), c.args.end());
+    const Ran cl = run_program(client, scratch_);
+    EXPECT_EQ(cl.status, 2) << c.args[1] << ": " << cl.err;
+    EXPECT_EQ(lines_of(cl.err).size(), 1u) << cl.err;
+    EXPECT_NE(cl.err.find(c.message), std::string::npos) << cl.err;
+  }
+  const Ran budget =
+      run_program({client_bin(), "127.0.0.1:9", "demo", "--max-display-faces", "0"}, scratch_);
+  EXPECT_EQ(budget.status, 2);
+  EXPECT_NE(budget.err.find("--max-display-faces 0: must be at least 1"), std::string::npos)
+      << budget.err;
+  const Ran tolerance =
+      run_program({client_bin(), "127.0.0.1:9", "demo", "--pixel-tolerance", "0"}, scratch_);
+  EXPECT_EQ(tolerance.status, 2);
+  EXPECT_NE(tolerance.err.find("--pixel-tolerance 0: must be above 0"), std::string::npos)
+      << tolerance.err;
+  const Ran both = run_program(
+      {client_bin(), "127.0.0.1:9", "demo", "--view-independent", "--camera", "0,0,3,0,0,0"},
+      scratch_);
+  EXPECT_EQ(both.status, 2);
+  EXPECT_NE(both.err.find("--view-independent"), std::string::npos) << both.err;
+  // A good camera works: subdivide refines for it.
+  const Ran good = run_program({tool_bin(), "subdivide", ply, "-o", scratch_ / "cam_out.ply",
+                                "--camera", "0,0,3,0,0,0,40", "--pixel-tolerance", "0.5"},
+                               scratch_);
+  EXPECT_EQ(good.status, 0) << good.err;
+  EXPECT_NE(good.out.find("camera 0,0,3,0,0,0,40 at 1024x768, pixel tolerance 0.5"),
+            std::string::npos)
+      << good.out;
+}
+
 // What one program accepts the other accepts, and both stop on the same
 // record: the client over the wire, the tool on the file.
 TEST_F(ToolCli, GoodBudgetsStopTheToolAndTheClientOnTheSameRecord) {

@@ -143,6 +143,10 @@ TEST_F(WindowTest, DrawsFramesWhileAStreamArrivesAndExitsCleanly) {
     EXPECT_EQ(report->last_sequence_shown, 4u) << "the final frame was missed";
   }
   EXPECT_EQ(controls.set_asa_calls, 0) << "no one touched the panel";
+  // Once a mesh is up, every frame draws one; the frames before it are counted apart.
+  EXPECT_EQ(report->frames_without_mesh, 0u);
+  EXPECT_LT(report->frames_before_first_mesh, report->frames_drawn);
+  EXPECT_GT(report->max_frame_ms, 0.0);
 
   // The window really showed a mesh: its last frame is not blank.
   auto image = read_png(options.exit_screenshot);
