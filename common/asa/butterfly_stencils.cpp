@@ -39,8 +39,9 @@
 
 namespace meshstream::asa {
 
-void ButterflyWeights::configure(float tension) {
+void ButterflyWeights::configure(float tension, bool bound_offsets) {
   tension_ = tension;
+  bound_offsets_ = bound_offsets;
   table_.clear();
   offset_.clear();
 }
