@@ -5,7 +5,7 @@
 // be farther than 9/8 of its edge's length from the input surface. Checked
 // on meshes with boundaries, holes, slivers, a stray vertex (what a bad scan
 // or a repair leaves) and on small real ones; and without the bound the
-// stray vertex does make a spike, so the check can fail.
+// stray vertex, crank and mask do make spikes, so the check can fail.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -186,6 +186,33 @@ TEST(AsaSpikes, RealMeshesWithBoundariesHolesAndRepairsStayWithinTheBound) {
       continue;
     }
     EXPECT_LE(worst_ratio(imported->mesh, true, name), 1.0 + 1e-5) << name;
+  }
+}
+
+// On real meshes too the plain rules make spikes and the bound removes them:
+// crank (a CAD part with slivers, repaired duplicate faces and non-manifold
+// edges) and mask (an open surface) at the old fixed default, one level.
+TEST(AsaSpikes, RealMeshesSpikeWithoutTheBoundAndNotWithIt) {
+  MESHSTREAM_REQUIRE_TEST_MESHES();
+  for (const auto& [name, spike] : {std::pair<const char*, double>{"crank.off", 10.0},
+                                    std::pair<const char*, double>{"mask.off", 1.2}}) {
+    auto imported = import_mesh(::meshstream::testing::test_mesh(name));
+    ASSERT_TRUE(imported) << name << ": " << imported.error().message;
+    const Mesh& mesh = imported->mesh;
+    AsaOptions o;
+    o.bound_offsets = false;
+    auto plain = subdivide(mesh, o);
+    o.bound_offsets = true;
+    auto bounded = subdivide(mesh, o);
+    ASSERT_TRUE(plain && bounded) << name;
+    const Spike without = worst_spike(mesh, plain->mesh);
+    const Spike with = worst_spike(mesh, bounded->mesh);
+    // Without: a vertex many times farther out than its edge allows
+    // (crank: 72x, mask: 1.4x when written).
+    EXPECT_GT(without.ratio(), spike) << name;
+    EXPECT_LE(with.distance, with.allowed * (1 + 1e-5) + 1e-7)
+        << name << ": vertex " << with.vertex << " is " << with.distance
+        << " from the surface, its edge allows " << with.allowed;
   }
 }
 
