@@ -221,8 +221,8 @@ inline bool extreme_valence(const LevelView& m, uint32_t v) {
   return m.valence[v] < kFewestRegularFaces || m.valence[v] > kMostRegularFaces;
 }
 
-// sin(theta / 2) * L / (sqrt(3) d) for faces f, g (centroids times 3:
-// d = |3 c_f - 3 c_g| / 3).
+// sin(theta / 2) * max(1, L / (sqrt(3) d)) for faces f, g, d the distance
+// of their centroids (stored times 3: d = |3 c_f - 3 c_g| / 3).
 inline float scaled_sin_half(const BoundFace& f, const BoundFace& g, float edge_length) {
   const float sin_half = length(f.normal - g.normal) * 0.5f;
   const float d = length(f.centroid - g.centroid) * (1.0f / 3.0f);
