@@ -20,11 +20,14 @@
 // Writes bench/report/fidelity.md (or DIR/fidelity.md with --report-dir DIR).
 // Usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply]
 //                       [--margin M] [--groups-per-octave G] [--guidance-samples N]
-//                       [--guidance-only]
+//                       [--guidance-only] [--ratios 20,10] [--spikes]
 //   --margin, --groups-per-octave: the guidance's AsaGuidanceOptions (the
 //   encoder's defaults otherwise), to measure what they change.
 //   --guidance-only: no pictures, only the guidance's choices and its cost.
 //   --quick: fandisk, casting and hemisphere only (about 40 s of CPU).
+//   --ratios: only these compression ratios.
+//   --spikes: the variants of the offset bound (issue 20 point 3): auto and
+//   the old default with and without it, crease detection at t 0.85.
 // MESHSTREAM_FIDELITY_PNG_DIR=DIR also writes the default-view pictures there.
 #include <algorithm>
 #include <chrono>
@@ -56,8 +59,8 @@ namespace fs = std::filesystem;
 
 constexpr int kWidth = 640;
 constexpr int kHeight = 480;
-constexpr int kRatios[] = {40, 20, 10, 5};
-constexpr double kPsnrCap = 99.0;  // identical pictures
+std::vector<int> kRatios = {40, 20, 10, 5};  // --ratios replaces them
+constexpr double kPsnrCap = 99.0;            // identical pictures
 
 struct View {
   float yaw, pitch;
@@ -71,7 +74,26 @@ struct Variant {
   bool asa = true;
   AsaOptions options;
   bool guided = false;  // the stream's ASA guidance (asa_guidance.h), `--asa auto`
+  bool bound = true;    // the offset bound (AsaOptions::bound_offsets, issue 20 point 3)
 };
+
+// --spikes: the offset bound on and off for the guided and the old default
+// settings, and crease detection at the old default's t (issue 20 point 3).
+// The first three keep the roles the report gives them (plain, auto, old).
+std::vector<Variant> spike_variants() {
+  std::vector<Variant> v;
+  v.push_back({"no ASA", false, {}});
+  v.push_back({"auto (encoder-guided)", true, {}, true});
+  v.push_back({"old default (L1, t 0.85)", true, {}});
+  v.push_back({"auto, without the offset bound", true, {}, true, false});
+  v.push_back({"old default, without the offset bound", true, {}, false, false});
+  AsaOptions o;
+  o.crease_degrees = 45;
+  v.push_back({"crease 45 (t 0.85)", true, o});
+  o.crease_degrees = 60;
+  v.push_back({"crease 60 (t 0.85)", true, o});
+  return v;
+}
 
 std::vector<Variant> variants() {
   std::vector<Variant> v;
@@ -188,6 +210,7 @@ int main(int argc, char** argv) {
   AsaGuidanceOptions guidance_options;  // the encoder's defaults unless asked otherwise
   guidance_options.threads = EncodeOptions{}.threads;  // as encode_hcs passes them
   bool guidance_only = false;  // no pictures: the guidance's choices and cost
+  bool spikes = false;         // the offset bound's variants (spike_variants)
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--report-dir" && i + 1 < argc) {
@@ -210,12 +233,18 @@ int main(int argc, char** argv) {
       guidance_only = true;
     } else if (a == "--quick") {
       quick = true;
+    } else if (a == "--spikes") {
+      spikes = true;
+    } else if (a == "--ratios" && i + 1 < argc) {
+      kRatios.clear();
+      for (const std::string& r : split_commas(argv[++i])) kRatios.push_back(std::stoi(r));
     } else if (a == "--meshes" && i + 1 < argc) {
       names = split_commas(argv[++i]);
     } else if (a == "--help" || a == "-h") {
       std::printf(
           "usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply] "
-          "[--margin M] [--groups-per-octave G] [--guidance-samples N] [--guidance-only]\n");
+          "[--margin M] [--groups-per-octave G] [--guidance-samples N] [--guidance-only] "
+          "[--ratios 20,10] [--spikes]\n");
       return 0;
     } else {
       std::fprintf(stderr, "fidelity_bench: unknown argument %s\n", a.c_str());
@@ -243,7 +272,7 @@ int main(int argc, char** argv) {
   }
 
   const double t_start = now_s();
-  const std::vector<Variant> vars = variants();
+  const std::vector<Variant> vars = spikes ? spike_variants() : variants();
   std::vector<Row> rows;
   std::vector<EncodeCost> costs;
   std::vector<std::string> skipped;
@@ -351,6 +380,7 @@ int main(int argc, char** argv) {
           asa = o && *o;
           if (asa) options = **o;
         }
+        options.bound_offsets = v.bound;
         if (asa) {
           auto r = subdivide(*prefix, options);
           if (!r) {

@@ -30,6 +30,10 @@
 //   component of the Butterfly offset is kept. Curve-rule edges (boundary,
 //   crease) keep the full curve point: a normal offset alone would
 //   straighten a curved boundary.
+// * The offset bound (issue 20, no spikes; butterfly_rules.h, bound_offset):
+//   after the rule (and the projection), a point farther from the edge's
+//   midpoint than L (1/8 + sigma) (L / 8 for an irregular stencil) is pulled
+//   back to that distance. AsaOptions::bound_offsets turns it off.
 #include "common/asa/butterfly_stencils.h"
 
 #include <cmath>
@@ -39,8 +43,9 @@
 
 namespace meshstream::asa {
 
-void ButterflyWeights::configure(float tension) {
+void ButterflyWeights::configure(float tension, bool bound_offsets) {
   tension_ = tension;
+  bound_offsets_ = bound_offsets;
   table_.clear();
   offset_.clear();
 }

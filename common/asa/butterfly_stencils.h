@@ -18,7 +18,9 @@ namespace meshstream::asa {
 // costs O(K), not O(K^2).
 class ButterflyWeights {
  public:
-  void configure(float tension);
+  // bound_offsets: every new point is kept within the offset bound of
+  // butterfly_rules.h (no spikes, issue 20); off gives the plain rules.
+  void configure(float tension, bool bound_offsets = true);
   // Adds the weights of every interior (feature-free) vertex's valence.
   // O(V) plus O(K) per new valence.
   void add_valences(const uint32_t* valence, const uint8_t* vertex_features, uint32_t vertex_count);
@@ -31,12 +33,14 @@ class ButterflyWeights {
   void add(uint32_t K);
 
   float tension() const { return tension_; }
+  bool bounds_offsets() const { return bound_offsets_; }
   // s_0 .. s_{K-1} for valence K (K >= 3, added before), then the centre
   // weight at [K].
   const float* extraordinary(uint32_t K) const { return table_.data() + offset_[K]; }
 
  private:
   float tension_ = 0;
+  bool bound_offsets_ = true;
   std::vector<float> table_;
   std::vector<uint32_t> offset_;  // per valence, kNone when absent
 };

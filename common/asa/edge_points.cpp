@@ -109,23 +109,32 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
 
 // Each split edge of the centre gets its sum; an edge with two extraordinary
 // centres gets the average of both (in either arrival order: same bits).
-[[gnu::always_inline]] inline void store_centre_points(uint32_t K, const uint32_t* ids,
-                                                       const float* sx, const float* sy,
-                                                       const float* sz, uint32_t first_new,
-                                                       Vec3f* pos, EdgePointScratch& s) {
+// With `bound` (Zorin placement: the point is final here), the offset bound
+// is applied to the final point with the ring's own copy of the endpoints
+// (rules::bound_offset gives the same bits: A + B and |B - A| do not depend
+// on the order), so no scattered reads are needed for it.
+[[gnu::always_inline]] inline void store_centre_points(
+    const LevelView& m, uint32_t K, const uint32_t* ids, const uint32_t* edge_corners, Vec3f centre,
+    const float* rx, const float* ry, const float* rz, const float* sx, const float* sy,
+    const float* sz, bool bound, uint32_t first_new, Vec3f* pos, EdgePointScratch& s) {
   for (uint32_t j = 0; j < K; ++j) {
     const uint32_t id = ids[j];
     if (id == kNone) continue;
     const Vec3f sum{sx[j], sy[j], sz[j]};
     uint8_t& state = s.arrivals[id - first_new];
+    Vec3f q;
     if (state == kTwoCentres) {
       pos[id] = sum;
       state = kSecondOfTwo;
+      continue;  // final at the second centre
     } else if (state == kSecondOfTwo) {
-      pos[id] = (pos[id] + sum) * 0.5f;
+      q = (pos[id] + sum) * 0.5f;
     } else {
-      pos[id] = sum;
+      q = sum;
     }
+    if (bound)
+      q = rules::bound_offset_between(m, edge_corners[j], centre, {rx[j], ry[j], rz[j]}, q);
+    pos[id] = q;
   }
 }
 
@@ -135,8 +144,8 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
 // rules::extraordinary_point (same bits), but the K independent sums
 // vectorize.
 [[gnu::noinline]] void centre_points(const LevelView& m, const uint32_t* edge_vertex,
-                                     uint32_t first_new, const ButterflyWeights& wt, Vec3f* pos,
-                                     EdgePointScratch& s) {
+                                     uint32_t first_new, const ButterflyWeights& wt,
+                                     bool bound_here, Vec3f* pos, EdgePointScratch& s) {
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
   // Fans either come from the cache (a uniform child level: no walking) or
@@ -167,6 +176,7 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     if (s.ring.size() < need) {
       s.ring.assign(need, 0.0f);  // the padding stays zero
       s.ring_ids.resize(K);
+      s.ring_corners.resize(K);
     }
     // Layout: ring x, y, z (2K + 4 each: the ring twice, so rotations are
     // contiguous, then zero padding for the last vector), then sums x, y, z
@@ -179,6 +189,7 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     float* sy = sx + K + 4;
     float* sz = sy + K + 4;
     uint32_t* ids = s.ring_ids.data();
+    uint32_t* edge_corners = s.ring_corners.data();
     for (uint32_t j = 0; j < K; ++j) {
       if (cached) {
         x = fan[j];
@@ -191,6 +202,7 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
       ry[j] = ry[j + K] = p.y;
       rz[j] = rz[j + K] = p.z;
       ids[j] = edge_vertex[prev_corner(x)];
+      edge_corners[j] = prev_corner(x);
       if (!cached) x = next_corner(opp[nx]);
     }
     if (record) {
@@ -200,7 +212,8 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     for (uint32_t j = 2 * K; j < stride; ++j) rx[j] = ry[j] = rz[j] = 0.0f;
     const Vec3f centre = m.positions[v] * weights[K];
     sum_stencils(K, weights, centre, rx, ry, rz, sx, sy, sz);
-    store_centre_points(K, ids, sx, sy, sz, first_new, pos, s);
+    store_centre_points(m, K, ids, edge_corners, m.positions[v], rx, ry, rz, sx, sy, sz, bound_here,
+                        first_new, pos, s);
   }
 }
 
@@ -210,12 +223,13 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
 [[gnu::always_inline]] inline void first_pass_edge(const LevelView& m, uint32_t c, uint32_t id,
                                                    bool irregular_a, bool irregular_b,
                                                    const uint32_t* across, float w, bool project,
-                                                   uint32_t first_new, Vec3f* pos,
+                                                   bool bound, uint32_t first_new, Vec3f* pos,
                                                    EdgePointScratch& s) {
   const uint32_t* cv = m.corner_vertex;
   const uint8_t* fe = m.feature_edge;
   if (fe[c]) {
-    pos[id] = rules::curve_point(m, c);
+    const Vec3f q = rules::curve_point(m, c);
+    pos[id] = bound ? rules::bound_offset(m, c, q) : q;
     return;
   }
   const uint32_t o = m.opposite[c];
@@ -237,7 +251,8 @@ inline void note_centre(uint32_t v, uint32_t corner, EdgePointScratch& s) {
     } else {
       q = rules::regular_point(m, c, w);
     }
-    pos[id] = project ? rules::project_point(m, c, q) : q;
+    if (project) q = rules::project_point(m, c, q);
+    pos[id] = bound ? rules::bound_offset(m, c, q) : q;
     return;
   }
   s.arrivals[id - first_new] = irregular_a && irregular_b ? kTwoCentres : kOneCentre;
@@ -257,6 +272,7 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
   const uint32_t* opp = m.opposite;
   const uint32_t* cv = m.corner_vertex;
   const bool project = placement == EdgePlacement::kProjection;
+  const bool bound = wt.bounds_offsets();
   const float w = wt.tension();
   if (s.vertex_corner.size() < m.vertex_count) s.vertex_corner.resize(m.vertex_count, kNone);
   s.arrivals.resize(new_count);
@@ -305,16 +321,20 @@ void compute_edge_points(const LevelView& m, const uint32_t* edge_vertex, uint32
       const uint32_t o = opp[c];
       if (id == kNone || (o != kNone && o < c)) continue;
       first_pass_edge(m, c, id, irregular[cv[next_corner(c)]], irregular[cv[prev_corner(c)]],
-                      across, w, project, first_new, pos, s);
+                      across, w, project, bound, first_new, pos, s);
     }
   }
 
-  centre_points(m, edge_vertex, first_new, wt, pos, s);
+  // Zorin placement: the centres apply the bound themselves; with
+  // projection it comes after the projection, below.
+  centre_points(m, edge_vertex, first_new, wt, bound && !project, pos, s);
 
-  // Projection placement of the extraordinary edges, now that they are known.
+  // Projection placement (and then the offset bound) of the extraordinary
+  // edges, now that their points are known.
   for (const uint32_t c : s.pending) {
     const uint32_t id = edge_vertex[c];
-    pos[id] = rules::project_point(m, c, pos[id]);
+    const Vec3f q = rules::project_point(m, c, pos[id]);
+    pos[id] = bound ? rules::bound_offset(m, c, q) : q;
   }
 }
 

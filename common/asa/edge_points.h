@@ -25,6 +25,7 @@ struct EdgePointScratch {
   std::vector<uint8_t> arrivals;        // per new vertex (minus first_new): stencils still expected
   std::vector<float> ring;         // one centre's one-ring (twice over) and sums, per coordinate
   std::vector<uint32_t> ring_ids;  // new vertex on each ring edge (or kNone)
+  std::vector<uint32_t> ring_corners;  // the corner facing each ring edge
   // Fans of the extraordinary centres (corners in walk order), recorded by a
   // walk; after a uniform split the caller maps them to the child level
   // (map_fans_to_uniform_children) and the next call reads them instead of

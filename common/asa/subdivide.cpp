@@ -101,7 +101,7 @@ Status build_base_level(const Mesh& mesh, const AsaOptions& options, AsaWorkspac
   asa::faces_per_vertex(ws.corner_scratch, base.valence);
   view.valence = base.valence.data();
   view.green = nullptr;
-  ws.weights.configure(options.tension);
+  ws.weights.configure(options.tension, options.bound_offsets);
   ws.weights.add_valences(base.valence.data(), base.vertex_features.data(), V);
   return {};
 }

@@ -59,8 +59,13 @@ struct AsaOptions {
   float flatness = 0.85f;  // t: an interior edge is flat when t < N1.N2 <= 1
   bool uniform = false;    // split every triangle (classic modified Butterfly)
   ButterflyRule rule = ButterflyRule::kZorin;
-  float tension = 0.0f;             // omega of the ten-point stencil
-  float crease_degrees = 0;         // > 0: edges bending more than this stay sharp
+  float tension = 0.0f;      // omega of the ten-point stencil
+  float crease_degrees = 0;  // > 0: edges bending more than this stay sharp
+  // No spikes (issue 20): a new vertex's offset from its edge's midpoint is
+  // capped by the edge's length and the stencil's dihedral angles, and an
+  // irregular stencil gets a gentler cap (butterfly_rules.h, bound_offset).
+  // Off: the plain rules (for comparisons; no program exposes it).
+  bool bound_offsets = true;
   bool track_source_faces = false;  // fill AsaResult::source_face
   // View-dependent ASA (view.h): a bent edge is refined only where it
   // matters on screen for this camera. Off: the whole mesh, as the thesis.
