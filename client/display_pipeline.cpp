@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "client/frame_mesh_pool.h"
+#include "common/asa/approximate.h"
 
 namespace meshstream::client {
 
@@ -33,9 +34,10 @@ AsaOptions options_with_view(const PipelineSettings& settings, const Mesh& decod
 // The options differ in more than the camera and tolerance.
 bool asa_settings_changed(const PipelineSettings& a, const PipelineSettings& b) {
   const AsaOptions &x = a.asa, &y = b.asa;
-  return a.asa_enabled != b.asa_enabled || a.view.dependent != b.view.dependent ||
-         x.levels != y.levels || x.flatness != y.flatness || x.uniform != y.uniform ||
-         x.rule != y.rule || x.tension != y.tension || x.crease_degrees != y.crease_degrees;
+  return a.asa_enabled != b.asa_enabled || a.approximate != b.approximate ||
+         a.view.dependent != b.view.dependent || x.levels != y.levels || x.flatness != y.flatness ||
+         x.uniform != y.uniform || x.rule != y.rule || x.tension != y.tension ||
+         x.crease_degrees != y.crease_degrees;
 }
 
 }  // namespace
@@ -179,6 +181,7 @@ void DisplayPipeline::loop() {
       info.asa_guided = guided_.label_for(frame.records_decoded);
       const std::optional<AsaOptions> chosen = guided_.options_for(frame.records_decoded);
       effective.asa_enabled = chosen.has_value();
+      effective.approximate = guided_.approximates_for(frame.records_decoded);
       if (chosen) {
         effective.asa.levels = chosen->levels;
         effective.asa.flatness = chosen->flatness;
@@ -190,8 +193,23 @@ void DisplayPipeline::loop() {
     const bool options_changed = !used || asa_settings_changed(effective, *used);
     used = effective;
     const AsaOptions options = options_with_view(effective, *frame.decoded, frame.camera);
-    auto display = builder_.build(frame.decoded, changes, effective.asa_enabled, options,
-                                  options_changed || !last, info.build);
+    // Approximating: ASA runs on the relaxed positions. Relaxing moves the
+    // neighbours of every changed vertex too, so the decoder's changes do
+    // not describe the builder's input: a full update each time.
+    std::shared_ptr<const Mesh> asa_input = frame.decoded;
+    const bool approximate = effective.asa_enabled && effective.approximate;
+    if (approximate) {
+      auto relaxed = std::make_shared<Mesh>(*frame.decoded);
+      if (auto s = relax_toward_smooth(*relaxed, asa_choice_relax(options)); !s) {
+        decoded_.stop();
+        if (client_) client_->stop();
+        mark_finished(s.error());
+        break;
+      }
+      asa_input = std::move(relaxed);
+    }
+    auto display = builder_.build(asa_input, changes, effective.asa_enabled, options,
+                                  options_changed || !last || approximate, info.build);
     changes.clear();
     if (!display) {
       decoded_.stop();

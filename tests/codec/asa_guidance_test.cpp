@@ -73,6 +73,40 @@ TEST(AsaGuidance, EveryChoiceByteRoundTripsOrIsRefused) {
   }
 }
 
+TEST(AsaGuidance, AnApproximatingChoiceRelaxesThePrefixThenSubdividesIt) {
+  const Mesh prefix = make_icosphere(1);
+  const uint8_t interpolating = *asa_choice_of(AsaOptions{});  // L1 t0.85
+  const uint8_t approximating = *approximating_choice(interpolating);
+  EXPECT_EQ(asa_choice_label(approximating), "L1 t0.85 approximate");
+  Mesh relaxed = prefix;
+  ASSERT_TRUE(relax_toward_smooth(relaxed, asa_choice_relax(AsaOptions{})));
+  auto expected = subdivide(relaxed, AsaOptions{});
+  ASSERT_TRUE(expected);
+  std::vector<uint32_t> source;
+  auto shown = apply_asa_choice(prefix, approximating, &source);
+  ASSERT_TRUE(shown) << shown.error().message;
+  EXPECT_EQ(shown->positions, expected->mesh.positions);
+  EXPECT_EQ(shown->triangles, expected->mesh.triangles);
+  EXPECT_EQ(source.size(), shown->face_count());
+  auto plain = apply_asa_choice(prefix, interpolating);
+  ASSERT_TRUE(plain);
+  EXPECT_NE(plain->positions, shown->positions);
+  auto off = apply_asa_choice(prefix, kAsaChoiceOff);
+  ASSERT_TRUE(off);
+  EXPECT_EQ(off->positions, prefix.positions);
+  EXPECT_EQ(apply_asa_choice(prefix, 0xd0).error().code, ErrorCode::kCorrupt);
+  // In a guidance block it reads like any other choice; a byte naming no
+  // choice (here an approximating one with crease index 5) refuses the
+  // whole guidance, so the client shows the decoded mesh (guided_asa.h).
+  AsaGuidance g;
+  g.groups = {{0, approximating}, {4, kAsaChoiceOff}};
+  auto read = read_asa_guidance(header_with(g), 10);
+  ASSERT_TRUE(read && *read);
+  EXPECT_EQ((*read)->choice_for(1), approximating);
+  g.groups.front().choice = 0xd0;
+  EXPECT_EQ(read_asa_guidance(header_with(g), 10).error().code, ErrorCode::kCorrupt);
+}
+
 TEST(AsaGuidance, BlockRoundTripsAndPicksTheGroupOfAPrefix) {
   AsaGuidance g;
   g.groups = {{0, kAsaChoiceOff}, {7, 0x21}, {300, 0x01}, {999, kAsaChoiceOff}};
