@@ -20,10 +20,15 @@
 // Writes bench/report/fidelity.md (or DIR/fidelity.md with --report-dir DIR).
 // Usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply]
 //                       [--margin M] [--groups-per-octave G] [--guidance-samples N]
-//                       [--guidance-only] [--ratios 20,10] [--spikes]
+//                       [--guidance-only] [--few-variants] [--no-approximate]
+//                       [--shading-margin M] [--ratios 20,10] [--spikes]
 //   --margin, --groups-per-octave: the guidance's AsaGuidanceOptions (the
 //   encoder's defaults otherwise), to measure what they change.
 //   --guidance-only: no pictures, only the guidance's choices and its cost.
+//   --few-variants: plain, auto, the old default and the approximating
+//   option only (half the pictures).
+//   --no-approximate: the guidance without its approximating candidate.
+//   --shading-margin M: the guidance's shading margin (< 0: distance alone).
 //   --quick: fandisk, casting and hemisphere only (about 40 s of CPU).
 //   --ratios: only these compression ratios.
 //   --spikes: the variants of the offset bound (issue 20 point 3): auto and
@@ -44,6 +49,7 @@
 
 #include "bench/real_mesh_list.h"
 #include "client/viewer/offscreen.h"
+#include "common/asa/approximate.h"
 #include "common/asa/subdivide.h"
 #include "common/codec/asa_guidance.h"
 #include "common/codec/decoder.h"
@@ -73,8 +79,9 @@ struct Variant {
   std::string label;
   bool asa = true;
   AsaOptions options;
-  bool guided = false;  // the stream's ASA guidance (asa_guidance.h), `--asa auto`
-  bool bound = true;    // the offset bound (AsaOptions::bound_offsets, issue 20 point 3)
+  bool guided = false;       // the stream's ASA guidance (asa_guidance.h), `--asa auto`
+  bool approximate = false;  // relax_toward_smooth, then ASA (`--approximate`)
+  bool bound = true;         // the offset bound (AsaOptions::bound_offsets, issue 20 point 3)
 };
 
 // --spikes: the offset bound on and off for the guided and the old default
@@ -85,8 +92,12 @@ std::vector<Variant> spike_variants() {
   v.push_back({"no ASA", false, {}});
   v.push_back({"auto (encoder-guided)", true, {}, true});
   v.push_back({"old default (L1, t 0.85)", true, {}});
-  v.push_back({"auto, without the offset bound", true, {}, true, false});
-  v.push_back({"old default, without the offset bound", true, {}, false, false});
+  Variant unbounded{"auto, without the offset bound", true, {}, true};
+  unbounded.bound = false;
+  v.push_back(unbounded);
+  unbounded = {"old default, without the offset bound", true, {}};
+  unbounded.bound = false;
+  v.push_back(unbounded);
   AsaOptions o;
   o.crease_degrees = 45;
   v.push_back({"crease 45 (t 0.85)", true, o});
@@ -95,12 +106,19 @@ std::vector<Variant> spike_variants() {
   return v;
 }
 
-std::vector<Variant> variants() {
+// `few`: only what the targets need (plain, auto, old default) and the
+// approximating option: half the pictures.
+std::vector<Variant> variants(bool few) {
   std::vector<Variant> v;
   v.push_back({"no ASA", false, {}});
   v.push_back({"auto (encoder-guided)", true, {}, true});
   v.push_back({"old default (L1, t 0.85)", true, {}});
   AsaOptions o;
+  o.flatness = 0.95f;
+  o.crease_degrees = 45;
+  v.push_back({"approximate (L1 t0.95 crease45, relaxed)", true, o, false, true});
+  if (few) return v;
+  o = {};
   o.levels = 2;
   v.push_back({"levels 2", true, o});
   o = {};
@@ -211,6 +229,7 @@ int main(int argc, char** argv) {
   guidance_options.threads = EncodeOptions{}.threads;  // as encode_hcs passes them
   bool guidance_only = false;  // no pictures: the guidance's choices and cost
   bool spikes = false;         // the offset bound's variants (spike_variants)
+  bool few_variants = false;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--report-dir" && i + 1 < argc) {
@@ -227,8 +246,12 @@ int main(int argc, char** argv) {
       guidance_options.candidates.clear();
       for (const std::string& c : split_commas(argv[++i]))
         guidance_options.candidates.push_back(uint8_t(std::stoi(c, nullptr, 0)));
-    } else if (a == "--normal-weight" && i + 1 < argc) {
-      guidance_options.normal_weight = std::atof(argv[++i]);
+    } else if (a == "--shading-margin" && i + 1 < argc) {
+      guidance_options.shading_margin = std::atof(argv[++i]);
+    } else if (a == "--few-variants") {
+      few_variants = true;
+    } else if (a == "--no-approximate") {
+      guidance_options.approximate = false;
     } else if (a == "--guidance-only") {
       guidance_only = true;
     } else if (a == "--quick") {
@@ -244,7 +267,8 @@ int main(int argc, char** argv) {
       std::printf(
           "usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply] "
           "[--margin M] [--groups-per-octave G] [--guidance-samples N] [--guidance-only] "
-          "[--ratios 20,10] [--spikes]\n");
+          "[--few-variants] [--no-approximate] [--shading-margin M] [--ratios 20,10] "
+          "[--spikes]\n");
       return 0;
     } else {
       std::fprintf(stderr, "fidelity_bench: unknown argument %s\n", a.c_str());
@@ -272,7 +296,7 @@ int main(int argc, char** argv) {
   }
 
   const double t_start = now_s();
-  const std::vector<Variant> vars = spikes ? spike_variants() : variants();
+  const std::vector<Variant> vars = spikes ? spike_variants() : variants(few_variants);
   std::vector<Row> rows;
   std::vector<EncodeCost> costs;
   std::vector<std::string> skipped;
@@ -313,6 +337,9 @@ int main(int argc, char** argv) {
         std::printf(" %s %.3f n %.3f;",
                     asa_choice_label(guidance_options.candidates[k - 1]).c_str(),
                     g.rms[k] / g.rms[0], g.normal[k] / g.normal[0]);
+      if (g.approximate_rms > 0)
+        std::printf(" approximate %.3f n %.3f;", g.approximate_rms / g.rms[0],
+                    g.approximate_normal / g.normal[0]);
       std::printf("\n");
     }
     auto index = stream ? read_stream_index(*stream) : tl::unexpected(stream.error());
@@ -368,33 +395,60 @@ int main(int argc, char** argv) {
       for (const Variant& v : vars) {
         Measure m;
         Mesh shown;
-        AsaOptions options = v.options;
-        bool asa = v.asa;
+        // The choice byte shown: the guidance's, or the variant's own.
+        uint8_t choice = kAsaChoiceOff;
         if (v.guided) {
           uint32_t records = 0;
           while (records < index->records.size() &&
                  index->records[records].offset + index->records[records].size <= row.prefix_bytes)
             ++records;
-          row.choice = asa_choice_label((*guidance)->choice_for(records));
-          auto o = asa_choice_options((*guidance)->choice_for(records));
-          asa = o && *o;
-          if (asa) options = **o;
+          choice = (*guidance)->choice_for(records);
+          row.choice = asa_choice_label(choice);
         }
-        options.bound_offsets = v.bound;
+        const bool asa = v.guided ? choice != kAsaChoiceOff : v.asa;
         if (asa) {
-          auto r = subdivide(*prefix, options);
+          Result<Mesh> r = tl::unexpected(Error{ErrorCode::kInvalidArgument, "no choice byte"});
+          if (v.guided && v.bound) {
+            r = apply_asa_choice(*prefix, choice);
+          } else if (v.guided) {  // the guidance's choice with the plain rules (--spikes)
+            auto o = asa_choice_options(choice);
+            Mesh input = *prefix;
+            if (o && *o && asa_choice_approximates(choice))
+              (void)relax_toward_smooth(input, asa_choice_relax(**o));
+            if (!o || !*o) {
+              r = tl::unexpected(o ? Error{ErrorCode::kInvalidArgument, "no ASA"} : o.error());
+            } else {
+              AsaOptions plain = **o;
+              plain.bound_offsets = false;
+              if (auto s = subdivide(input, plain))
+                r = std::move(s->mesh);
+              else
+                r = tl::unexpected(s.error());
+            }
+          } else if (v.approximate) {
+            r = apply_asa_choice(*prefix, *approximating_choice(*asa_choice_of(v.options)));
+          } else if (auto s = subdivide(*prefix, [&] {
+                       AsaOptions o = v.options;
+                       o.bound_offsets = v.bound;
+                       return o;
+                     }())) {
+            r = std::move(s->mesh);
+          } else {
+            r = tl::unexpected(s.error());
+          }
           if (!r) {
             m.error = r.error().message;
             row.by_variant.push_back(m);
             continue;
           }
-          if (r->mesh.face_count() == prefix->face_count() && !row.by_variant.empty()) {
+          if (r->face_count() == prefix->face_count() && !row.by_variant.empty() &&
+              !asa_choice_approximates(choice) && !v.approximate) {
             // Nothing split: the output is the prefix itself (old vertices and
             // face order are kept), so it measures as the plain prefix.
             row.by_variant.push_back(row.by_variant.front());
             continue;
           }
-          shown = std::move(r->mesh);
+          shown = std::move(*r);
         } else {
           shown = *prefix;
         }

@@ -196,6 +196,7 @@ class StreamingRun {
     settings.asa_on_complete = o.asa_complete;
     settings.asa_guided = o.asa_guided;
     settings.asa = o.asa;
+    settings.approximate = o.approximate;
     settings.path = o.asa_path;
     settings.view.dependent = !o.view_independent;
     settings.view.camera = o.camera;

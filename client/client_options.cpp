@@ -73,8 +73,8 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   app.add_option("--asa", asa_mode,
                  "auto: the post-processing the stream's encoder measured closest to the "
                  "original for each part of the stream (none where none helped, and for streams "
-                 "without guidance); on: ASA with --asa-levels, --flatness, --rule, --crease (any "
-                 "of them implies on); off: the decoded mesh (as --no-asa)")
+                 "without guidance); on: ASA with --asa-levels, --flatness, --rule, --crease, "
+                 "--approximate (any of them implies on); off: the decoded mesh (as --no-asa)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
   app.add_option("--asa-levels", o.asa.levels,
@@ -94,6 +94,11 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
                  "(31.8 at t = 0.85) is refused: every edge ASA refines would stay sharp")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
+  app.add_flag("--approximate", o.approximate,
+               "approximating instead of interpolating: relax the decoded positions (Taubin "
+               "lambda|mu along the normals; boundaries and edges bending more than --crease, or "
+               "60 degrees, stay) before ASA, for coarse prefixes whose positions carry large "
+               "errors; implies --asa on");
   bool no_asa = false;
   app.add_flag("--no-asa", no_asa, "show the decoded mesh without ASA");
   std::string camera_text;
@@ -222,12 +227,13 @@ ParsedClientOptions parse_client_options(int argc, char** argv) {
   }
   o.asa.rule = rule == "projection" ? ButterflyRule::kProjection : ButterflyRule::kZorin;
   const bool fixed_settings = app.count("--asa-levels") + app.count("--flatness") +
-                                  app.count("--rule") + app.count("--crease") >
+                                  app.count("--rule") + app.count("--crease") +
+                                  app.count("--approximate") >
                               0;
   if (no_asa && app.count("--asa") && asa_mode != "off")
     return usage("--no-asa contradicts --asa " + asa_mode);
   if (asa_mode == "off" && fixed_settings)
-    return usage("--asa off takes no --asa-levels, --flatness, --rule or --crease");
+    return usage("--asa off takes no --asa-levels, --flatness, --rule, --crease or --approximate");
   o.asa_enabled = !no_asa && asa_mode != "off";
   o.asa_guided = o.asa_enabled && asa_mode == "auto" && !fixed_settings;
   if (o.asa_enabled) {

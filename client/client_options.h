@@ -3,7 +3,8 @@
 //   meshstream-client HOST:PORT [MODEL] | http://HOST[:PORT]/PATH/MODEL.hcs [--list] [--out DIR
 //   [--out-every N] [--out-format ply|glb]
 //     [--out-at LIST] [--overwrite]] [--asa-levels L]
-//     [--flatness T] [--rule zorin|projection] [--crease DEG] [--no-asa] [--asa-complete]
+//     [--flatness T] [--rule zorin|projection] [--crease DEG] [--approximate] [--no-asa]
+//     [--asa-complete]
 //     [--camera EX,EY,EZ,TX,TY,TZ[,FOV]] [--pixel-tolerance PX] [--view-independent]
 //     [--max-display-faces N]
 //     [--bytes N | --vertices N | --percent P | --percent-bytes P] [--json] [--view]
@@ -42,7 +43,9 @@ struct ClientOptions {
   // --asa on, or any of --asa-levels, --flatness, --rule, --crease: the
   // fixed settings in `asa`.
   bool asa_guided = true;
-  bool asa_complete = false;          // --asa-complete: ASA on the complete mesh too
+  bool asa_complete = false;  // --asa-complete: ASA on the complete mesh too
+  // --approximate: relax the decoded positions before ASA (approximate.h)
+  bool approximate = false;
   AsaOptions asa;                     // levels, flatness, rule, crease
   AsaPath asa_path = AsaPath::kAuto;  // --asa-path (benchmarks and tests)
   // View-dependent ASA (common/asa/view.h): refine for this camera (default:

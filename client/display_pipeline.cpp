@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "client/frame_mesh_pool.h"
+#include "common/asa/approximate.h"
 
 namespace meshstream::client {
 
@@ -60,9 +61,10 @@ AsaOptions options_with_view(const PipelineSettings& settings,
 // The options differ in more than the camera and tolerance.
 bool asa_settings_changed(const PipelineSettings& a, const PipelineSettings& b) {
   const AsaOptions &x = a.asa, &y = b.asa;
-  return a.asa_enabled != b.asa_enabled || a.view.dependent != b.view.dependent ||
-         x.levels != y.levels || x.flatness != y.flatness || x.uniform != y.uniform ||
-         x.rule != y.rule || x.tension != y.tension || x.crease_degrees != y.crease_degrees;
+  return a.asa_enabled != b.asa_enabled || a.approximate != b.approximate ||
+         a.view.dependent != b.view.dependent || x.levels != y.levels || x.flatness != y.flatness ||
+         x.uniform != y.uniform || x.rule != y.rule || x.tension != y.tension ||
+         x.crease_degrees != y.crease_degrees;
 }
 
 }  // namespace
@@ -242,6 +244,7 @@ void DisplayPipeline::loop() {
       info.asa_guided = guided_.label_for(frame.records_decoded);
       const std::optional<AsaOptions> chosen = guided_.options_for(frame.records_decoded);
       effective.asa_enabled = chosen.has_value();
+      effective.approximate = guided_.approximates_for(frame.records_decoded);
       if (chosen) {
         effective.asa.levels = chosen->levels;
         effective.asa.flatness = chosen->flatness;
@@ -255,6 +258,21 @@ void DisplayPipeline::loop() {
     used = effective;
     const AsaOptions options =
         options_with_view(effective, frame.decoded, view_facts, frame.camera);
+    // Approximating: ASA runs on the relaxed positions. Relaxing moves the
+    // neighbours of every changed vertex too, so the decoder's changes do
+    // not describe the builder's input: a full update each time.
+    std::shared_ptr<const Mesh> asa_input = frame.decoded;
+    const bool approximate = effective.asa_enabled && effective.approximate;
+    if (approximate) {
+      auto relaxed = std::make_shared<Mesh>(*frame.decoded);
+      if (auto s = relax_toward_smooth(*relaxed, asa_choice_relax(options)); !s) {
+        decoded_.stop();
+        if (client_) client_->stop();
+        mark_finished(s.error());
+        break;
+      }
+      asa_input = std::move(relaxed);
+    }
     std::optional<Result<DisplayMesh>> built;
     if (effective.asa_enabled && !complete && settings.drop_stale_asa_at_end &&
         !settings.asa_on_complete && records_total > 0) {
@@ -263,10 +281,10 @@ void DisplayPipeline::loop() {
       // for a result it would replace at once.
       auto job = std::make_shared<BuildJob>();
       job->builder = builder_;
-      job->mesh = frame.decoded;
+      job->mesh = asa_input;
       job->changes = std::move(changes);
       job->asa_enabled = effective.asa_enabled;
-      job->options_changed = options_changed || !last;
+      job->options_changed = options_changed || !last || approximate;
       job->options = options;
       std::thread([job] {
         auto r = job->builder->build(job->mesh, job->changes, job->asa_enabled, job->options,
@@ -299,8 +317,8 @@ void DisplayPipeline::loop() {
         continue;
       }
     } else {
-      built = builder_->build(frame.decoded, changes, effective.asa_enabled, options,
-                              options_changed || !last, info.build);
+      built = builder_->build(asa_input, changes, effective.asa_enabled, options,
+                              options_changed || !last || approximate, info.build);
       changes.clear();
     }
     auto& display = *built;

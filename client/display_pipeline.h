@@ -47,6 +47,9 @@ struct ViewSettings {
 struct PipelineSettings {
   bool asa_enabled = true;
   AsaOptions asa;  // asa.view is filled per update from `view`
+  // With ASA: relax the decoded positions first (approximate.h;
+  // --approximate, or the guidance's approximating choices).
+  bool approximate = false;
   // ASA is for a partly received model: once every record of the stream is
   // decoded, the display is the decoded mesh itself (it is then closer to
   // the original than its ASA: crank 0.118 % against 4.08 % of the diagonal),

@@ -23,6 +23,10 @@ std::optional<AsaOptions> GuidedAsa::options_for(uint32_t records) const {
   return *options;
 }
 
+bool GuidedAsa::approximates_for(uint32_t records) const {
+  return guidance_ && asa_choice_approximates(guidance_->choice_for(records));
+}
+
 std::string GuidedAsa::label_for(uint32_t records) const {
   if (!guidance_) return "off (no guidance)";
   return asa_choice_label(guidance_->choice_for(records));

@@ -22,6 +22,9 @@ class GuidedAsa {
   // The setting for a prefix of `records` records: nullopt for none (no
   // guidance, guidance refused, or the encoder chose none there).
   std::optional<AsaOptions> options_for(uint32_t records) const;
+  // Whether that setting relaxes the decoded positions first (an
+  // approximating choice, asa_guidance.h).
+  bool approximates_for(uint32_t records) const;
   // "L1 t0.85 crease45", "off", or "none (no guidance)" for events.
   std::string label_for(uint32_t records) const;
   // Why the stream's guidance was refused, once (then ""): the caller warns.

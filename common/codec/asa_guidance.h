@@ -24,6 +24,13 @@
 // bits 4-6 crease angle (none, 40, 45, 60, 75 degrees; 5-7 unused), bit 7
 // the projection rule (else Zorin). A choice whose crease angle is below
 // acos(t) (settings_check.h) is invalid: it would do nothing.
+// Approximating choices (issue 20, point 4; written since the guidance has
+// an approximating candidate): levels bits 0 and bit 7 set: the decoded
+// positions relaxed by relax_toward_smooth (approximate.h; the crease angle,
+// 60 degrees without one, as its sharp angle), then one level of Zorin ASA
+// with bits 2-6's flatness and crease angle. Older
+// readers refuse such a byte ("no levels") and so the whole guidance: they
+// show the decoded mesh, the safe default, never the ASA step alone.
 #pragma once
 
 #include <cstdint>
@@ -33,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "common/asa/approximate.h"
 #include "common/asa/subdivide.h"
 #include "common/base/result.h"
 #include "common/codec/container.h"
@@ -51,6 +59,20 @@ Result<std::optional<AsaOptions>> asa_choice_options(uint8_t choice);
 std::optional<uint8_t> asa_choice_of(const AsaOptions& options);
 // "off" or e.g. "L1 t0.85 crease45": for reports and events.
 std::string asa_choice_label(uint8_t choice);
+
+// Whether `choice` is an approximating one (relax_toward_smooth, then ASA);
+// false for off, interpolating and invalid bytes.
+bool asa_choice_approximates(uint8_t choice);
+// The approximating choice of an interpolating one-level Zorin choice (its
+// flatness and crease angle), or nullopt.
+std::optional<uint8_t> approximating_choice(uint8_t choice);
+// The relaxation an approximating choice runs before its ASA step.
+RelaxOptions asa_choice_relax(const AsaOptions& asa_step);
+// The mesh `choice` shows for `prefix`: the prefix itself (off), its ASA
+// subdivision, or the subdivision of the relaxed prefix. kCorrupt for an invalid byte; ASA's and
+// the relaxation's errors. With track_source_faces when `source_face` is given.
+Result<Mesh> apply_asa_choice(const Mesh& prefix, uint8_t choice,
+                              std::vector<uint32_t>* source_face = nullptr);
 
 struct AsaGuidanceGroup {
   uint32_t first_record = 0;  // the group's prefixes end at this record or later
@@ -97,15 +119,27 @@ struct AsaGuidanceOptions {
   // well-spread subset, the same for each candidate) and their
   // neighbourhoods, with the original's samples near them.
   uint32_t probe_faces = 4000;
-  // How much the normal deviation (1 - cos, at the original's samples)
-  // counts beside the RMS distance: a candidate's score is its RMS ratio to
-  // the plain prefix times its normal-deviation ratio to this power.
-  double normal_weight = 0;
+  // ASA must also lower the shading deviation (mean 1 - cos between the
+  // original's and the shown surface's shading normals, made as the
+  // client's renderer makes them) by this share: pictures are shaded, and
+  // distance alone can improve while the picture gets worse (casting at
+  // ratio 10: 0.92x the RMS, 1.04x the shading deviation, -0.40 dB).
+  // Negative: distance alone decides.
+  double shading_margin = 0.02;
   // Threads for the closest-point queries (0 = one per core); the choices
   // are the same for every count.
   unsigned threads = 1;
   // Called with the share of the measurement done; empty = no calls.
   std::function<void(double)> progress;
+  // Where an interpolating one-level candidate won, also try it on the
+  // relaxed prefix (its approximating choice): chosen by the same rule, and
+  // only when it is closer than that candidate by the margin too.
+  bool approximate = true;
+  // ... at groups measured at this ratio or coarser: the option is for
+  // coarse prefixes (on the 12 bench meshes it never beat its interpolating
+  // setting by the margin at any ratio, bench/REPORT.md), and the finer
+  // groups' measurements cost the most.
+  double approximate_above_ratio = 16;
   // The settings tried, as choice bytes; off is always tried.
   std::vector<uint8_t> candidates = default_candidates();
   static std::vector<uint8_t> default_candidates();
@@ -117,7 +151,9 @@ struct AsaGuidanceReport {
     uint32_t first_record = 0, measured_record = 0;
     double ratio = 0;            // of the measured prefix
     std::vector<double> rms;     // per candidate (off first), relative to the diagonal
-    std::vector<double> normal;  // per candidate (off first): mean 1 - cos of the normals
+    std::vector<double> normal;  // per candidate (off first): shading deviation (0: not measured)
+    // The winner's approximating choice, when one was measured (else 0).
+    double approximate_rms = 0, approximate_normal = 0;
     uint8_t choice = kAsaChoiceOff;
     uint32_t prefix_faces = 0;
     double seconds = 0;  // decoding up to it and measuring it

@@ -10,6 +10,8 @@
 #include <atomic>
 #include <set>
 
+#include "common/asa/approximate.h"
+#include "common/asa/subdivide.h"
 #include "common/asa/view.h"
 #include "tests/client/client_harness.h"
 
@@ -345,6 +347,28 @@ TEST_F(ClientCliTest, TheCompleteStreamIsShownAndSavedAsDecoded) {
   ASSERT_EQ(asked.status, 0) << asked.err;
   EXPECT_GT(load_ply(out / "asked/final.ply").face_count(), decoded.face_count())
       << "--asa-complete did not post-process the complete mesh";
+}
+
+// Issue 20, point 4: --approximate relaxes the decoded prefix before ASA
+// (approximate.h): final.ply is ASA of the relaxed final.decoded.ply, and
+// not the interpolating ASA of it.
+TEST_F(ClientCliTest, ApproximateRelaxesTheDecodedPrefixBeforeAsa) {
+  TempDir out;
+  const CliRun run =
+      client(fast_->address(), {"demo", "--json", "--approximate", "--view-independent",
+                                "--percent-bytes", "30", "--out", out / "a"});
+  ASSERT_EQ(run.status, 0) << run.err;
+  const Mesh decoded = load_ply(out / "a/final.decoded.ply");
+  Mesh relaxed = decoded;
+  ASSERT_TRUE(relax_toward_smooth(relaxed));
+  auto expected = subdivide(relaxed, AsaOptions{});
+  ASSERT_TRUE(expected);
+  auto interpolating = subdivide(decoded, AsaOptions{});
+  ASSERT_TRUE(interpolating);
+  const Mesh shown = load_ply(out / "a/final.ply");
+  EXPECT_TRUE(same_geometry(shown, expected->mesh));
+  EXPECT_FALSE(same_geometry(shown, interpolating->mesh));
+  EXPECT_EQ(client(fast_->address(), {"demo", "--approximate", "--asa", "off"}).status, 2);
 }
 
 // Row 6: --out into a folder with files in it is refused (exit 1, naming

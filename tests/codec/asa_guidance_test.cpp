@@ -30,7 +30,7 @@ StreamHeader header_with(const AsaGuidance& g) {
 }
 
 TEST(AsaGuidance, EveryChoiceByteRoundTripsOrIsRefused) {
-  int valid = 0;
+  int valid = 0, approximating = 0;
   for (int b = 0; b < 256; ++b) {
     const uint8_t byte = uint8_t(b);
     auto options = asa_choice_options(byte);
@@ -44,17 +44,67 @@ TEST(AsaGuidance, EveryChoiceByteRoundTripsOrIsRefused) {
       continue;
     }
     EXPECT_GE((*options)->levels, 1);
+    if (asa_choice_approximates(byte)) {
+      // One Zorin level of the same flatness and crease, then the relaxation.
+      ++approximating;
+      EXPECT_EQ((*options)->levels, 1);
+      EXPECT_EQ((*options)->rule, ButterflyRule::kZorin);
+      const auto step = asa_choice_of(**options);
+      ASSERT_TRUE(step) << b;
+      EXPECT_EQ(approximating_choice(*step), std::optional<uint8_t>(byte)) << b;
+      EXPECT_NE(asa_choice_label(byte).find("approximate"), std::string::npos);
+      continue;
+    }
     EXPECT_EQ(asa_choice_of(**options), std::optional<uint8_t>(byte)) << b;
   }
   // Off, and 3 levels x 4 flatness x 5 creases x 2 rules less the creases
-  // below acos(t): 40 degrees is below acos(0.75) = 41.4.
-  EXPECT_EQ(valid, 1 + 3 * (4 * 5 - 1) * 2);
-  EXPECT_FALSE(asa_choice_options(0x04));  // no levels, other bits set
-  EXPECT_FALSE(asa_choice_options(0x51));  // crease index 5
+  // below acos(t): 40 degrees is below acos(0.75) = 41.4; and the
+  // approximating ones: 4 flatness x 5 creases, less the same one.
+  EXPECT_EQ(approximating, 4 * 5 - 1);
+  EXPECT_EQ(valid, 1 + 3 * (4 * 5 - 1) * 2 + approximating);
+  EXPECT_FALSE(asa_choice_options(0x04));    // no levels, other bits set
+  EXPECT_FALSE(asa_choice_options(0x51));    // crease index 5
+  EXPECT_FALSE(asa_choice_options(0xd0));    // approximating, crease index 5
+  EXPECT_FALSE(approximating_choice(0x02));  // two levels: no approximating form
+  EXPECT_FALSE(approximating_choice(0x81));  // the projection rule: none either
   for (uint8_t c : AsaGuidanceOptions::default_candidates()) {
     auto o = asa_choice_options(c);
     ASSERT_TRUE(o && *o) << int(c);
   }
+}
+
+TEST(AsaGuidance, AnApproximatingChoiceRelaxesThePrefixThenSubdividesIt) {
+  const Mesh prefix = make_icosphere(1);
+  const uint8_t interpolating = *asa_choice_of(AsaOptions{});  // L1 t0.85
+  const uint8_t approximating = *approximating_choice(interpolating);
+  EXPECT_EQ(asa_choice_label(approximating), "L1 t0.85 approximate");
+  Mesh relaxed = prefix;
+  ASSERT_TRUE(relax_toward_smooth(relaxed, asa_choice_relax(AsaOptions{})));
+  auto expected = subdivide(relaxed, AsaOptions{});
+  ASSERT_TRUE(expected);
+  std::vector<uint32_t> source;
+  auto shown = apply_asa_choice(prefix, approximating, &source);
+  ASSERT_TRUE(shown) << shown.error().message;
+  EXPECT_EQ(shown->positions, expected->mesh.positions);
+  EXPECT_EQ(shown->triangles, expected->mesh.triangles);
+  EXPECT_EQ(source.size(), shown->face_count());
+  auto plain = apply_asa_choice(prefix, interpolating);
+  ASSERT_TRUE(plain);
+  EXPECT_NE(plain->positions, shown->positions);
+  auto off = apply_asa_choice(prefix, kAsaChoiceOff);
+  ASSERT_TRUE(off);
+  EXPECT_EQ(off->positions, prefix.positions);
+  EXPECT_EQ(apply_asa_choice(prefix, 0xd0).error().code, ErrorCode::kCorrupt);
+  // In a guidance block it reads like any other choice; a byte naming no
+  // choice (here an approximating one with crease index 5) refuses the
+  // whole guidance, so the client shows the decoded mesh (guided_asa.h).
+  AsaGuidance g;
+  g.groups = {{0, approximating}, {4, kAsaChoiceOff}};
+  auto read = read_asa_guidance(header_with(g), 10);
+  ASSERT_TRUE(read && *read);
+  EXPECT_EQ((*read)->choice_for(1), approximating);
+  g.groups.front().choice = 0xd0;
+  EXPECT_EQ(read_asa_guidance(header_with(g), 10).error().code, ErrorCode::kCorrupt);
 }
 
 TEST(AsaGuidance, BlockRoundTripsAndPicksTheGroupOfAPrefix) {
@@ -242,7 +292,15 @@ TEST(AsaGuidance, RealMeshesGetTheirOwnChoice) {
         any_asa = true;
         const auto& c = AsaGuidanceOptions::default_candidates();
         const size_t k = size_t(std::find(c.begin(), c.end(), row.choice) - c.begin());
-        EXPECT_LT(row.rms[k + 1], row.rms[0] * 0.98) << name << " ratio " << row.ratio;
+        if (k < c.size()) {
+          EXPECT_LT(row.rms[k + 1], row.rms[0] * 0.98) << name << " ratio " << row.ratio;
+          // ... and in how the picture is shaded (the shading margin).
+          EXPECT_LT(row.normal[k + 1], row.normal[0] * 0.98) << name << " ratio " << row.ratio;
+        } else {  // the approximating form of a candidate: closer than that too
+          ASSERT_TRUE(asa_choice_approximates(row.choice));
+          EXPECT_LT(row.approximate_rms, row.rms[0] * 0.98 * 0.98) << name;
+          EXPECT_LT(row.approximate_normal, row.normal[0] * 0.98) << name;
+        }
       }
     }
     if (std::string(name) == "bunny.off") EXPECT_TRUE(any_asa) << "a smooth scan gains from ASA";
