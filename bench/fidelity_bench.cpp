@@ -22,6 +22,7 @@
 //                       [--margin M] [--groups-per-octave G] [--guidance-samples N]
 //                       [--guidance-only] [--few-variants] [--no-approximate]
 //                       [--shading-margin M] [--ratios 20,10] [--spikes]
+//                       [--middle-only]
 //   --margin, --groups-per-octave: the guidance's AsaGuidanceOptions (the
 //   encoder's defaults otherwise), to measure what they change.
 //   --guidance-only: no pictures, only the guidance's choices and its cost.
@@ -31,6 +32,8 @@
 //   --shading-margin M: the guidance's shading margin (< 0: distance alone).
 //   --quick: fandisk, casting and hemisphere only (about 40 s of CPU).
 //   --ratios: only these compression ratios.
+//   --middle-only: the guidance measures each group at its middle prefix
+//   only (AsaGuidanceOptions::check_finest_end = false).
 //   --spikes: the variants of the offset bound (issue 20 point 3): auto and
 //   the old default with and without it, crease detection at t 0.85.
 // MESHSTREAM_FIDELITY_PNG_DIR=DIR also writes the default-view pictures there.
@@ -178,6 +181,7 @@ struct Measure {
   uint32_t faces = 0;
   double psnr = 0;  // mean over the views
   double worst_view_psnr = 0;
+  std::vector<double> view_psnr;  // per view of kViews
   double rms = 0, hausdorff = 0;  // relative to the original's diagonal
 };
 
@@ -258,6 +262,8 @@ int main(int argc, char** argv) {
       quick = true;
     } else if (a == "--spikes") {
       spikes = true;
+    } else if (a == "--middle-only") {
+      guidance_options.check_finest_end = false;
     } else if (a == "--ratios" && i + 1 < argc) {
       kRatios.clear();
       for (const std::string& r : split_commas(argv[++i])) kRatios.push_back(std::stoi(r));
@@ -268,7 +274,7 @@ int main(int argc, char** argv) {
           "usage: fidelity_bench [--report-dir DIR] [--quick] [--meshes a.off,b.ply] "
           "[--margin M] [--groups-per-octave G] [--guidance-samples N] [--guidance-only] "
           "[--few-variants] [--no-approximate] [--shading-margin M] [--ratios 20,10] "
-          "[--spikes]\n");
+          "[--spikes] [--middle-only]\n");
       return 0;
     } else {
       std::fprintf(stderr, "fidelity_bench: unknown argument %s\n", a.c_str());
@@ -340,6 +346,9 @@ int main(int argc, char** argv) {
       if (g.approximate_rms > 0)
         std::printf(" approximate %.3f n %.3f;", g.approximate_rms / g.rms[0],
                     g.approximate_normal / g.normal[0]);
+      if (g.finest_ratio > 0)
+        std::printf(" at the finest prefix (ratio %.1f): %.3f n %.3f;", g.finest_ratio,
+                    g.finest_rms_ratio, g.finest_normal_ratio);
       std::printf("\n");
     }
     auto index = stream ? read_stream_index(*stream) : tl::unexpected(stream.error());
@@ -473,6 +482,7 @@ int main(int argc, char** argv) {
           const double p = psnr_rgb((*seen)[k], (*reference)[k]);
           m.psnr += p / double(kViews.size());
           m.worst_view_psnr = std::min(m.worst_view_psnr, p);
+          m.view_psnr.push_back(p);
         }
         const SurfaceDistance d = surface_distance(*prepared_original, *prepared);
         m.rms = d.relative_rms();
@@ -540,8 +550,8 @@ int main(int argc, char** argv) {
 
   // The targets of issue 20 for the default (`--asa auto`).
   {
-    double worst_2010 = 1e9, mean_all = 0, worst_rms = 0;
-    std::string worst_at;
+    double worst_2010 = 1e9, mean_all = 0, worst_rms = 0, worst_view_2010 = 1e9;
+    std::string worst_at, worst_view_at;
     size_t n = 0;
     for (const Row& r : rows) {
       const Measure& p = r.by_variant[0];
@@ -553,6 +563,18 @@ int main(int argc, char** argv) {
       if ((r.ratio == 20 || r.ratio == 10) && gain < worst_2010) {
         worst_2010 = gain;
         worst_at = r.mesh + " at ratio " + std::to_string(r.ratio);
+      }
+      // The issue's own measure is one picture (the default view): every
+      // view must hold, not only their mean.
+      for (size_t k = 0;
+           (r.ratio == 20 || r.ratio == 10) && k < p.view_psnr.size() && k < a.view_psnr.size();
+           ++k) {
+        const double g = a.view_psnr[k] - p.view_psnr[k];
+        if (g < worst_view_2010) {
+          worst_view_2010 = g;
+          worst_view_at = r.mesh + " at ratio " + std::to_string(r.ratio) + ", view " +
+                          std::to_string(k + 1) + (k == 0 ? " (the default)" : "");
+        }
       }
       if (p.rms > 0) worst_rms = std::max(worst_rms, a.rms / p.rms);
     }
@@ -570,6 +592,9 @@ int main(int argc, char** argv) {
        << "| never more than 0.1 dB below the plain prefix at ratios 20 and 10 | worst "
        << fmt("%+.2f", worst_2010) << " dB (" << worst_at << ") | "
        << (worst_2010 >= -0.1 ? "met" : "not met") << " |\n"
+       << "| the same, in every single view (not only their mean) | worst "
+       << fmt("%+.2f", worst_view_2010) << " dB (" << worst_view_at << ") | "
+       << (worst_view_2010 >= -0.1 ? "met" : "not met") << " |\n"
        << "| mean gain at least 0.5 dB (all ratios) | " << fmt("%+.2f", mean_all) << " dB | "
        << (mean_all >= 0.5 ? "met" : "not met") << " |\n"
        << "| RMS never more than 2 % above the plain prefix's | worst " << fmt("%.3f", worst_rms)

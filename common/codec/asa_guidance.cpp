@@ -488,7 +488,7 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
 
   // Groups: runs of records in one bin, the complete stream on its own.
   struct Planned {
-    uint32_t first, measured;
+    uint32_t first, measured, last;
   };
   std::vector<Planned> planned;
   for (uint32_t i = 0; i + 1 < n;) {
@@ -499,7 +499,7 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
       if (std::abs(std::log(ratio_of(j) / middle)) < std::abs(std::log(ratio_of(best) / middle)))
         best = j;
     }
-    planned.push_back({i, best});
+    planned.push_back({i, best, j - 1});
     i = j;
   }
 
@@ -587,6 +587,35 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
       row.approximate_rms = d.rms;
       row.approximate_normal = d.normal;
       if (d.rms < to_beat && qualifies(plain, d, options)) choice = *a;
+    }
+    if (choice != kAsaChoiceOff && options.check_finest_end && p.last > p.measured) {
+      const uint64_t last_end = records[p.last].offset + records[p.last].size;
+      auto more = decoder.feed(stream.subspan(fed, last_end - fed));
+      if (!more) return tl::unexpected(more.error());
+      fed = last_end;
+      const Mesh& finest = decoder.mesh();
+      const Probes finest_probes = measure.probes(finest);
+      const Distances finest_plain = measure.measure(finest, finest_probes, nullptr);
+      AsaOptions step = **asa_choice_options(choice);
+      step.track_source_faces = true;
+      const Mesh* input = &finest;
+      Mesh relaxed;
+      if (asa_choice_approximates(choice)) {
+        relaxed = finest;
+        if (auto s = relax_toward_smooth(relaxed, asa_choice_relax(step)); !s)
+          return tl::unexpected(s.error());
+        input = &relaxed;
+      }
+      if (auto s = subdivide_into(*input, step, workspace, out); !s)
+        return tl::unexpected(s.error());
+      const Distances d = out.mesh.face_count() == finest.face_count()
+                              ? finest_plain
+                              : measure.measure(out.mesh, finest_probes, &out.source_face,
+                                                (1 - options.margin) * finest_plain.rms);
+      row.finest_ratio = ratio_of(p.last);
+      row.finest_rms_ratio = finest_plain.rms > 0 ? d.rms / finest_plain.rms : 0;
+      row.finest_normal_ratio = finest_plain.normal > 0 ? d.normal / finest_plain.normal : 0;
+      if (!qualifies(finest_plain, d, options)) choice = kAsaChoiceOff;
     }
     row.choice = choice;
     row.prefix_faces = prefix_faces;

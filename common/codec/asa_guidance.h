@@ -140,6 +140,13 @@ struct AsaGuidanceOptions {
   // setting by the margin at any ratio, bench/REPORT.md), and the finer
   // groups' measurements cost the most.
   double approximate_above_ratio = 16;
+  // A group's choice is shown at every prefix in it, down to its finest,
+  // where ASA's gain is smallest (the prefix has filled in): the winner must
+  // qualify at the group's finest prefix too, else the group gets none. One
+  // more measurement per group that chose ASA (the middle prefix alone chose
+  // ASA on casting at ratio 11, whose default view then lost 0.46 dB at
+  // ratio 10 while the finest prefix, ratio 5.6, measured a shading loss).
+  bool check_finest_end = true;
   // The settings tried, as choice bytes; off is always tried.
   std::vector<uint8_t> candidates = default_candidates();
   static std::vector<uint8_t> default_candidates();
@@ -154,6 +161,10 @@ struct AsaGuidanceReport {
     std::vector<double> normal;  // per candidate (off first): shading deviation (0: not measured)
     // The winner's approximating choice, when one was measured (else 0).
     double approximate_rms = 0, approximate_normal = 0;
+    // The winner at the group's finest prefix (check_finest_end; else 0):
+    // its ratio, and the winner's RMS and shading deviation there relative
+    // to the plain prefix's.
+    double finest_ratio = 0, finest_rms_ratio = 0, finest_normal_ratio = 0;
     uint8_t choice = kAsaChoiceOff;
     uint32_t prefix_faces = 0;
     double seconds = 0;  // decoding up to it and measuring it
