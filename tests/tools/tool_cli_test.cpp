@@ -428,5 +428,34 @@ TEST_F(ToolCli, DecodeAndGenerateWriteStlAndOff) {
   EXPECT_EQ(unknown_of_missing.status, 2) << unknown_of_missing.err;
 }
 
+// Issue 18: what a file format cannot hold is named in a warning, never
+// dropped in silence. The v11 fixture cube carries vertex colours, a
+// TANGENT side attribute and a textured material.
+TEST_F(ToolCli, DecodeNamesWhatTheOutputFormatCannotHold) {
+  const std::string cube = std::string(MESHSTREAM_SOURCE_DIR) +
+                           "/tests/codec/data/container3_v11_faceted_cube_attributes.hcs";
+  const Ran off = run_program({tool_bin(), "decode", cube, "-o", scratch_ / "cube.off"}, scratch_);
+  ASSERT_EQ(off.status, 0) << off.err;
+  EXPECT_NE(
+      off.err.find("warning: not stored: extra attribute TANGENT (OFF has no such attribute)"),
+      std::string::npos)
+      << off.err;
+  EXPECT_NE(off.err.find("warning: not stored: materials and textures"), std::string::npos)
+      << off.err;
+  const Ran obj = run_program({tool_bin(), "decode", cube, "-o", scratch_ / "cube.obj"}, scratch_);
+  ASSERT_EQ(obj.status, 0) << obj.err;
+  EXPECT_NE(obj.err.find("warning: not stored: vertex colours"), std::string::npos) << obj.err;
+  EXPECT_EQ(obj.err.find("materials"), std::string::npos) << "OBJ keeps materials: " << obj.err;
+  // PLY holds colours and the side attribute as vertex properties; only the
+  // material is lost there.
+  const Ran ply = run_program({tool_bin(), "decode", cube, "-o", scratch_ / "cube.ply"}, scratch_);
+  ASSERT_EQ(ply.status, 0) << ply.err;
+  EXPECT_EQ(ply.err.find("TANGENT"), std::string::npos) << ply.err;
+  EXPECT_EQ(ply.err.find("vertex colours"), std::string::npos) << ply.err;
+  EXPECT_NE(ply.err.find("warning: not stored: materials and textures (PLY has none"),
+            std::string::npos)
+      << ply.err;
+}
+
 }  // namespace
 }  // namespace meshstream
