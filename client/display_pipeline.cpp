@@ -273,6 +273,7 @@ void DisplayPipeline::loop() {
       }
       asa_input = std::move(relaxed);
     }
+    const bool full_update = options_changed || !last || approximate;
     std::optional<Result<DisplayMesh>> built;
     if (effective.asa_enabled && !complete && settings.drop_stale_asa_at_end &&
         !settings.asa_on_complete && records_total > 0) {
@@ -284,7 +285,7 @@ void DisplayPipeline::loop() {
       job->mesh = asa_input;
       job->changes = std::move(changes);
       job->asa_enabled = effective.asa_enabled;
-      job->options_changed = options_changed || !last || approximate;
+      job->options_changed = full_update;
       job->options = options;
       std::thread([job] {
         auto r = job->builder->build(job->mesh, job->changes, job->asa_enabled, job->options,
@@ -317,8 +318,8 @@ void DisplayPipeline::loop() {
         continue;
       }
     } else {
-      built = builder_->build(asa_input, changes, effective.asa_enabled, options,
-                              options_changed || !last || approximate, info.build);
+      built = builder_->build(asa_input, changes, effective.asa_enabled, options, full_update,
+                              info.build);
       changes.clear();
     }
     auto& display = *built;

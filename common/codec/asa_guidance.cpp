@@ -464,6 +464,19 @@ bool qualifies(const Distances& plain, const Distances& d, const AsaGuidanceOpti
   return d.normal < (1 - o.shading_margin) * plain.normal;
 }
 
+// Runs `choice` (not off) on `prefix` into `out`, source faces tracked; an
+// approximating choice relaxes a copy of the prefix first (same faces, so
+// the prefix's probes and source faces still hold).
+Status subdivide_choice_into(const Mesh& prefix, uint8_t choice, AsaWorkspace& workspace,
+                             AsaResult& out) {
+  AsaOptions step = **asa_choice_options(choice);
+  step.track_source_faces = true;
+  if (!asa_choice_approximates(choice)) return subdivide_into(prefix, step, workspace, out);
+  Mesh relaxed = prefix;
+  if (auto s = relax_toward_smooth(relaxed, asa_choice_relax(step)); !s) return s;
+  return subdivide_into(relaxed, step, workspace, out);
+}
+
 }  // namespace
 
 Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const uint8_t> stream,
@@ -575,12 +588,7 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
     // step, and a smaller difference is within the measurement's noise.
     const bool coarse = row.ratio >= options.approximate_above_ratio;
     if (auto a = options.approximate && coarse ? approximating_choice(choice) : std::nullopt) {
-      AsaOptions step = **asa_choice_options(*a);
-      step.track_source_faces = true;
-      Mesh relaxed = prefix;  // same faces: the probes and source faces hold
-      if (auto s = relax_toward_smooth(relaxed, asa_choice_relax(step)); !s)
-        return tl::unexpected(s.error());
-      if (auto s = subdivide_into(relaxed, step, workspace, out); !s)
+      if (auto s = subdivide_choice_into(prefix, *a, workspace, out); !s)
         return tl::unexpected(s.error());
       const double to_beat = (1 - options.margin) * best_rms;
       const Distances d = measure.measure(out.mesh, probes, &out.source_face, to_beat);
@@ -596,17 +604,7 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
       const Mesh& finest = decoder.mesh();
       const Probes finest_probes = measure.probes(finest);
       const Distances finest_plain = measure.measure(finest, finest_probes, nullptr);
-      AsaOptions step = **asa_choice_options(choice);
-      step.track_source_faces = true;
-      const Mesh* input = &finest;
-      Mesh relaxed;
-      if (asa_choice_approximates(choice)) {
-        relaxed = finest;
-        if (auto s = relax_toward_smooth(relaxed, asa_choice_relax(step)); !s)
-          return tl::unexpected(s.error());
-        input = &relaxed;
-      }
-      if (auto s = subdivide_into(*input, step, workspace, out); !s)
+      if (auto s = subdivide_choice_into(finest, choice, workspace, out); !s)
         return tl::unexpected(s.error());
       const Distances d = out.mesh.face_count() == finest.face_count()
                               ? finest_plain
