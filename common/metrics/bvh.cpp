@@ -121,17 +121,42 @@ uint32_t TriangleBvh::build_node(Builder& out, std::vector<uint32_t>& refs, uint
     for (uint32_t v : mesh.triangles[f]) box.grow(to_double(mesh.positions[v]));
   };
 
-  Box bounds, centroid_bounds;
-  for (uint32_t i = begin; i < end; ++i) {
-    grow_by_corners(bounds, refs[i]);
-    centroid_bounds.grow(centroids[refs[i]]);
+  Box centroid_bounds;
+  for (uint32_t i = begin; i < end; ++i) centroid_bounds.grow(centroids[refs[i]]);
+  const uint32_t count = end - begin;
+  const Vec3d extent = centroid_bounds.hi - centroid_bounds.lo;
+  int axis = 0;
+  if (extent.y > extent[axis]) axis = 1;
+  if (extent.z > extent[axis]) axis = 2;
+  const bool binned = count > kMaxLeafTriangles && depth < kSahDepthLimit && extent[axis] > 0;
+
+  // Binned SAH along the widest centroid axis. The node's bounds are its
+  // bins' union (min and max are exact: the same box as from the corners
+  // directly), so the corners are read once a level, not twice.
+  Box bounds;
+  Box bin_box[kBins];
+  uint32_t bin_count[kBins] = {};
+  const double scale = binned ? kBins / extent[axis] : 0;
+  auto bin_of = [&](uint32_t f) {
+    const double t = (centroids[f][axis] - centroid_bounds.lo[axis]) * scale;
+    return std::min<uint32_t>(kBins - 1, static_cast<uint32_t>(std::max(0.0, t)));
+  };
+  if (binned) {
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t b = bin_of(refs[i]);
+      ++bin_count[b];
+      grow_by_corners(bin_box[b], refs[i]);
+    }
+    for (uint32_t b = 0; b < kBins; ++b)
+      if (bin_count[b] > 0) bounds.grow(bin_box[b]);
+  } else {
+    for (uint32_t i = begin; i < end; ++i) grow_by_corners(bounds, refs[i]);
   }
   const Vec3d pad{inflate_, inflate_, inflate_};
   const Vec3d lo = bounds.lo - pad, hi = bounds.hi + pad;
   nodes_[index].lo = {round_down(lo.x), round_down(lo.y), round_down(lo.z)};
   nodes_[index].hi = {round_up(hi.x), round_up(hi.y), round_up(hi.z)};
 
-  const uint32_t count = end - begin;
   auto make_leaf = [&] {
     nodes_[index].first = begin;
     nodes_[index].count = count;
@@ -139,26 +164,8 @@ uint32_t TriangleBvh::build_node(Builder& out, std::vector<uint32_t>& refs, uint
   };
   if (count <= kMaxLeafTriangles) return make_leaf();
 
-  const Vec3d extent = centroid_bounds.hi - centroid_bounds.lo;
-  int axis = 0;
-  if (extent.y > extent[axis]) axis = 1;
-  if (extent.z > extent[axis]) axis = 2;
-
   uint32_t mid = begin;
-  if (depth < kSahDepthLimit && extent[axis] > 0) {
-    // Binned SAH along the widest centroid axis.
-    Box bin_box[kBins];
-    uint32_t bin_count[kBins] = {};
-    const double scale = kBins / extent[axis];
-    auto bin_of = [&](uint32_t f) {
-      const double t = (centroids[f][axis] - centroid_bounds.lo[axis]) * scale;
-      return std::min<uint32_t>(kBins - 1, static_cast<uint32_t>(std::max(0.0, t)));
-    };
-    for (uint32_t i = begin; i < end; ++i) {
-      const uint32_t b = bin_of(refs[i]);
-      ++bin_count[b];
-      grow_by_corners(bin_box[b], refs[i]);
-    }
+  if (binned) {
     double right_area[kBins];
     uint32_t right_count[kBins];
     Box acc;
