@@ -126,8 +126,9 @@ void add_encode_command(CLI::App& app, int& exit_code) {
                 "none, brings each part of the stream closest to the original; the client's "
                 "--asa auto follows it and shows a stream without it as decoded)");
   cmd->add_option("--threads", args->threads,
-                  "threads for decimation and the measurement of the candidate record "
-                  "orderings (0: one per core); the stream is the same for every count")
+                  "threads for decimation, the closest-point hierarchies and the measurement "
+                  "of the candidate record orderings (0: one per core); the stream is the same "
+                  "for every count")
       ->check(CLI::Range(0u, 1024u))
       ->capture_default_str();
   cmd->add_flag("--progress", args->progress,

@@ -321,19 +321,25 @@ struct Probes {
 // with their face normals, a hierarchy, and the sampling density.
 class GuidanceMeasure {
  public:
-  GuidanceMeasure(const Mesh& original, uint32_t samples, uint32_t probe_faces, unsigned threads)
+  GuidanceMeasure(const Mesh& original, uint32_t samples, uint32_t probe_faces, unsigned threads,
+                  const TriangleBvh* hierarchy)
       : threads_(threads), probe_faces_(std::max<uint32_t>(probe_faces, 1)) {
     samples = std::max<uint32_t>(samples, 1);
     const SurfaceSamples area = sample_surface_area(original, samples, 1);
     cell_area_ = area.area / samples;
     points_.assign(area.points.begin(), area.points.begin() + area.area_count);
-    bvh_ = TriangleBvh::build(original);
+    if (hierarchy && !hierarchy->empty()) {
+      bvh_ = hierarchy;
+    } else {
+      own_bvh_ = TriangleBvh::build(original, threads_);
+      bvh_ = &own_bvh_;
+    }
     diagonal_ = bounding_box(original).diagonal();
     normals_.resize(points_.size());
     const std::vector<Vec3f> corner = shading_corner_normals(original);
     for_each_block((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
       for (size_t i = b * kBlock; i < std::min(points_.size(), (b + 1) * kBlock); ++i) {
-        const ClosestHit hit = bvh_.closest(points_[i]);
+        const ClosestHit hit = bvh_->closest(points_[i]);
         normals_[i] = shading_normal_at(original, corner, hit.triangle, hit.point);
       }
     });
@@ -362,7 +368,7 @@ class GuidanceMeasure {
         p.kind[f] = Probes::kNeighbour;
     }
     const Mesh region = region_of(prefix, p, nullptr);
-    const TriangleBvh bvh = TriangleBvh::build(region);
+    const TriangleBvh bvh = TriangleBvh::build(region, threads_);
     std::vector<uint8_t> on_probe(points_.size(), 0);
     for_each_block((points_.size() + kBlock - 1) / kBlock, threads_, [&](size_t b) {
       uint32_t hint = TriangleBvh::kNoHint;
@@ -391,12 +397,12 @@ class GuidanceMeasure {
       if (kind_of(f) == Probes::kProbe) probed.push_back(f);
     const WeightedSamples from_shown = quadrature_samples(shown, cell_area_, probed);
     probed = {};
-    const double to_original = weighted_rms_distance(from_shown, bvh_, threads_);
+    const double to_original = weighted_rms_distance(from_shown, *bvh_, threads_);
     if (diagonal_ > 0 && to_original / diagonal_ >= give_up_at) return {to_original / diagonal_, 0};
 
     const Mesh region = probes.whole ? Mesh{} : region_of(shown, probes, source_face);
     const Mesh& target = probes.whole ? shown : region;
-    const TriangleBvh shown_bvh = TriangleBvh::build(target);
+    const TriangleBvh shown_bvh = TriangleBvh::build(target, threads_);
     const std::vector<Vec3f> corner = shading_corner_normals(target);
     const std::vector<uint32_t>& kept = probes.kept;
     const size_t blocks = (kept.size() + kBlock - 1) / kBlock;
@@ -448,8 +454,9 @@ class GuidanceMeasure {
   uint32_t probe_faces_ = 1;
   double cell_area_ = 0, diagonal_ = 0;
   std::vector<Vec3d> points_;
-  std::vector<Vec3d> normals_;  // shading normals of the original at points_
-  TriangleBvh bvh_;
+  std::vector<Vec3d> normals_;        // shading normals of the original at points_
+  const TriangleBvh* bvh_ = nullptr;  // own_bvh_ or the caller's
+  TriangleBvh own_bvh_;
   mutable std::vector<uint8_t> region_kind_;
 };
 
@@ -526,7 +533,8 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
     candidate_options.push_back(**o);
     candidate_options.back().track_source_faces = true;
   }
-  const GuidanceMeasure measure(original, options.samples, options.probe_faces, options.threads);
+  const GuidanceMeasure measure(original, options.samples, options.probe_faces, options.threads,
+                                options.original_hierarchy);
   // Progress by the bytes decoded and the measured prefixes' sizes (the
   // finer a prefix, the more its measurement costs).
   double planned_work = 0, work_done = 0;

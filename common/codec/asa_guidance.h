@@ -45,6 +45,7 @@
 #include "common/base/result.h"
 #include "common/codec/container.h"
 #include "common/mesh/mesh.h"
+#include "common/metrics/bvh.h"
 
 namespace meshstream {
 
@@ -126,9 +127,13 @@ struct AsaGuidanceOptions {
   // ratio 10: 0.92x the RMS, 1.04x the shading deviation, -0.40 dB).
   // Negative: distance alone decides.
   double shading_margin = 0.02;
-  // Threads for the closest-point queries (0 = one per core); the choices
-  // are the same for every count.
+  // Threads for the closest-point queries and the hierarchies (0 = one
+  // per core); the choices are the same for every count.
   unsigned threads = 1;
+  // A hierarchy over the original (its triangles and positions, e.g. the
+  // encoder's, refitted: TriangleBvh::refit), used instead of building
+  // one; it must outlive the call. Empty or null: built here.
+  const TriangleBvh* original_hierarchy = nullptr;
   // Called with the share of the measurement done; empty = no calls.
   std::function<void(double)> progress;
   // Where an interpolating one-level candidate won, also try it on the

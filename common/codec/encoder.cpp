@@ -96,12 +96,21 @@ std::vector<RecordOrdering> orderings_to_try(const EncodeOptions& options) {
 }
 
 // The original in grid units, for the surface-distance estimate.
-TriangleBvh grid_surface(const Mesh& mesh, const std::vector<Vec3i>& q) {
-  Mesh grid_mesh;
-  grid_mesh.triangles = mesh.triangles;
-  grid_mesh.positions.reserve(q.size());
-  for (const Vec3i& p : q) grid_mesh.positions.push_back(vec3_cast<float>(p));
-  return TriangleBvh::build(grid_mesh);
+Mesh grid_mesh(const Mesh& mesh, const std::vector<Vec3i>& q) {
+  Mesh grid;
+  grid.triangles = mesh.triangles;
+  grid.positions.reserve(q.size());
+  for (const Vec3i& p : q) grid.positions.push_back(vec3_cast<float>(p));
+  return grid;
+}
+TriangleBvh grid_surface(const Mesh& mesh, const std::vector<Vec3i>& q, unsigned threads) {
+  return TriangleBvh::build(grid_mesh(mesh, q), threads);
+}
+// `surface` (a hierarchy over the mesh's triangles in any positions)
+// moved to the grid units again: the tree over the original is built once
+// per encode and refitted for each use (the same distances as a build).
+Status to_grid_units(TriangleBvh& surface, const Mesh& mesh, const std::vector<Vec3i>& q) {
+  return surface.refit(grid_mesh(mesh, q));
 }
 
 // Granularity (docs/hcs-format.md): at least min(n / 50, 200) record
@@ -242,15 +251,29 @@ constexpr double kPrepareShare = 0.3;
 Result<size_t> measured_best(const Mesh& mesh, const QuantGrid& grid, const std::vector<Vec3i>& q,
                              const std::vector<EncodedStream>& streams, const RecordSizing& sizing,
                              bool parallel, ProgressTracker& progress,
-                             bool others_are_prefixes = false, unsigned query_threads = 1) {
+                             bool others_are_prefixes = false, unsigned query_threads = 1,
+                             TriangleBvh* hierarchy = nullptr) {
   Mesh reference;
   reference.triangles = mesh.triangles;
   reference.positions.reserve(q.size());
   for (const Vec3i& p : q) reference.positions.push_back(grid.dequantize(p));
   RdMeasureOptions measure_options;
   measure_options.threads = query_threads;
-  auto measure = RdMeasure::prepare(reference, measure_options);
+  TriangleBvh given;
+  if (hierarchy && !hierarchy->empty()) {
+    if (auto st = hierarchy->refit(reference); !st) return tl::unexpected(st.error());
+    given = std::move(*hierarchy);
+  }
+  auto measure = RdMeasure::prepare(reference, measure_options, std::move(given));
   if (!measure) return tl::unexpected(measure.error());
+  // The hierarchy goes back to the caller however the measurement ends.
+  struct GiveBack {
+    TriangleBvh* to;
+    Result<RdMeasure>& from;
+    ~GiveBack() {
+      if (to) *to = std::move(*from).take_hierarchy();
+    }
+  } give_back{hierarchy, measure};
   // About a third of the measuring is this preparation (a hierarchy over
   // the whole original); the curves share the rest.
   progress.within(kPrepareShare);
@@ -344,7 +367,8 @@ Result<std::vector<uint8_t>> with_attributes(const AttributePlan& plan, const Me
 // decimation's layers, replays, hierarchies) is freed when it returns, so
 // the guidance, measured after it, does not add to its peak.
 Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOptions& options,
-                                            EncodeReport* report) {
+                                            EncodeReport* report,
+                                            TriangleBvh* surface_out = nullptr) {
   if (auto st = check_options(options); !st) return tl::unexpected(st.error());
   // Quantize and decimate once for every candidate.
   auto grid = make_grid(mesh, options.quant_bits);
@@ -383,7 +407,16 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   TriangleBvh surface;
   if (on_prefixes ? uses_surface(orderings[0])
                   : std::any_of(orderings.begin(), orderings.end(), uses_surface))
-    surface = grid_surface(mesh, q);
+    surface = grid_surface(mesh, q, options.threads);
+  // The hierarchy over the original goes to the caller (the ASA guidance
+  // measures against the same triangles) whichever way this returns.
+  struct HandOut {
+    TriangleBvh* to;
+    TriangleBvh& from;
+    ~HandOut() {
+      if (to) *to = std::move(from);
+    }
+  } hand_out{surface_out, surface};
   const std::vector<Vec3f> input_normals = vertex_normals(q, mesh.triangles);
   auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report,
                               const std::function<void(double)>& candidate_progress,
@@ -412,6 +445,8 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
     // size; a winner other than the first is then encoded whole. One
     // encode at a time: the peak holds one replay.
     progress.stage("coding records", decimated_at, first_coded_at);
+    // (The surface the others need is built after it: built beside the
+    // first's replay, its hierarchy raised dragon_x1's peak by a quarter.)
     auto first =
         encode_candidates(encode_candidate, 1, sizing, false, report, progress.within_function());
     if (!first) return tl::unexpected(first.error());
@@ -422,23 +457,29 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
     std::vector<EncodedStream> streams;
     streams.push_back(std::move(first->streams[0]));
     if (surface.empty() && std::any_of(orderings.begin() + 1, orderings.end(), uses_surface))
-      surface = grid_surface(mesh, q);
+      surface = grid_surface(mesh, q, options.threads);
     for (size_t i = 1; i < orderings.size(); ++i) {
       auto prefix = encode_candidate(i, first->record_bytes, nullptr, {}, stop);
       if (!prefix) return tl::unexpected(prefix.error());
       streams.push_back(std::move(*prefix));
     }
-    // The measurement builds its own hierarchy over the original: the
-    // surface's goes first (and comes back for a winner that needs it).
+    // The measurement's hierarchy over the original is the surface's,
+    // refitted to the dequantized positions (and back to grid units for a
+    // winner that needs it): one build per encode.
     // One stream after the other, each measured on every thread: the peak
     // holds one decoded prefix and its hierarchy.
-    surface = TriangleBvh{};
-    auto best =
-        measured_best(mesh, *grid, q, streams, sizing, false, progress, true, options.threads);
+    auto best = measured_best(mesh, *grid, q, streams, sizing, false, progress, true,
+                              options.threads, &surface);
     if (!best) return tl::unexpected(best.error());
     if (*best == 0) return finish(streams[0]);
     progress.stage("coding the winner", measured_at, 1.0);
-    if (uses_surface(orderings[*best])) surface = grid_surface(mesh, q);
+    if (uses_surface(orderings[*best])) {
+      if (surface.empty()) {
+        surface = grid_surface(mesh, q, options.threads);
+      } else if (auto st = to_grid_units(surface, mesh, q); !st) {
+        return tl::unexpected(st.error());
+      }
+    }
     EncodeReport winner_report;
     auto winner = encode_candidate(*best, first->record_bytes, report ? &winner_report : nullptr,
                                    progress.within_function());
@@ -485,14 +526,21 @@ Result<std::vector<uint8_t>> encode_hcs(const Mesh& mesh, const EncodeOptions& o
     records_options.progress = [&options](const EncodeProgress& p) {
       if (p.stage != "done") options.progress({p.stage, p.fraction * kRecordsShare});
     };
-  auto stream = encode_records(mesh, records_options, report);
+  // The records' hierarchy over the original serves the guidance too,
+  // refitted to the original's own positions (the same distances as a
+  // hierarchy built over them).
+  TriangleBvh original_hierarchy;
+  auto stream = encode_records(mesh, records_options, report, &original_hierarchy);
   if (!stream) return stream;
+  if (!original_hierarchy.empty())
+    if (auto st = original_hierarchy.refit(mesh); !st) return tl::unexpected(st.error());
   // The ASA guidance last: it names records by their final numbers.
   ProgressTracker progress(options.progress);
   progress.stage("measuring ASA guidance", kRecordsShare, 1.0);
   AsaGuidanceOptions guidance_options;
   guidance_options.progress = progress.within_function();
   guidance_options.threads = options.threads;
+  guidance_options.original_hierarchy = &original_hierarchy;
   auto guidance = measure_asa_guidance(mesh, *stream, guidance_options);
   if (!guidance) return tl::unexpected(guidance.error());
   auto out = with_asa_guidance(*stream, *guidance);

@@ -72,7 +72,8 @@ struct EncodeOptions {
   // (docs/hcs-format.md, "Record order and size"), the others are kept for
   // experiments.
   int insertion_shift = 0;
-  // Threads: the decimation's removal costs on this many (0 = one per
+  // Threads: the decimation's removal costs, the closest-point queries and
+  // the hierarchy builds (TriangleBvh::build) on this many (0 = one per
   // core), and the automatic ordering's candidates and their measurement
   // each on its own thread unless 1 (then one after the other). The
   // stream is the same for every count.

@@ -9,9 +9,17 @@
 namespace meshstream {
 
 Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOptions& options) {
+  return prepare(original, options, TriangleBvh{});
+}
+
+Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOptions& options,
+                                     TriangleBvh hierarchy) {
   if (original.triangles.empty())
     return make_error(ErrorCode::kInvalidArgument,
                       "rate-distortion measure: mesh has no triangles");
+  if (!hierarchy.empty() && hierarchy.triangle_count() != original.face_count())
+    return make_error(ErrorCode::kInvalidArgument,
+                      "rate-distortion measure: the hierarchy is over another mesh");
   RdMeasure m;
   m.options_ = options;
   const SurfaceSamples area =
@@ -23,7 +31,8 @@ Result<RdMeasure> RdMeasure::prepare(const Mesh& original, const RdMeasureOption
   m.original_samples_.weights.assign(area.area_count,
                                      area.area / std::max<uint32_t>(area.area_count, 1));
   m.original_samples_.area = area.area;
-  m.original_bvh_ = TriangleBvh::build(original);
+  m.original_bvh_ =
+      hierarchy.empty() ? TriangleBvh::build(original, options.threads) : std::move(hierarchy);
   m.diagonal_ = bounding_box(original).diagonal();
   return m;
 }
@@ -65,7 +74,7 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
 double RdMeasure::relative_rms(const Mesh& shown) const {
   const unsigned threads = options_.threads;
   const double to_shown =
-      weighted_rms_distance(original_samples_, TriangleBvh::build(shown), threads);
+      weighted_rms_distance(original_samples_, TriangleBvh::build(shown, threads), threads);
   const double to_original =
       weighted_rms_distance(quadrature_samples(shown, cell_area_), original_bvh_, threads);
   return diagonal_ > 0 ? std::max(to_shown, to_original) / diagonal_ : 0;

@@ -56,6 +56,14 @@ class RdMeasure {
  public:
   // kInvalidArgument for a mesh without triangles. O(F log F + samples).
   static Result<RdMeasure> prepare(const Mesh& original, const RdMeasureOptions& options = {});
+  // The same with `hierarchy`, a hierarchy over `original` (its triangles
+  // and positions: TriangleBvh::refit), used instead of building one;
+  // empty: built. The measurement is the same.
+  static Result<RdMeasure> prepare(const Mesh& original, const RdMeasureOptions& options,
+                                   TriangleBvh hierarchy);
+  // The hierarchy over the original, handed back (the measure is then
+  // done with).
+  TriangleBvh take_hierarchy() && { return std::move(original_bvh_); }
 
   // Decodes `stream` at the budgets (fractions of `reference_bytes`, the
   // same for every candidate so their curves are compared at equal bytes)

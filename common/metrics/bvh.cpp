@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
+#include <string>
+#include <thread>
 
 #include "common/metrics/closest_point.h"
 
@@ -39,34 +42,59 @@ struct Box {
   }
 };
 
+// A subtree this large is worth a thread of its own.
+constexpr uint32_t kSpawnTriangles = 1u << 15;
+
+// Rounded outwards to floats: a node's stored bounds.
+float round_down(double x) {
+  float f = static_cast<float>(x);
+  return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float round_up(double x) {
+  float f = static_cast<float>(x);
+  return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+// A computed closest point may stray from its triangle by a few units in
+// the last place of the largest coordinate; boxes grown by far more than
+// that keep squared_distance_to_box a true lower bound after rounding.
+double inflation_for(const Mesh& mesh) {
+  double max_abs = 0;
+  for (const Triangle& t : mesh.triangles)
+    for (uint32_t v : t)
+      for (int i = 0; i < 3; ++i)
+        max_abs = std::max(max_abs, std::abs(double(mesh.positions[v][i])));
+  return 1e-12 * max_abs;
+}
+
 }  // namespace
 
-TriangleBvh TriangleBvh::build(const Mesh& mesh) {
+TriangleBvh TriangleBvh::build(const Mesh& mesh, unsigned threads) {
   TriangleBvh bvh;
   const uint32_t n = mesh.face_count();
   if (n == 0) return bvh;
   // Corner bounds are read from the mesh as needed (no copy of the corners:
   // it was the largest array of the build).
   std::vector<Vec3d> centroids(n);
-  double max_abs = 0;
   for (uint32_t f = 0; f < n; ++f) {
     std::array<Vec3d, 3> c;
-    for (int k = 0; k < 3; ++k) {
-      c[k] = to_double(mesh.positions[mesh.triangles[f][k]]);
-      for (int i = 0; i < 3; ++i) max_abs = std::max(max_abs, std::abs(c[k][i]));
-    }
+    for (int k = 0; k < 3; ++k) c[k] = to_double(mesh.positions[mesh.triangles[f][k]]);
     centroids[f] = (c[0] + c[1] + c[2]) * (1.0 / 3.0);
   }
-  // A computed closest point may stray from its triangle by a few units in
-  // the last place of the largest coordinate; boxes grown by far more than
-  // that keep squared_distance_to_box a true lower bound after rounding.
-  bvh.inflate_ = 1e-12 * max_abs;
+  bvh.inflate_ = inflation_for(mesh);
 
   std::vector<uint32_t> refs(n);
   for (uint32_t f = 0; f < n; ++f) refs[f] = f;
-  bvh.nodes_.reserve(2 * n / kMaxLeafTriangles + 1);
-  bvh.build_node(refs, 0, n, 0, mesh, centroids);
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  // Two levels of subtrees on their own threads for two or more threads
+  // (four subtrees keep two cores busy when the splits are uneven).
+  const uint32_t spawn_levels = threads > 1 ? 2 : 0;
+  Builder out;
+  out.nodes.reserve(2 * n / kMaxLeafTriangles + 1);
+  bvh.build_node(out, refs, 0, n, 0, mesh, centroids, spawn_levels);
   centroids = {};
+  bvh.nodes_ = std::move(out.nodes);
+  bvh.depth_ = out.depth;
   // Leaves hold 1..kMaxLeafTriangles triangles, so the reserve above is
   // often outgrown (doubling the array): keep only what the tree uses.
   bvh.nodes_.shrink_to_fit();
@@ -82,35 +110,53 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh) {
   return bvh;
 }
 
-uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, uint32_t end,
-                                 uint32_t depth, const Mesh& mesh,
-                                 const std::vector<Vec3d>& centroids) {
-  depth_ = std::max(depth_, depth + 1);
+uint32_t TriangleBvh::build_node(Builder& out, std::vector<uint32_t>& refs, uint32_t begin,
+                                 uint32_t end, uint32_t depth, const Mesh& mesh,
+                                 const std::vector<Vec3d>& centroids, uint32_t spawn_levels) const {
+  std::vector<Node>& nodes_ = out.nodes;
+  out.depth = std::max(out.depth, depth + 1);
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
   auto grow_by_corners = [&](Box& box, uint32_t f) {
     for (uint32_t v : mesh.triangles[f]) box.grow(to_double(mesh.positions[v]));
   };
 
-  Box bounds, centroid_bounds;
-  for (uint32_t i = begin; i < end; ++i) {
-    grow_by_corners(bounds, refs[i]);
-    centroid_bounds.grow(centroids[refs[i]]);
+  Box centroid_bounds;
+  for (uint32_t i = begin; i < end; ++i) centroid_bounds.grow(centroids[refs[i]]);
+  const uint32_t count = end - begin;
+  const Vec3d extent = centroid_bounds.hi - centroid_bounds.lo;
+  int axis = 0;
+  if (extent.y > extent[axis]) axis = 1;
+  if (extent.z > extent[axis]) axis = 2;
+  const bool binned = count > kMaxLeafTriangles && depth < kSahDepthLimit && extent[axis] > 0;
+
+  // Binned SAH along the widest centroid axis. The node's bounds are its
+  // bins' union (min and max are exact: the same box as from the corners
+  // directly), so the corners are read once a level, not twice.
+  Box bounds;
+  Box bin_box[kBins];
+  uint32_t bin_count[kBins] = {};
+  const double scale = binned ? kBins / extent[axis] : 0;
+  auto bin_of = [&](uint32_t f) {
+    const double t = (centroids[f][axis] - centroid_bounds.lo[axis]) * scale;
+    return std::min<uint32_t>(kBins - 1, static_cast<uint32_t>(std::max(0.0, t)));
+  };
+  if (binned) {
+    for (uint32_t i = begin; i < end; ++i) {
+      const uint32_t b = bin_of(refs[i]);
+      ++bin_count[b];
+      grow_by_corners(bin_box[b], refs[i]);
+    }
+    for (uint32_t b = 0; b < kBins; ++b)
+      if (bin_count[b] > 0) bounds.grow(bin_box[b]);
+  } else {
+    for (uint32_t i = begin; i < end; ++i) grow_by_corners(bounds, refs[i]);
   }
   const Vec3d pad{inflate_, inflate_, inflate_};
   const Vec3d lo = bounds.lo - pad, hi = bounds.hi + pad;
-  auto down = [](double x) {
-    float f = static_cast<float>(x);
-    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-  };
-  auto up = [](double x) {
-    float f = static_cast<float>(x);
-    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-  };
-  nodes_[index].lo = {down(lo.x), down(lo.y), down(lo.z)};
-  nodes_[index].hi = {up(hi.x), up(hi.y), up(hi.z)};
+  nodes_[index].lo = {round_down(lo.x), round_down(lo.y), round_down(lo.z)};
+  nodes_[index].hi = {round_up(hi.x), round_up(hi.y), round_up(hi.z)};
 
-  const uint32_t count = end - begin;
   auto make_leaf = [&] {
     nodes_[index].first = begin;
     nodes_[index].count = count;
@@ -118,26 +164,8 @@ uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, ui
   };
   if (count <= kMaxLeafTriangles) return make_leaf();
 
-  const Vec3d extent = centroid_bounds.hi - centroid_bounds.lo;
-  int axis = 0;
-  if (extent.y > extent[axis]) axis = 1;
-  if (extent.z > extent[axis]) axis = 2;
-
   uint32_t mid = begin;
-  if (depth < kSahDepthLimit && extent[axis] > 0) {
-    // Binned SAH along the widest centroid axis.
-    Box bin_box[kBins];
-    uint32_t bin_count[kBins] = {};
-    const double scale = kBins / extent[axis];
-    auto bin_of = [&](uint32_t f) {
-      const double t = (centroids[f][axis] - centroid_bounds.lo[axis]) * scale;
-      return std::min<uint32_t>(kBins - 1, static_cast<uint32_t>(std::max(0.0, t)));
-    };
-    for (uint32_t i = begin; i < end; ++i) {
-      const uint32_t b = bin_of(refs[i]);
-      ++bin_count[b];
-      grow_by_corners(bin_box[b], refs[i]);
-    }
+  if (binned) {
     double right_area[kBins];
     uint32_t right_count[kBins];
     Box acc;
@@ -178,11 +206,68 @@ uint32_t TriangleBvh::build_node(std::vector<uint32_t>& refs, uint32_t begin, ui
     });
   }
 
-  build_node(refs, begin, mid, depth + 1, mesh, centroids);
-  const uint32_t right = build_node(refs, mid, end, depth + 1, mesh, centroids);
+  uint32_t right = 0;
+  if (spawn_levels > 0 && count >= kSpawnTriangles) {
+    // The right subtree on its own thread into its own array (the two
+    // halves of refs are disjoint), appended after the left one: the
+    // nodes, their order and their indices are those of the serial build.
+    Builder right_out;
+    auto right_done = std::async(std::launch::async, [&] {
+      build_node(right_out, refs, mid, end, depth + 1, mesh, centroids, spawn_levels - 1);
+    });
+    build_node(out, refs, begin, mid, depth + 1, mesh, centroids, spawn_levels - 1);
+    right_done.get();
+    right = static_cast<uint32_t>(nodes_.size());
+    for (Node node : right_out.nodes) {
+      if (node.count == 0) node.first += right;  // an inner node's right child
+      nodes_.push_back(node);
+    }
+    out.depth = std::max(out.depth, right_out.depth);
+  } else {
+    build_node(out, refs, begin, mid, depth + 1, mesh, centroids, 0);
+    right = build_node(out, refs, mid, end, depth + 1, mesh, centroids, 0);
+  }
   nodes_[index].first = right;
   nodes_[index].count = 0;
   return index;
+}
+
+Status TriangleBvh::refit(const Mesh& mesh) {
+  if (mesh.face_count() != triangles_.size())
+    return make_error(ErrorCode::kInvalidArgument,
+                      "hierarchy refit: " + std::to_string(mesh.face_count()) +
+                          " triangles, the hierarchy has " + std::to_string(triangles_.size()));
+  if (triangles_.empty()) return {};
+  inflate_ = inflation_for(mesh);
+  for (Slot& s : triangles_) {
+    const Triangle& t = mesh.triangles[s.triangle];
+    s.corners = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]};
+  }
+  // Children follow their parent in the array, so going backwards meets
+  // both children before the parent. A leaf's box is its corners' (padded
+  // and rounded outwards as in the build); an inner box is its children's
+  // union (they are padded and rounded already: a looser box only prunes
+  // less).
+  const Vec3d pad{inflate_, inflate_, inflate_};
+  for (size_t i = nodes_.size(); i-- > 0;) {
+    Node& node = nodes_[i];
+    if (node.count > 0) {
+      Box box;
+      for (uint32_t s = node.first; s < node.first + node.count; ++s)
+        for (const Vec3f& c : triangles_[s].corners) box.grow(to_double(c));
+      const Vec3d lo = box.lo - pad, hi = box.hi + pad;
+      node.lo = {round_down(lo.x), round_down(lo.y), round_down(lo.z)};
+      node.hi = {round_up(hi.x), round_up(hi.y), round_up(hi.z)};
+    } else {
+      const Node& l = nodes_[i + 1];
+      const Node& r = nodes_[node.first];
+      for (int k = 0; k < 3; ++k) {
+        node.lo[k] = std::min(l.lo[k], r.lo[k]);
+        node.hi[k] = std::max(l.hi[k], r.hi[k]);
+      }
+    }
+  }
+  return {};
 }
 
 ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {

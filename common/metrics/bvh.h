@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/base/result.h"
 #include "common/mesh/mesh.h"
 #include "common/mesh/vec.h"
 
@@ -34,8 +35,19 @@ class TriangleBvh {
   // does). A mesh without triangles gives an empty hierarchy. Deterministic;
   // O(F log F) time, about 72 bytes per triangle kept (the build itself
   // needs about 60 more while it runs; 24 bytes less since the node
-  // bounds are floats).
-  static TriangleBvh build(const Mesh& mesh);
+  // bounds are floats). `threads` (0 = one per core) build the top
+  // subtrees side by side; the tree is the same for every count.
+  static TriangleBvh build(const Mesh& mesh, unsigned threads = 1);
+
+  // The same tree over new positions of the same triangles (`mesh` has
+  // the triangles it was built over, in the same order; its positions may
+  // differ, e.g. the grid units of a quantized mesh and their dequantized
+  // values): corners and bounds are recomputed bottom-up, the topology is
+  // kept. Queries stay exact (closest()), so every squared distance is the
+  // one a fresh build over `mesh` gives; only the triangle named on a tie
+  // may differ. O(F), a small fraction of a build. kInvalidArgument when
+  // the triangle count differs.
+  Status refit(const Mesh& mesh);
 
   bool empty() const { return triangles_.empty(); }
   uint32_t triangle_count() const { return static_cast<uint32_t>(triangles_.size()); }
@@ -66,8 +78,15 @@ class TriangleBvh {
     std::array<Vec3f, 3> corners;
     uint32_t triangle;
   };
-  uint32_t build_node(std::vector<uint32_t>& refs, uint32_t begin, uint32_t end, uint32_t depth,
-                      const Mesh& mesh, const std::vector<Vec3d>& centroids);
+  // Nodes of one subtree in depth-first order (its root first); the top
+  // subtrees each get their own, appended in order after the build.
+  struct Builder {
+    std::vector<Node> nodes;
+    uint32_t depth = 0;
+  };
+  uint32_t build_node(Builder& out, std::vector<uint32_t>& refs, uint32_t begin, uint32_t end,
+                      uint32_t depth, const Mesh& mesh, const std::vector<Vec3d>& centroids,
+                      uint32_t spawn_levels) const;
 
   std::vector<Node> nodes_;
   std::vector<Slot> triangles_;    // in leaf order

@@ -226,6 +226,34 @@ TEST(AsaGuidance, EncoderWritesGuidanceThatChangesNoDecodedByte) {
   EXPECT_EQ((*rg)->groups[0].choice, 0x01);
 }
 
+// The encoder passes its own hierarchy over the original, refitted to the
+// original's positions: the measurement finds the same distances and the
+// same choices as with one built for it.
+TEST(AsaGuidance, AGivenHierarchyMeasuresTheSame) {
+  const Mesh mesh = make_demo_mesh(6000);
+  EncodeOptions plain;
+  plain.asa_guidance = false;
+  auto stream = encode_hcs(mesh, plain);
+  ASSERT_TRUE(stream);
+  Mesh elsewhere = mesh;
+  for (Vec3f& p : elsewhere.positions) p = p * 300.0f + Vec3f{-5, 2, 9};
+  TriangleBvh hierarchy = TriangleBvh::build(elsewhere);
+  ASSERT_TRUE(hierarchy.refit(mesh));
+  AsaGuidanceOptions own, given;
+  given.original_hierarchy = &hierarchy;
+  AsaGuidanceReport own_report, given_report;
+  auto a = measure_asa_guidance(mesh, *stream, own, &own_report);
+  auto b = measure_asa_guidance(mesh, *stream, given, &given_report);
+  ASSERT_TRUE(a && b);
+  ASSERT_EQ(a->groups.size(), b->groups.size());
+  for (size_t i = 0; i < a->groups.size(); ++i) EXPECT_EQ(a->groups[i].choice, b->groups[i].choice);
+  ASSERT_EQ(own_report.groups.size(), given_report.groups.size());
+  for (size_t i = 0; i < own_report.groups.size(); ++i) {
+    EXPECT_EQ(own_report.groups[i].rms, given_report.groups[i].rms) << "group " << i;
+    EXPECT_EQ(own_report.groups[i].normal, given_report.groups[i].normal) << "group " << i;
+  }
+}
+
 TEST(AsaGuidance, DamagedGuidanceFailsTheHeaderChecksumOrIsRefused) {
   const Mesh mesh = make_demo_mesh(4000);
   auto guided = encode_hcs(mesh);

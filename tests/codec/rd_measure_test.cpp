@@ -75,6 +75,37 @@ TEST_F(RdMeasureOnDemo, CurveFallsAsTheBudgetGrows) {
   EXPECT_LT(curve->back().relative_rms, curve->front().relative_rms);
 }
 
+// The encoder hands the measure a hierarchy built over other positions of
+// the same triangles (grid units) and refitted: the curve is the same,
+// number for number, as with the measure's own.
+TEST_F(RdMeasureOnDemo, ARefittedHierarchyGivesTheSameCurve) {
+  auto reference = quantized_reference(mesh, 12);
+  ASSERT_TRUE(reference);
+  Mesh elsewhere = *reference;
+  for (Vec3f& p : elsewhere.positions) p = p * 4096.0f + Vec3f{7, -3, 11};
+  TriangleBvh hierarchy = TriangleBvh::build(elsewhere, 2);
+  ASSERT_TRUE(hierarchy.refit(*reference));
+  auto given = RdMeasure::prepare(*reference, RdMeasureOptions{}, std::move(hierarchy));
+  ASSERT_TRUE(given);
+  EncodeOptions options;
+  options.asa_guidance = false;
+  auto stream = encode_hcs(mesh, options);
+  ASSERT_TRUE(stream);
+  auto own = measure->curve(*stream, stream->size());
+  auto refitted = given->curve(*stream, stream->size());
+  ASSERT_TRUE(own && refitted);
+  ASSERT_EQ(own->size(), refitted->size());
+  for (size_t i = 0; i < own->size(); ++i) {
+    EXPECT_EQ((*own)[i].bytes, (*refitted)[i].bytes);
+    EXPECT_EQ((*own)[i].relative_rms, (*refitted)[i].relative_rms) << "budget " << i;
+  }
+  // A hierarchy over another mesh is refused.
+  TriangleBvh small = TriangleBvh::build(make_icosphere(1));
+  auto wrong = RdMeasure::prepare(*reference, RdMeasureOptions{}, std::move(small));
+  ASSERT_FALSE(wrong);
+  EXPECT_EQ(wrong.error().code, ErrorCode::kInvalidArgument);
+}
+
 TEST(RdMeasure, GarbageStreamIsAnError) {
   auto measure = RdMeasure::prepare(make_icosphere(2));
   ASSERT_TRUE(measure);

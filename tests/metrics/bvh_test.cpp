@@ -50,8 +50,8 @@ Mesh triangle_soup(uint32_t count, std::mt19937& rng) {
   return m;
 }
 
-void expect_matches_brute_force(const Mesh& m, const std::vector<Vec3d>& queries) {
-  const TriangleBvh bvh = TriangleBvh::build(m);
+void expect_matches_brute_force(const TriangleBvh& bvh, const Mesh& m,
+                                const std::vector<Vec3d>& queries) {
   ASSERT_EQ(bvh.triangle_count(), m.face_count());
   uint32_t hint = TriangleBvh::kNoHint;
   for (const Vec3d& q : queries) {
@@ -68,6 +68,10 @@ void expect_matches_brute_force(const Mesh& m, const std::vector<Vec3d>& queries
     EXPECT_EQ(bvh.closest(q, hint).squared_distance, want);
     hint = hit.triangle;
   }
+}
+
+void expect_matches_brute_force(const Mesh& m, const std::vector<Vec3d>& queries) {
+  expect_matches_brute_force(TriangleBvh::build(m), m, queries);
 }
 
 TEST(TriangleBvh, MatchesBruteForceOnASphere) {
@@ -122,6 +126,53 @@ TEST(TriangleBvh, BuildIsDeterministic) {
   for (Vec3d q : {Vec3d{0.3, 0.2, 2}, Vec3d{-1, 0, 0.5}}) {
     EXPECT_EQ(x.closest(q).triangle, y.closest(q).triangle);
   }
+}
+
+TEST(TriangleBvh, ThreadsBuildTheSameTree) {
+  const Mesh m = testing::icosphere(6);  // 81920 triangles: subtrees on their own threads
+  const TriangleBvh one = TriangleBvh::build(m, 1), four = TriangleBvh::build(m, 4);
+  ASSERT_EQ(one.node_count(), four.node_count());
+  EXPECT_EQ(one.depth(), four.depth());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coord(-1.5, 1.5);
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3d q{coord(rng), coord(rng), coord(rng)};
+    const ClosestHit a = one.closest(q), b = four.closest(q);
+    ASSERT_EQ(a.squared_distance, b.squared_distance);
+    ASSERT_EQ(a.triangle, b.triangle);  // the same tree visits in the same order
+  }
+}
+
+TEST(TriangleBvh, RefitToNewPositionsIsExact) {
+  // Built over one set of positions, refitted to others (moved, scaled and
+  // jittered): every query still matches brute force over the new ones.
+  const Mesh m = testing::icosphere(3);
+  Mesh moved = m;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> jitter(-0.05f, 0.05f);
+  for (Vec3f& p : moved.positions)
+    p = p * 37.0f + Vec3f{100 + jitter(rng), -3 + jitter(rng), 0.5f + jitter(rng)};
+  TriangleBvh bvh = TriangleBvh::build(m);
+  ASSERT_TRUE(bvh.refit(moved));
+  std::uniform_real_distribution<double> coord(-60, 60);
+  std::vector<Vec3d> queries;
+  for (int i = 0; i < 1000; ++i)
+    queries.push_back(Vec3d{100, -3, 0.5} + Vec3d{coord(rng), coord(rng), coord(rng)});
+  for (int i = 0; i < 300; ++i) queries.push_back(to_double(moved.positions[rng() % 642]));
+  expect_matches_brute_force(bvh, moved, queries);
+  // And back: the original positions again.
+  ASSERT_TRUE(bvh.refit(m));
+  expect_matches_brute_force(bvh, m, {{0.3, 0.2, 2}, {-1, 0, 0.5}, {0, 0, 0}});
+}
+
+TEST(TriangleBvh, RefitRefusesOtherTriangleCounts) {
+  const Mesh m = testing::icosphere(1);
+  TriangleBvh bvh = TriangleBvh::build(m);
+  Mesh fewer = m;
+  fewer.triangles.pop_back();
+  const auto st = bvh.refit(fewer);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.error().code, ErrorCode::kInvalidArgument);
 }
 
 }  // namespace
