@@ -186,9 +186,10 @@ uint32_t drop_duplicates(Mesh& mesh, std::vector<uint8_t>& had_twin) {
 // any other face was a flap hanging off the surface at non-manifold edges.
 // It adds nothing to the surface and would be a component of its own for
 // the codec: drop it. Returns the number of faces dropped.
-uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin) {
+// `groups`: the repaired mesh's edge groups (make_manifold hands them back).
+uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin,
+                             const EdgeGroups& groups) {
   if (had_twin.size() != mesh.triangles.size()) return 0;
-  const EdgeGroups groups = build_edge_groups(mesh);
   std::vector<uint8_t> shared_edges(mesh.face_count(), 0);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     if (groups.use_count(e) < 2) continue;
@@ -284,13 +285,16 @@ Result<CleanReport> clean_faces(Mesh& mesh, const ImportOptions& options) {
     return report;
   }
   const uint32_t vertices_before_repair = mesh.vertex_count();
-  auto repaired = make_manifold(mesh, std::move(groups));
+  EdgeGroups repaired_groups;
+  auto repaired = make_manifold(mesh, std::move(groups), &repaired_groups);
   if (!repaired) return tl::unexpected(repaired.error());
   report.split_vertices = repaired->split_vertices;
   report.detached_faces = repaired->detached_faces;
   report.flipped_faces = repaired->flipped_faces;
+  if (!options.drop_double_sided_flaps) repaired_groups = {};
   if (options.drop_double_sided_flaps) {
-    report.double_sided_flaps = drop_isolated_twins(mesh, had_twin);
+    report.double_sided_flaps = drop_isolated_twins(mesh, had_twin, repaired_groups);
+    repaired_groups = {};
     if (report.double_sided_flaps > 0) {
       // Vertices only the flaps used: repair copies (appended after the
       // original vertices) were never really added; originals are unreferenced.

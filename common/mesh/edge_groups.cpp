@@ -1,6 +1,7 @@
 #include "common/mesh/edge_groups.h"
 
 #include <algorithm>
+#include <cstring>
 
 namespace meshstream {
 
@@ -85,6 +86,141 @@ EdgeGroups build_edge_groups(const Mesh& mesh) {
   }
   groups.begin.push_back(static_cast<uint32_t>(groups.uses.size()));
   return groups;
+}
+
+void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change) {
+  // The renumbered faces' sides as they are now, in the groups' order:
+  // by edge, then by face (a face has one side on an edge).
+  struct Side {
+    uint32_t lo, hi;
+    EdgeUse use;
+  };
+  std::vector<Side> added;
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    if (!(change[f] & kFaceRenumbered)) continue;
+    const Triangle& t = mesh.triangles[f];
+    for (uint8_t i = 0; i < 3; ++i) {
+      const uint32_t a = t[i], b = t[i == 2 ? 0 : i + 1];
+      added.push_back({std::min(a, b), std::max(a, b), EdgeUse{f, i, a < b}});
+    }
+  }
+  std::sort(added.begin(), added.end(), [](const Side& x, const Side& y) {
+    if (x.lo != y.lo) return x.lo < y.lo;
+    if (x.hi != y.hi) return x.hi < y.hi;
+    return x.use.face < y.use.face;
+  });
+
+  // Pass 1, forward: drop the renumbered faces' old uses and the edges left
+  // without a use; reverse the reversed faces' sides (side 0 <-> 2, as
+  // reverse_face swaps corners 1 and 2). Writes never pass reads.
+  std::vector<EdgeUse>& uses = groups.uses;
+  const uint32_t old_edges = groups.edge_count();
+  uint32_t kept_uses = 0, kept_edges = 0;
+  for (uint32_t e = 0; e < old_edges; ++e) {
+    const uint32_t first = kept_uses;
+    for (uint32_t k = groups.begin[e]; k < groups.begin[e + 1]; ++k) {
+      EdgeUse u = uses[k];
+      const uint8_t c = change[u.face];
+      if (c & kFaceRenumbered) continue;
+      if (c & kFaceReversed) {
+        u.local = static_cast<uint8_t>(2 - u.local);
+        u.forward = !u.forward;
+      }
+      uses[kept_uses++] = u;
+    }
+    if (kept_uses == first) continue;
+    groups.lo[kept_edges] = groups.lo[e];
+    groups.hi[kept_edges] = groups.hi[e];
+    groups.begin[kept_edges] = first;
+    ++kept_edges;
+  }
+
+  // Pass 2, backward: merge the added sides in, writing from the top of the
+  // arrays down. The uses end at their old size again (faces keep three
+  // sides); the edges get at most one per distinct added edge more, the
+  // surplus (added edges that exist already) is closed up afterwards.
+  uint32_t added_edges = 0;
+  for (size_t i = 0; i < added.size(); ++i) {
+    added_edges += i == 0 || added[i].lo != added[i - 1].lo || added[i].hi != added[i - 1].hi;
+  }
+  const uint32_t edge_room = kept_edges + added_edges;
+  groups.lo.resize(edge_room);
+  groups.hi.resize(edge_room);
+  groups.begin.resize(edge_room);
+  auto old_key = [&groups](int64_t i) {
+    return (static_cast<uint64_t>(groups.lo[i]) << 32) | groups.hi[i];
+  };
+  auto added_key = [&added](int64_t i) {
+    return (static_cast<uint64_t>(added[i].lo) << 32) | added[i].hi;
+  };
+  uint32_t use_out = static_cast<uint32_t>(uses.size());
+  uint32_t edge_out = edge_room;
+  uint32_t old_end = kept_uses;  // end of the uses of old edge `e`
+  int64_t e = static_cast<int64_t>(kept_edges) - 1;
+  int64_t a = static_cast<int64_t>(added.size()) - 1;
+  // Invariants: use_out = old_end + the added uses left, edge_out = e + 1 +
+  // the distinct added edges left. So once every added side is in, the old
+  // edges left are where they belong already.
+  while (a >= 0) {
+    const uint64_t next_added = added_key(a);
+    if (e >= 0 && old_key(e) > next_added) {
+      // Old edges above the next added one move up as one block: memmove,
+      // and their use offsets shift by the same amount.
+      int64_t lo = 0, hi = e;  // first old edge in [0, e] above next_added
+      while (lo < hi) {
+        const int64_t mid = (lo + hi) / 2;
+        if (old_key(mid) > next_added) {
+          hi = mid;
+        } else {
+          lo = mid + 1;
+        }
+      }
+      const uint32_t first_use = groups.begin[lo];
+      const uint32_t shift = use_out - old_end;
+      const uint32_t edges = static_cast<uint32_t>(e - lo + 1);
+      std::memmove(uses.data() + first_use + shift, uses.data() + first_use,
+                   (old_end - first_use) * sizeof(EdgeUse));
+      const uint32_t dst = edge_out - edges;
+      std::memmove(groups.lo.data() + dst, groups.lo.data() + lo, edges * sizeof(uint32_t));
+      std::memmove(groups.hi.data() + dst, groups.hi.data() + lo, edges * sizeof(uint32_t));
+      std::memmove(groups.begin.data() + dst, groups.begin.data() + lo, edges * sizeof(uint32_t));
+      for (uint32_t i = dst; i < edge_out; ++i) groups.begin[i] += shift;
+      use_out -= old_end - first_use;
+      edge_out = dst;
+      old_end = first_use;
+      e = lo - 1;
+      continue;
+    }
+    // One edge: the next added one, with the old uses of the same edge if
+    // there is one, merged by face, largest first.
+    const bool with_old = e >= 0 && old_key(e) == next_added;
+    const uint32_t old_first = with_old ? groups.begin[e] : old_end;
+    uint32_t k = old_end;
+    while (a >= 0 && added_key(a) == next_added) {
+      if (k > old_first && uses[k - 1].face > added[a].use.face) {
+        uses[--use_out] = uses[--k];
+      } else {
+        uses[--use_out] = added[a--].use;
+      }
+    }
+    while (k > old_first) uses[--use_out] = uses[--k];
+    --edge_out;
+    groups.lo[edge_out] = static_cast<uint32_t>(next_added >> 32);
+    groups.hi[edge_out] = static_cast<uint32_t>(next_added);
+    groups.begin[edge_out] = use_out;
+    if (with_old) {
+      old_end = old_first;
+      --e;
+    }
+  }
+  // Close the gap left by added edges that were there already.
+  const uint32_t gap_begin = static_cast<uint32_t>(e + 1), gap = edge_out - gap_begin;
+  if (gap > 0) {
+    groups.lo.erase(groups.lo.begin() + gap_begin, groups.lo.begin() + edge_out);
+    groups.hi.erase(groups.hi.begin() + gap_begin, groups.hi.begin() + edge_out);
+    groups.begin.erase(groups.begin.begin() + gap_begin, groups.begin.begin() + edge_out);
+  }
+  groups.begin.push_back(static_cast<uint32_t>(uses.size()));
 }
 
 }  // namespace meshstream

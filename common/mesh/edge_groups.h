@@ -36,4 +36,21 @@ struct EdgeGroups {
 // and 12 per face (the larger vertex of every side).
 EdgeGroups build_edge_groups(const Mesh& mesh);
 
+// How a face changed since its edge groups were built (update_edge_groups).
+enum FaceChange : uint8_t {
+  kFaceKept = 0,
+  kFaceReversed = 1,    // reverse_face: the same vertices, walked the other way
+  kFaceRenumbered = 2,  // some corner now holds another vertex (may be reversed too)
+};
+
+// Brings `groups`, built for a mesh with the same faces but for the changes
+// in `change` (one entry per face, FaceChange bits), up to date with `mesh`:
+// the arrays afterwards are exactly build_edge_groups(mesh)'s. The sides of
+// renumbered faces are taken out and merged back in at their new edges;
+// reversed ones are fixed in place. Two sequential passes over the groups
+// plus a sort of the renumbered faces' sides, in place (no second copy of
+// the groups): for the repair, whose rounds change a few faces of millions.
+// Precondition: all faces usable (indices in range, no repeated vertex).
+void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change);
+
 }  // namespace meshstream

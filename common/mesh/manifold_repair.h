@@ -43,7 +43,10 @@ Status check_manifold(const Mesh& mesh);
 // Adjacency::build. O((V + F) * rounds); rounds is small (2-3 on real data).
 Result<RepairCounts> make_manifold(Mesh& mesh);
 // The same, starting from build_edge_groups(mesh) already built by the
-// caller (import builds them to decide whether to repair at all).
-Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups);
+// caller (import builds them to decide whether to repair at all). With
+// `final_groups`, the edge groups of the repaired mesh are handed back
+// (import's flap check reads them instead of building them again).
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups,
+                                   EdgeGroups* final_groups = nullptr);
 
 }  // namespace meshstream
