@@ -272,7 +272,8 @@ Result<CleanReport> clean_faces(Mesh& mesh, const ImportOptions& options) {
   }
 
   EdgeGroups groups = build_edge_groups(mesh);
-  const ManifoldCounts found = count_nonmanifold(mesh, groups);
+  UnionFind fans = two_face_fans(mesh, groups);
+  const ManifoldCounts found = count_nonmanifold(mesh, groups, fans);
   report.nonmanifold_edges = found.nonmanifold_edges;
   report.nonmanifold_vertices = found.nonmanifold_vertices;
   if (options.keep_nonmanifold) return report;
@@ -281,12 +282,13 @@ Result<CleanReport> clean_faces(Mesh& mesh, const ImportOptions& options) {
   if (found.manifold() && found.orientation_conflicts == 0) return report;
   if (!options.repair_nonmanifold) {
     groups = {};
+    fans = UnionFind(0);
     if (auto status = check_manifold(mesh); !status) return tl::unexpected(status.error());
     return report;
   }
   const uint32_t vertices_before_repair = mesh.vertex_count();
   EdgeGroups repaired_groups;
-  auto repaired = make_manifold(mesh, std::move(groups), &repaired_groups);
+  auto repaired = make_manifold(mesh, std::move(groups), std::move(fans), &repaired_groups);
   if (!repaired) return tl::unexpected(repaired.error());
   report.split_vertices = repaired->split_vertices;
   report.detached_faces = repaired->detached_faces;

@@ -8,6 +8,7 @@
 #include "common/mesh/adjacency.h"
 #include "common/mesh/corner_data.h"
 #include "common/mesh/edge_groups.h"
+#include "common/mesh/topology.h"
 #include "common/mesh/union_find.h"
 
 namespace meshstream {
@@ -57,18 +58,6 @@ void add_joins(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Joi
   }
 }
 
-// Corner sets joined across every two-face edge and the given joins (not
-// cut) at each shared endpoint; each set is one fan of faces around one vertex.
-UnionFind fans_through(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
-  UnionFind sets(3 * mesh.face_count());
-  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) == 2)
-      join_across(mesh, groups, e, groups.begin[e], groups.begin[e] + 1, sets);
-  }
-  add_joins(mesh, groups, joins, sets);
-  return sets;
-}
-
 // Step 1 for one non-manifold edge: a greedy matching of consistently
 // oriented pairs (opposite directions), best score first. Score: faces
 // already in one fan at both endpoints (through two-face edges) beat faces
@@ -110,7 +99,7 @@ void match_nonmanifold_edge(const Mesh& mesh, const EdgeGroups& groups, uint32_t
 }
 
 // The pairings at non-manifold edges (the two-face edges are joined anyway).
-// `fans`: the corner sets through the two-face edges alone (fans_through
+// `fans`: the corner sets through the two-face edges alone (two_face_fans,
 // with no joins); the matching reads them and leaves them as they are.
 std::vector<Join> choose_joins(const Mesh& mesh, const EdgeGroups& groups, UnionFind& fans) {
   std::vector<Join> joins;
@@ -378,7 +367,7 @@ Status check_manifold(const Mesh& mesh) {
                             edge_name(mesh, groups.lo[e], groups.hi[e]) + " in the same direction");
     }
   }
-  UnionFind sets = fans_through(mesh, groups, {});
+  UnionFind sets = two_face_fans(mesh, groups);
   std::vector<uint32_t> first_root(mesh.vertex_count(), kNone);
   for (uint32_t c = 0; c < 3 * mesh.face_count(); ++c) {
     const uint32_t v = mesh.triangles[c / 3][c % 3];
@@ -398,6 +387,12 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
 }
 
 Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, EdgeGroups* final_groups) {
+  UnionFind fans = two_face_fans(mesh, groups);
+  return make_manifold(mesh, std::move(groups), std::move(fans), final_groups);
+}
+
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind first_fans,
+                                   EdgeGroups* final_groups) {
   RepairCounts counts;
   constexpr int kMaxRounds = 32;
   std::string last_problem;
@@ -406,7 +401,7 @@ Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, EdgeGroups* fi
     // updates them in place (update_edge_groups), as a fresh build would
     // give them, instead of building them again (the old and the new
     // groups are never alive at once).
-    UnionFind fans = fans_through(mesh, groups, {});
+    UnionFind fans = round == 0 ? std::move(first_fans) : two_face_fans(mesh, groups);
     std::vector<Join> joins = choose_joins(mesh, groups, fans);
     std::vector<uint8_t> change;  // orient's flips, then the split's copies
     auto flipped = orient(mesh, groups, joins, change);

@@ -7,6 +7,7 @@
 #include "common/base/result.h"
 #include "common/mesh/edge_groups.h"
 #include "common/mesh/mesh.h"
+#include "common/mesh/union_find.h"
 
 namespace meshstream {
 
@@ -48,5 +49,9 @@ Result<RepairCounts> make_manifold(Mesh& mesh);
 // (import's flap check reads them instead of building them again).
 Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups,
                                    EdgeGroups* final_groups = nullptr);
+// The same, with two_face_fans(mesh, groups) too already built by the caller
+// (import counts the non-manifold vertices with them).
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind fans,
+                                   EdgeGroups* final_groups);
 
 }  // namespace meshstream
