@@ -66,55 +66,73 @@ void renumber(Mesh& mesh, const std::vector<uint32_t>& new_index, uint32_t new_c
   }
 }
 
-// True when every group of merged vertices has bit-identical values.
+// True when every group of merged vertices has bit-identical values:
+// vertex v went to new_index[v], whose first vertex was first_of[new_index[v]].
 template <class T>
-bool consistent_after_merge(const std::vector<T>& values,
-                            const std::vector<uint32_t>& representative) {
+bool consistent_after_merge(const std::vector<T>& values, const std::vector<uint32_t>& new_index,
+                            const std::vector<uint32_t>& first_of) {
   if (values.empty()) return true;
   for (size_t v = 0; v < values.size(); ++v) {
-    if (std::memcmp(&values[v], &values[representative[v]], sizeof(T)) != 0) return false;
+    if (std::memcmp(&values[v], &values[first_of[new_index[v]]], sizeof(T)) != 0) return false;
   }
   return true;
 }
 
+uint64_t position_hash(const std::array<uint32_t, 3>& key) {
+  uint64_t h = (key[0] * 0x9E3779B97F4A7C15ull) ^ (key[1] * 0xC2B2AE3D27D4EB4Full) ^
+               (key[2] * 0x165667B19E3779F9ull);
+  return h ^ (h >> 29);
+}
+
 // Merges vertices whose positions are bit-identical (so -0 and +0 stay
 // apart, as the manifest counts them); each keeps the lowest index of its
-// group. An open-addressing table of the 96-bit keys: O(V), 8-16 bytes per
-// vertex besides the result.
+// group, and the groups keep the order of their first vertices. An
+// open-addressing table of the 96-bit keys, sized to the distinct positions
+// seen so far (grown by doubling): an STL file's corners are about 6 copies
+// of each position, so a table over every corner would be 6x too big (134 MB
+// for 3.2M triangles). O(V); besides the result, 4 bytes a file vertex and
+// 8-16 a distinct position.
 uint32_t weld(Mesh& mesh) {
   const uint32_t n = mesh.vertex_count();
-  size_t table_size = 16;
-  while (table_size < 2 * static_cast<size_t>(n)) table_size *= 2;
-  const size_t mask = table_size - 1;
-  std::vector<uint32_t> table(table_size, kNone);
-  std::vector<uint32_t> representative(n);
-  uint32_t merged = 0;
-  for (uint32_t v = 0; v < n; ++v) {
+  size_t table_size = 1024;
+  std::vector<uint32_t> table(table_size, kNone);  // first vertex of each position
+  std::vector<uint32_t> new_index(n);
+  std::vector<uint32_t> first_of;  // new index -> its first (lowest) file vertex
+  auto insert = [&](uint32_t v) {
     const std::array<uint32_t, 3> key = bits(mesh.positions[v]);
-    uint64_t h = (key[0] * 0x9E3779B97F4A7C15ull) ^ (key[1] * 0xC2B2AE3D27D4EB4Full) ^
-                 (key[2] * 0x165667B19E3779F9ull);
-    h ^= h >> 29;
-    for (size_t slot = h & mask;; slot = (slot + 1) & mask) {
+    const size_t mask = table_size - 1;
+    for (size_t slot = position_hash(key) & mask;; slot = (slot + 1) & mask) {
       const uint32_t other = table[slot];
       if (other == kNone) {
         table[slot] = v;
-        representative[v] = v;
-        break;
+        return true;
       }
       if (bits(mesh.positions[other]) == key) {
-        representative[v] = other;
-        ++merged;
-        break;
+        new_index[v] = new_index[other];
+        return false;
       }
+    }
+  };
+  for (uint32_t v = 0; v < n; ++v) {
+    if (2 * (first_of.size() + 1) > table_size) {  // keep the table at most half full
+      table_size *= 2;
+      table.assign(table_size, kNone);
+      for (const uint32_t w : first_of) insert(w);
+    }
+    if (insert(v)) {
+      new_index[v] = static_cast<uint32_t>(first_of.size());
+      first_of.push_back(v);
     }
   }
   table = {};
+  const uint32_t count = static_cast<uint32_t>(first_of.size());
+  const uint32_t merged = n - count;
   if (merged == 0) return 0;
 
   // Values that differ between welded vertices are seams: kept per corner
   // (the corners still index the file's vertices, which are the values).
   auto check = [&](auto& values, auto& corner) {
-    if (!consistent_after_merge(values, representative)) {
+    if (!consistent_after_merge(values, new_index, first_of)) {
       corner = to_corner_attribute(mesh, values);
       values.clear();
     }
@@ -122,13 +140,7 @@ uint32_t weld(Mesh& mesh) {
   check(mesh.normals, mesh.corner_normals);
   check(mesh.colors, mesh.corner_colors);
   check(mesh.texcoords, mesh.corner_texcoords);
-
-  std::vector<uint32_t> new_index(n, kNone);
-  uint32_t count = 0;
-  for (uint32_t v = 0; v < n; ++v) {
-    if (representative[v] == v) new_index[v] = count++;
-  }
-  for (uint32_t v = 0; v < n; ++v) new_index[v] = new_index[representative[v]];
+  first_of = {};
   renumber(mesh, new_index, count);
   return merged;
 }

@@ -49,9 +49,13 @@ EdgeGroups build_edge_groups(const Mesh& mesh) {
     EdgeUse use;
   };
   std::vector<Side> big;
-  groups.lo.reserve(groups.uses.size() / 2 + 1);
-  groups.hi.reserve(groups.uses.size() / 2 + 1);
-  groups.begin.reserve(groups.uses.size() / 2 + 2);
+  // Every edge of a closed mesh has two sides; boundaries and the repair's
+  // splits (update_edge_groups) add a few more edges: room for them, so the
+  // arrays are not copied to grow (pages never touched cost no memory).
+  const size_t edge_room = groups.uses.size() / 2 + groups.uses.size() / 32 + 16;
+  groups.lo.reserve(edge_room);
+  groups.hi.reserve(edge_room);
+  groups.begin.reserve(edge_room + 1);
   for (uint32_t v = 0; v < n; ++v) {
     const uint32_t first = offset[v], last = offset[v + 1];
     if (last - first > 32) {
@@ -144,6 +148,11 @@ void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<
     added_edges += i == 0 || added[i].lo != added[i - 1].lo || added[i].hi != added[i - 1].hi;
   }
   const uint32_t edge_room = kept_edges + added_edges;
+  if (edge_room + 1 > groups.begin.capacity()) {  // rare: build_edge_groups leaves room
+    groups.lo.reserve(edge_room + edge_room / 32);
+    groups.hi.reserve(edge_room + edge_room / 32);
+    groups.begin.reserve(edge_room + edge_room / 32 + 1);
+  }
   groups.lo.resize(edge_room);
   groups.hi.resize(edge_room);
   groups.begin.resize(edge_room);
