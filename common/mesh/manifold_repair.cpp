@@ -391,8 +391,23 @@ Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, EdgeGroups* fi
   return make_manifold(mesh, std::move(groups), std::move(fans), final_groups);
 }
 
+// Room for the vertex copies the repair appends, made now: growing the
+// arrays by doubling in the middle of the fan split would hold the old and
+// the new array at once beside everything the split needs (the peak).
+// Pages the copies never reach cost no memory.
+template <class T>
+void leave_room(std::vector<T>& values) {
+  if (values.empty()) return;
+  const size_t room = values.size() + values.size() / 32 + 64;
+  if (values.capacity() < room) values.reserve(room);
+}
+
 Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind first_fans,
                                    EdgeGroups* final_groups) {
+  leave_room(mesh.positions);
+  leave_room(mesh.normals);
+  leave_room(mesh.colors);
+  leave_room(mesh.texcoords);
   RepairCounts counts;
   constexpr int kMaxRounds = 32;
   std::string last_problem;
