@@ -88,10 +88,10 @@ uint64_t position_hash(const std::array<uint32_t, 3>& key) {
 // apart, as the manifest counts them); each keeps the lowest index of its
 // group, and the groups keep the order of their first vertices. An
 // open-addressing table of the 96-bit keys, sized to the distinct positions
-// seen so far (grown by doubling): an STL file's corners are about 6 copies
-// of each position, so a table over every corner would be 6x too big (134 MB
-// for 3.2M triangles). O(V); besides the result, 4 bytes a file vertex and
-// 8-16 a distinct position.
+// expected (from the first vertices) and grown by doubling: an STL file's
+// corners are about 6 copies of each position, so a table over every corner
+// would be 6x too big (134 MB for 3.2M triangles). O(V); besides the result,
+// 4 bytes a file vertex and 8-16 a distinct position.
 uint32_t weld(Mesh& mesh) {
   const uint32_t n = mesh.vertex_count();
   size_t table_size = 1024;
@@ -113,12 +113,23 @@ uint32_t weld(Mesh& mesh) {
       }
     }
   };
+  auto grow = [&](size_t size) {
+    table_size = size;
+    table.assign(table_size, kNone);
+    for (const uint32_t w : first_of) insert(w);
+  };
+  // After the first vertices, the table is sized once for the share of
+  // distinct positions they had (a PLY file: all, an STL file: about 1/6),
+  // so it rarely has to grow again; growing keeps it right either way.
+  constexpr uint32_t kSample = 1 << 16;
   for (uint32_t v = 0; v < n; ++v) {
-    if (2 * (first_of.size() + 1) > table_size) {  // keep the table at most half full
-      table_size *= 2;
-      table.assign(table_size, kNone);
-      for (const uint32_t w : first_of) insert(w);
+    if (v == kSample) {
+      const uint64_t expected = static_cast<uint64_t>(first_of.size()) * n / kSample;
+      size_t size = table_size;
+      while (size < 2 * expected) size *= 2;
+      if (size > table_size) grow(size);
     }
+    if (2 * (first_of.size() + 1) > table_size) grow(2 * table_size);  // at most half full
     if (insert(v)) {
       new_index[v] = static_cast<uint32_t>(first_of.size());
       first_of.push_back(v);
