@@ -98,13 +98,16 @@ uint32_t weld(Mesh& mesh) {
   std::vector<uint32_t> table(table_size, kNone);  // first vertex of each position
   std::vector<uint32_t> new_index(n);
   std::vector<uint32_t> first_of;  // new index -> its first (lowest) file vertex
-  auto insert = [&](uint32_t v) {
+  // Puts v in the table: true when its position is new (the caller numbers
+  // it), else v gets the number of the first vertex with that position.
+  auto insert = [&table, &new_index, &mesh](uint32_t v) {
     const std::array<uint32_t, 3> key = bits(mesh.positions[v]);
-    const size_t mask = table_size - 1;
+    const size_t mask = table.size() - 1;
+    uint32_t* slots = table.data();
     for (size_t slot = position_hash(key) & mask;; slot = (slot + 1) & mask) {
-      const uint32_t other = table[slot];
+      const uint32_t other = slots[slot];
       if (other == kNone) {
-        table[slot] = v;
+        slots[slot] = v;
         return true;
       }
       if (bits(mesh.positions[other]) == key) {
@@ -122,21 +125,27 @@ uint32_t weld(Mesh& mesh) {
   // distinct positions they had (a PLY file: all, an STL file: about 1/6),
   // so it rarely has to grow again; growing keeps it right either way.
   constexpr uint32_t kSample = 1 << 16;
-  for (uint32_t v = 0; v < n; ++v) {
+  uint32_t count = 0;
+  for (uint32_t v = 0; v < n;) {
     if (v == kSample) {
-      const uint64_t expected = static_cast<uint64_t>(first_of.size()) * n / kSample;
+      const uint64_t expected = static_cast<uint64_t>(count) * n / kSample;
       size_t size = table_size;
       while (size < 2 * expected) size *= 2;
       if (size > table_size) grow(size);
+      first_of.reserve(expected + expected / 8 + 16);
     }
-    if (2 * (first_of.size() + 1) > table_size) grow(2 * table_size);  // at most half full
-    if (insert(v)) {
-      new_index[v] = static_cast<uint32_t>(first_of.size());
-      first_of.push_back(v);
+    if (2 * (count + 1) > table_size) grow(2 * table_size);  // at most half full
+    // Vertices that cannot fill the table past half, up to the sample's end.
+    uint32_t end = static_cast<uint32_t>(std::min<uint64_t>(n, v + (table_size / 2 - count)));
+    if (v < kSample) end = std::min(end, kSample);
+    for (; v < end; ++v) {
+      if (insert(v)) {
+        new_index[v] = count++;
+        first_of.push_back(v);
+      }
     }
   }
   table = {};
-  const uint32_t count = static_cast<uint32_t>(first_of.size());
   const uint32_t merged = n - count;
   if (merged == 0) return 0;
 
