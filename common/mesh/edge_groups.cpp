@@ -92,7 +92,28 @@ EdgeGroups build_edge_groups(const Mesh& mesh) {
   return groups;
 }
 
-void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change) {
+namespace {
+
+// The index of edge (lo, hi) in `groups`, or kNoEdge.
+constexpr uint32_t kNoEdge = 0xFFFFFFFFu;
+uint32_t find_edge(const EdgeGroups& groups, uint32_t lo, uint32_t hi) {
+  uint32_t first = 0, last = groups.edge_count();
+  while (first < last) {
+    const uint32_t mid = first + (last - first) / 2;
+    if (groups.lo[mid] < lo || (groups.lo[mid] == lo && groups.hi[mid] < hi)) {
+      first = mid + 1;
+    } else {
+      last = mid;
+    }
+  }
+  return first < groups.edge_count() && groups.lo[first] == lo && groups.hi[first] == hi ? first
+                                                                                         : kNoEdge;
+}
+
+}  // namespace
+
+void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change,
+                        const std::vector<std::pair<uint32_t, Triangle>>& old_triangles) {
   // The renumbered faces' sides as they are now, in the groups' order:
   // by edge, then by face (a face has one side on an edge).
   struct Side {
@@ -100,14 +121,38 @@ void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<
     EdgeUse use;
   };
   std::vector<Side> added;
+  // The old edges holding a side of a changed face: only they are looked
+  // at one use at a time, the rest moves in blocks.
+  std::vector<uint32_t> touched;
+  bool lost = false;  // a side not in the groups: they were not this mesh's
+  auto touch = [&](const Triangle& t) {
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t a = t[i], b = t[(i + 1) % 3];
+      const uint32_t e = find_edge(groups, std::min(a, b), std::max(a, b));
+      if (e == kNoEdge) lost = true;
+      touched.push_back(e);
+    }
+  };
+  for (const auto& [f, old] : old_triangles) touch(old);
+  uint32_t renumbered = 0;
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    if (change[f] == kFaceKept) continue;
+    if (change[f] == kFaceReversed) touch(mesh.triangles[f]);
     if (!(change[f] & kFaceRenumbered)) continue;
+    ++renumbered;
     const Triangle& t = mesh.triangles[f];
     for (uint8_t i = 0; i < 3; ++i) {
       const uint32_t a = t[i], b = t[i == 2 ? 0 : i + 1];
       added.push_back({std::min(a, b), std::max(a, b), EdgeUse{f, i, a < b}});
     }
   }
+  auto build_afresh = [&groups, &mesh] {  // not what the caller promised: be right, not fast
+    groups = {};
+    groups = build_edge_groups(mesh);
+  };
+  if (lost || old_triangles.size() != renumbered) return build_afresh();
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   std::sort(added.begin(), added.end(), [](const Side& x, const Side& y) {
     if (x.lo != y.lo) return x.lo < y.lo;
     if (x.hi != y.hi) return x.hi < y.hi;
@@ -116,16 +161,42 @@ void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<
 
   // Pass 1, forward: drop the renumbered faces' old uses and the edges left
   // without a use; reverse the reversed faces' sides (side 0 <-> 2, as
-  // reverse_face swaps corners 1 and 2). Writes never pass reads.
+  // reverse_face swaps corners 1 and 2). The untouched edges between move
+  // down in blocks, their use offsets by the same amount. Writes never pass
+  // reads.
   std::vector<EdgeUse>& uses = groups.uses;
   const uint32_t old_edges = groups.edge_count();
   uint32_t kept_uses = 0, kept_edges = 0;
-  for (uint32_t e = 0; e < old_edges; ++e) {
+  auto move_block = [&](uint32_t from, uint32_t to) {  // old edges [from, to)
+    if (from == to) return;
+    const uint32_t first_use = groups.begin[from], end_use = groups.begin[to];
+    const uint32_t shift = first_use - kept_uses;
+    if (shift > 0 || kept_edges != from) {
+      std::memmove(uses.data() + kept_uses, uses.data() + first_use,
+                   (end_use - first_use) * sizeof(EdgeUse));
+      std::memmove(groups.lo.data() + kept_edges, groups.lo.data() + from,
+                   (to - from) * sizeof(uint32_t));
+      std::memmove(groups.hi.data() + kept_edges, groups.hi.data() + from,
+                   (to - from) * sizeof(uint32_t));
+      for (uint32_t i = 0; i < to - from; ++i)
+        groups.begin[kept_edges + i] = groups.begin[from + i] - shift;
+    }
+    kept_uses += end_use - first_use;
+    kept_edges += to - from;
+  };
+  uint32_t next = 0;  // first old edge not yet moved
+  uint32_t removed = 0;
+  for (const uint32_t e : touched) {
+    move_block(next, e);
+    next = e + 1;
     const uint32_t first = kept_uses;
     for (uint32_t k = groups.begin[e]; k < groups.begin[e + 1]; ++k) {
       EdgeUse u = uses[k];
       const uint8_t c = change[u.face];
-      if (c & kFaceRenumbered) continue;
+      if (c & kFaceRenumbered) {
+        ++removed;
+        continue;
+      }
       if (c & kFaceReversed) {
         u.local = static_cast<uint8_t>(2 - u.local);
         u.forward = !u.forward;
@@ -138,6 +209,8 @@ void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<
     groups.begin[kept_edges] = first;
     ++kept_edges;
   }
+  move_block(next, old_edges);
+  if (removed != 3 * renumbered) return build_afresh();  // an old triangle was wrong
 
   // Pass 2, backward: merge the added sides in, writing from the top of the
   // arrays down. The uses end at their old size again (faces keep three

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "common/mesh/mesh.h"
@@ -45,12 +46,16 @@ enum FaceChange : uint8_t {
 
 // Brings `groups`, built for a mesh with the same faces but for the changes
 // in `change` (one entry per face, FaceChange bits), up to date with `mesh`:
-// the arrays afterwards are exactly build_edge_groups(mesh)'s. The sides of
-// renumbered faces are taken out and merged back in at their new edges;
-// reversed ones are fixed in place. Two sequential passes over the groups
-// plus a sort of the renumbered faces' sides, in place (no second copy of
-// the groups): for the repair, whose rounds change a few faces of millions.
-// Precondition: all faces usable (indices in range, no repeated vertex).
-void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change);
+// the arrays afterwards are exactly build_edge_groups(mesh)'s.
+// `old_triangles` holds every renumbered face with its triangle from before
+// (any order). The sides of renumbered faces are taken out and merged back in
+// at their new edges, reversed ones are fixed in place; the edges between
+// move in blocks (memmove). In place (no second copy of the groups), and
+// about O(changed sides * log edges) besides the moves: for the repair, whose
+// rounds change a few faces of millions. Precondition: all faces usable
+// (indices in range, no repeated vertex); groups that do not match the
+// promise are built afresh.
+void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change,
+                        const std::vector<std::pair<uint32_t, Triangle>>& old_triangles);
 
 }  // namespace meshstream

@@ -259,9 +259,11 @@ void apply_flips(Mesh& mesh, const std::vector<uint8_t>& to_flip) {
 // flipped face's corners 1 and 2 trade places), so the copies are made in
 // the same order as splitting after the flips would. Returns the number of
 // vertex copies made; marks the faces given a copy kFaceRenumbered in
-// `change` (which holds to_flip's kFaceReversed marks).
+// `change` (which holds to_flip's kFaceReversed marks) and keeps their
+// triangles from before in `old_triangles` (for update_edge_groups).
 uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins,
-                    UnionFind sets, std::vector<uint8_t>& change) {
+                    UnionFind sets, std::vector<uint8_t>& change,
+                    std::vector<std::pair<uint32_t, Triangle>>& old_triangles) {
   add_joins(mesh, groups, joins, sets);
   const uint32_t corner_count = 3 * mesh.face_count();
   // The fan that keeps the original vertex is the first one visited; the
@@ -288,16 +290,22 @@ uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups, const std::vector<Join
       it->second = add_copy(mesh, v);
       ++copies;
     }
+    // A face's corners are visited one after the other, so its triangle is
+    // still the old one when its first corner is renumbered.
+    if (!(change[c / 3] & kFaceRenumbered)) {
+      old_triangles.emplace_back(c / 3, mesh.triangles[c / 3]);
+      change[c / 3] |= kFaceRenumbered;
+    }
     corner_vertex = it->second;
-    change[c / 3] |= kFaceRenumbered;
   }
   return copies;
 }
 
 // Step 4. Returns {faces detached, vertex copies made}; `change` gets
 // kFaceRenumbered for every face given a copy (sized to the faces).
-std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& groups,
-                                                 std::vector<uint8_t>& change) {
+std::pair<uint32_t, uint32_t> detach_extra_faces(
+    Mesh& mesh, const EdgeGroups& groups, std::vector<uint8_t>& change,
+    std::vector<std::pair<uint32_t, Triangle>>& old_triangles) {
   std::vector<uint8_t> detach(mesh.face_count(), 0);
   bool any = false;
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
@@ -336,12 +344,14 @@ std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& g
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     if (!detach[f]) continue;
     ++faces;
+    const Triangle before = mesh.triangles[f];
     for (uint32_t& v : mesh.triangles[f]) {
       if (users[v] <= 1) continue;  // already only this face's
       --users[v];
       v = add_copy(mesh, v);
       users.push_back(1);
       ++copies;
+      if (change[f] == kFaceKept) old_triangles.emplace_back(f, before);
       change[f] = kFaceRenumbered;
     }
   }
@@ -426,16 +436,19 @@ Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind firs
     // still hold), the flips come after it. Flipping changes no vertex of
     // any face, so groups and joins stay valid afterwards too (only the
     // directions recorded in them are stale).
-    const uint32_t split = split_fans(mesh, groups, joins, std::move(fans), change);
+    std::vector<std::pair<uint32_t, Triangle>> old_triangles;
+    const uint32_t split = split_fans(mesh, groups, joins, std::move(fans), change, old_triangles);
     apply_flips(mesh, change);
     counts.split_vertices += split;
     joins = {};
-    if (split > 0) update_edge_groups(groups, mesh, change);
+    if (split > 0) update_edge_groups(groups, mesh, change, old_triangles);
+    old_triangles.clear();
     // Without a split the detaching reads the directions from before the
     // flips, as it always has (the choice of pair, hence the output, must
     // not change); they are brought up to date after it.
     std::vector<uint8_t> detached_change;
-    const auto [detached, copies] = detach_extra_faces(mesh, groups, detached_change);
+    const auto [detached, copies] =
+        detach_extra_faces(mesh, groups, detached_change, old_triangles);
     counts.detached_faces += detached;
     counts.split_vertices += copies;
     if (split == 0 && *flipped > 0) flip_uses(groups, change);
@@ -443,7 +456,7 @@ Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind firs
     // Detaching faces nearly always leaves new non-manifold vertices: go
     // straight to another round.
     if (detached > 0) {
-      update_edge_groups(groups, mesh, detached_change);
+      update_edge_groups(groups, mesh, detached_change, old_triangles);
       continue;
     }
     // Nothing detached: no edge has more than two faces now. Every vertex

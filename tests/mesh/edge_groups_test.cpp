@@ -36,6 +36,7 @@ void check_random_changes(Mesh mesh, double share, uint32_t seed) {
   EdgeGroups groups = build_edge_groups(mesh);
   for (int round = 0; round < 4; ++round) {
     std::vector<uint8_t> change(mesh.face_count(), kFaceKept);
+    std::vector<std::pair<uint32_t, Triangle>> old_triangles;
     for (uint32_t f = 0; f < mesh.face_count(); ++f) {
       if (unit(random) >= share) continue;
       const double what = unit(random);
@@ -54,6 +55,7 @@ void check_random_changes(Mesh mesh, double share, uint32_t seed) {
         v = random() % mesh.vertex_count();
         if (v == t[0] || v == t[1] || v == t[2]) continue;
       }
+      old_triangles.emplace_back(f, t);
       t[i] = v;
       change[f] |= kFaceRenumbered;
       if (what > 0.9) {
@@ -61,7 +63,7 @@ void check_random_changes(Mesh mesh, double share, uint32_t seed) {
         change[f] |= kFaceReversed;
       }
     }
-    update_edge_groups(groups, mesh, change);
+    update_edge_groups(groups, mesh, change, old_triangles);
     expect_same_groups(groups, build_edge_groups(mesh));
     if (::testing::Test::HasFailure()) return;
   }
@@ -70,7 +72,7 @@ void check_random_changes(Mesh mesh, double share, uint32_t seed) {
 TEST(EdgeGroupsUpdate, NoChangeKeepsTheGroups) {
   Mesh mesh = make_icosphere(2);
   EdgeGroups groups = build_edge_groups(mesh);
-  update_edge_groups(groups, mesh, std::vector<uint8_t>(mesh.face_count(), kFaceKept));
+  update_edge_groups(groups, mesh, std::vector<uint8_t>(mesh.face_count(), kFaceKept), {});
   expect_same_groups(groups, build_edge_groups(mesh));
 }
 
@@ -87,12 +89,25 @@ TEST(EdgeGroupsUpdate, FirstAndLastFacesRenumbered) {
   Mesh mesh = make_open_grid(8);
   EdgeGroups groups = build_edge_groups(mesh);
   std::vector<uint8_t> change(mesh.face_count(), kFaceKept);
+  std::vector<std::pair<uint32_t, Triangle>> old_triangles;
   for (uint32_t f : {0u, mesh.face_count() - 1}) {
+    old_triangles.emplace_back(f, mesh.triangles[f]);
     mesh.positions.push_back(mesh.positions[mesh.triangles[f][0]]);
     mesh.triangles[f][0] = mesh.vertex_count() - 1;
     change[f] = kFaceRenumbered;
   }
-  update_edge_groups(groups, mesh, change);
+  update_edge_groups(groups, mesh, change, old_triangles);
+  expect_same_groups(groups, build_edge_groups(mesh));
+}
+
+TEST(EdgeGroupsUpdate, AMissingOldTriangleStillGivesAFreshBuildsGroups) {
+  Mesh mesh = make_icosphere(2);
+  EdgeGroups groups = build_edge_groups(mesh);
+  std::vector<uint8_t> change(mesh.face_count(), kFaceKept);
+  mesh.positions.push_back(mesh.positions[mesh.triangles[5][1]]);
+  mesh.triangles[5][1] = mesh.vertex_count() - 1;
+  change[5] = kFaceRenumbered;
+  update_edge_groups(groups, mesh, change, {});  // face 5's old triangle not given
   expect_same_groups(groups, build_edge_groups(mesh));
 }
 
