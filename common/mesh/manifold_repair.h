@@ -41,7 +41,9 @@ Status check_manifold(const Mesh& mesh);
 //  repeat until nothing changes. Copies keep the position and attributes.
 // Fails with kNonManifold when a surface is non-orientable through its
 // two-face edges alone (Möbius-like). The result always passes
-// Adjacency::build. O((V + F) * rounds); rounds is small (2-3 on real data).
+// Adjacency::build (checked without building one: see make_manifold's last
+// step). O((V + F) * rounds); rounds is small (2-3 on real data); the edge
+// groups are updated in place between rounds, never rebuilt.
 Result<RepairCounts> make_manifold(Mesh& mesh);
 // The same, starting from build_edge_groups(mesh) already built by the
 // caller (import builds them to decide whether to repair at all). With
