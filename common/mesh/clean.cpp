@@ -66,55 +66,93 @@ void renumber(Mesh& mesh, const std::vector<uint32_t>& new_index, uint32_t new_c
   }
 }
 
-// True when every group of merged vertices has bit-identical values.
+// True when every group of merged vertices has bit-identical values:
+// vertex v went to new_index[v], whose first vertex was first_of[new_index[v]].
 template <class T>
-bool consistent_after_merge(const std::vector<T>& values,
-                            const std::vector<uint32_t>& representative) {
+bool consistent_after_merge(const std::vector<T>& values, const std::vector<uint32_t>& new_index,
+                            const std::vector<uint32_t>& first_of) {
   if (values.empty()) return true;
   for (size_t v = 0; v < values.size(); ++v) {
-    if (std::memcmp(&values[v], &values[representative[v]], sizeof(T)) != 0) return false;
+    if (std::memcmp(&values[v], &values[first_of[new_index[v]]], sizeof(T)) != 0) return false;
   }
   return true;
 }
 
+uint64_t position_hash(const std::array<uint32_t, 3>& key) {
+  uint64_t h = (key[0] * 0x9E3779B97F4A7C15ull) ^ (key[1] * 0xC2B2AE3D27D4EB4Full) ^
+               (key[2] * 0x165667B19E3779F9ull);
+  return h ^ (h >> 29);
+}
+
 // Merges vertices whose positions are bit-identical (so -0 and +0 stay
 // apart, as the manifest counts them); each keeps the lowest index of its
-// group. An open-addressing table of the 96-bit keys: O(V), 8-16 bytes per
-// vertex besides the result.
+// group, and the groups keep the order of their first vertices. An
+// open-addressing table of the 96-bit keys, sized to the distinct positions
+// expected (from the first vertices) and grown by doubling: an STL file's
+// corners are about 6 copies of each position, so a table over every corner
+// would be 6x too big (134 MB for 3.2M triangles). O(V); besides the result,
+// 4 bytes a file vertex and 8-16 a distinct position.
 uint32_t weld(Mesh& mesh) {
   const uint32_t n = mesh.vertex_count();
-  size_t table_size = 16;
-  while (table_size < 2 * static_cast<size_t>(n)) table_size *= 2;
-  const size_t mask = table_size - 1;
-  std::vector<uint32_t> table(table_size, kNone);
-  std::vector<uint32_t> representative(n);
-  uint32_t merged = 0;
-  for (uint32_t v = 0; v < n; ++v) {
+  size_t table_size = 1024;
+  std::vector<uint32_t> table(table_size, kNone);  // first vertex of each position
+  std::vector<uint32_t> new_index(n);
+  std::vector<uint32_t> first_of;  // new index -> its first (lowest) file vertex
+  // Puts v in the table: true when its position is new (the caller numbers
+  // it), else v gets the number of the first vertex with that position.
+  auto insert = [&table, &new_index, &mesh](uint32_t v) {
     const std::array<uint32_t, 3> key = bits(mesh.positions[v]);
-    uint64_t h = (key[0] * 0x9E3779B97F4A7C15ull) ^ (key[1] * 0xC2B2AE3D27D4EB4Full) ^
-                 (key[2] * 0x165667B19E3779F9ull);
-    h ^= h >> 29;
-    for (size_t slot = h & mask;; slot = (slot + 1) & mask) {
-      const uint32_t other = table[slot];
+    const size_t mask = table.size() - 1;
+    uint32_t* slots = table.data();
+    for (size_t slot = position_hash(key) & mask;; slot = (slot + 1) & mask) {
+      const uint32_t other = slots[slot];
       if (other == kNone) {
-        table[slot] = v;
-        representative[v] = v;
-        break;
+        slots[slot] = v;
+        return true;
       }
       if (bits(mesh.positions[other]) == key) {
-        representative[v] = other;
-        ++merged;
-        break;
+        new_index[v] = new_index[other];
+        return false;
+      }
+    }
+  };
+  auto grow = [&](size_t size) {
+    table_size = size;
+    table.assign(table_size, kNone);
+    for (const uint32_t w : first_of) insert(w);
+  };
+  // After the first vertices, the table is sized once for the share of
+  // distinct positions they had (a PLY file: all, an STL file: about 1/6),
+  // so it rarely has to grow again; growing keeps it right either way.
+  constexpr uint32_t kSample = 1 << 16;
+  uint32_t count = 0;
+  for (uint32_t v = 0; v < n;) {
+    if (v == kSample) {
+      const uint64_t expected = static_cast<uint64_t>(count) * n / kSample;
+      size_t size = table_size;
+      while (size < 2 * expected) size *= 2;
+      if (size > table_size) grow(size);
+      first_of.reserve(expected + expected / 8 + 16);
+    }
+    if (2 * (count + 1) > table_size) grow(2 * table_size);  // at most half full
+    // Vertices that cannot fill the table past half, up to the sample's end.
+    uint32_t end = static_cast<uint32_t>(std::min<uint64_t>(n, v + (table_size / 2 - count)));
+    if (v < kSample) end = std::min(end, kSample);
+    for (; v < end; ++v) {
+      if (insert(v)) {
+        new_index[v] = count++;
+        first_of.push_back(v);
       }
     }
   }
   table = {};
+  const uint32_t merged = n - count;
   if (merged == 0) return 0;
 
   // Values that differ between welded vertices are seams: kept per corner
   // (the corners still index the file's vertices, which are the values).
   auto check = [&](auto& values, auto& corner) {
-    if (!consistent_after_merge(values, representative)) {
+    if (!consistent_after_merge(values, new_index, first_of)) {
       corner = to_corner_attribute(mesh, values);
       values.clear();
     }
@@ -122,13 +160,7 @@ uint32_t weld(Mesh& mesh) {
   check(mesh.normals, mesh.corner_normals);
   check(mesh.colors, mesh.corner_colors);
   check(mesh.texcoords, mesh.corner_texcoords);
-
-  std::vector<uint32_t> new_index(n, kNone);
-  uint32_t count = 0;
-  for (uint32_t v = 0; v < n; ++v) {
-    if (representative[v] == v) new_index[v] = count++;
-  }
-  for (uint32_t v = 0; v < n; ++v) new_index[v] = new_index[representative[v]];
+  first_of = {};
   renumber(mesh, new_index, count);
   return merged;
 }
@@ -186,9 +218,10 @@ uint32_t drop_duplicates(Mesh& mesh, std::vector<uint8_t>& had_twin) {
 // any other face was a flap hanging off the surface at non-manifold edges.
 // It adds nothing to the surface and would be a component of its own for
 // the codec: drop it. Returns the number of faces dropped.
-uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin) {
+// `groups`: the repaired mesh's edge groups (make_manifold hands them back).
+uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin,
+                             const EdgeGroups& groups) {
   if (had_twin.size() != mesh.triangles.size()) return 0;
-  const EdgeGroups groups = build_edge_groups(mesh);
   std::vector<uint8_t> shared_edges(mesh.face_count(), 0);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     if (groups.use_count(e) < 2) continue;
@@ -271,7 +304,8 @@ Result<CleanReport> clean_faces(Mesh& mesh, const ImportOptions& options) {
   }
 
   EdgeGroups groups = build_edge_groups(mesh);
-  const ManifoldCounts found = count_nonmanifold(mesh, groups);
+  UnionFind fans = two_face_fans(mesh, groups);
+  const ManifoldCounts found = count_nonmanifold(mesh, groups, fans);
   report.nonmanifold_edges = found.nonmanifold_edges;
   report.nonmanifold_vertices = found.nonmanifold_vertices;
   if (options.keep_nonmanifold) return report;
@@ -280,17 +314,21 @@ Result<CleanReport> clean_faces(Mesh& mesh, const ImportOptions& options) {
   if (found.manifold() && found.orientation_conflicts == 0) return report;
   if (!options.repair_nonmanifold) {
     groups = {};
+    fans = UnionFind(0);
     if (auto status = check_manifold(mesh); !status) return tl::unexpected(status.error());
     return report;
   }
   const uint32_t vertices_before_repair = mesh.vertex_count();
-  auto repaired = make_manifold(mesh, std::move(groups));
+  EdgeGroups repaired_groups;
+  auto repaired = make_manifold(mesh, std::move(groups), std::move(fans), &repaired_groups);
   if (!repaired) return tl::unexpected(repaired.error());
   report.split_vertices = repaired->split_vertices;
   report.detached_faces = repaired->detached_faces;
   report.flipped_faces = repaired->flipped_faces;
+  if (!options.drop_double_sided_flaps) repaired_groups = {};
   if (options.drop_double_sided_flaps) {
-    report.double_sided_flaps = drop_isolated_twins(mesh, had_twin);
+    report.double_sided_flaps = drop_isolated_twins(mesh, had_twin, repaired_groups);
+    repaired_groups = {};
     if (report.double_sided_flaps > 0) {
       // Vertices only the flaps used: repair copies (appended after the
       // original vertices) were never really added; originals are unreferenced.

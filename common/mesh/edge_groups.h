@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "common/mesh/mesh.h"
@@ -35,5 +36,26 @@ struct EdgeGroups {
 // about 42 bytes per face for the result and, while building, 8 per vertex
 // and 12 per face (the larger vertex of every side).
 EdgeGroups build_edge_groups(const Mesh& mesh);
+
+// How a face changed since its edge groups were built (update_edge_groups).
+enum FaceChange : uint8_t {
+  kFaceKept = 0,
+  kFaceReversed = 1,    // reverse_face: the same vertices, walked the other way
+  kFaceRenumbered = 2,  // some corner now holds another vertex (may be reversed too)
+};
+
+// Brings `groups`, built for a mesh with the same faces but for the changes
+// in `change` (one entry per face, FaceChange bits), up to date with `mesh`:
+// the arrays afterwards are exactly build_edge_groups(mesh)'s.
+// `old_triangles` holds every renumbered face with its triangle from before
+// (any order). The sides of renumbered faces are taken out and merged back in
+// at their new edges, reversed ones are fixed in place; the edges between
+// move in blocks (memmove). In place (no second copy of the groups), and
+// about O(changed sides * log edges) besides the moves: for the repair, whose
+// rounds change a few faces of millions. Precondition: all faces usable
+// (indices in range, no repeated vertex); groups that do not match the
+// promise are built afresh.
+void update_edge_groups(EdgeGroups& groups, const Mesh& mesh, const std::vector<uint8_t>& change,
+                        const std::vector<std::pair<uint32_t, Triangle>>& old_triangles);
 
 }  // namespace meshstream

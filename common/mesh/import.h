@@ -87,7 +87,9 @@ struct ImportedMesh {
 // cut loose (option drop_double_sided_flaps). Vertex order is the file's, minus what was
 // dropped, plus repair copies appended at the end. Cost: O(V + F) (welding
 // by hashing, duplicates and edges by per-vertex buckets: no sort over the
-// whole mesh) plus parsing, times the repair's rounds (2-3 on real data).
+// whole mesh) plus parsing. The edge groups are built once and updated in
+// place by the repair; each repair round (2-3 on real data) adds one
+// union-find over the corners and sequential passes over the groups.
 Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& options = {});
 
 // The cleaning step alone, on a mesh already in memory (same rules as import).

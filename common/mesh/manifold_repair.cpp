@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <deque>
 #include <sstream>
+#include <unordered_map>
 
 #include "common/mesh/adjacency.h"
 #include "common/mesh/corner_data.h"
 #include "common/mesh/edge_groups.h"
+#include "common/mesh/topology.h"
 #include "common/mesh/union_find.h"
 
 namespace meshstream {
@@ -56,18 +58,6 @@ void add_joins(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Joi
   }
 }
 
-// Corner sets joined across every two-face edge and the given joins (not
-// cut) at each shared endpoint; each set is one fan of faces around one vertex.
-UnionFind fans_through(const Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins) {
-  UnionFind sets(3 * mesh.face_count());
-  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
-    if (groups.use_count(e) == 2)
-      join_across(mesh, groups, e, groups.begin[e], groups.begin[e] + 1, sets);
-  }
-  add_joins(mesh, groups, joins, sets);
-  return sets;
-}
-
 // Step 1 for one non-manifold edge: a greedy matching of consistently
 // oriented pairs (opposite directions), best score first. Score: faces
 // already in one fan at both endpoints (through two-face edges) beat faces
@@ -109,7 +99,7 @@ void match_nonmanifold_edge(const Mesh& mesh, const EdgeGroups& groups, uint32_t
 }
 
 // The pairings at non-manifold edges (the two-face edges are joined anyway).
-// `fans`: the corner sets through the two-face edges alone (fans_through
+// `fans`: the corner sets through the two-face edges alone (two_face_fans,
 // with no joins); the matching reads them and leaves them as they are.
 std::vector<Join> choose_joins(const Mesh& mesh, const EdgeGroups& groups, UnionFind& fans) {
   std::vector<Join> joins;
@@ -175,6 +165,30 @@ class ParityUnionFind {
   std::vector<uint8_t> parity_;
 };
 
+// True when both faces of every two-face edge walk it in opposite
+// directions (the recorded directions must be the faces' current ones). A
+// sequential pass over the groups: no face is read.
+bool two_face_edges_consistent(const EdgeGroups& groups) {
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) != 2) continue;
+    if (groups.uses[groups.begin[e]].forward == groups.uses[groups.begin[e] + 1].forward)
+      return false;
+  }
+  return true;
+}
+
+// After reverse_face on the faces in `to_flip`: their sides are the same
+// edges walked the other way, side 0 <-> 2 (reverse_face swaps corners 1 and
+// 2), side 1 stays. No membership changes, so the groups stay those a fresh
+// build_edge_groups would give (uses of an edge stay in face order).
+void flip_uses(EdgeGroups& groups, const std::vector<uint8_t>& to_flip) {
+  for (EdgeUse& u : groups.uses) {
+    if (!(to_flip[u.face] & kFaceReversed)) continue;
+    u.local = static_cast<uint8_t>(2 - u.local);
+    u.forward = !u.forward;
+  }
+}
+
 // Step 2. Orients patches through required joins (a contradiction there is a
 // non-orientable surface: error), then glues patches through optional joins
 // where they agree and cuts the ones that contradict. Returns the number of
@@ -183,6 +197,14 @@ class ParityUnionFind {
 Result<uint32_t> orient(const Mesh& mesh, const EdgeGroups& groups, std::vector<Join>& joins,
                         std::vector<uint8_t>& to_flip) {
   const uint32_t f_count = mesh.face_count();
+  // Joins always pair opposite directions (match_nonmanifold_edge), so when
+  // every two-face edge does too, every relation below asks for "no flip":
+  // each face has parity 0 to its root, no join contradicts, every set keeps
+  // its orientation. The answer is known without the pass over the faces.
+  if (two_face_edges_consistent(groups)) {
+    to_flip.assign(f_count, 0);
+    return 0u;
+  }
   ParityUnionFind faces(f_count);
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     if (groups.use_count(e) != 2) continue;
@@ -226,7 +248,7 @@ Result<uint32_t> orient(const Mesh& mesh, const EdgeGroups& groups, std::vector<
 
 void apply_flips(Mesh& mesh, const std::vector<uint8_t>& to_flip) {
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
-    if (to_flip[f]) reverse_face(mesh, f);  // its corner data follows
+    if (to_flip[f] & kFaceReversed) reverse_face(mesh, f);  // its corner data follows
   }
 }
 
@@ -236,35 +258,54 @@ void apply_flips(Mesh& mesh, const std::vector<uint8_t>& to_flip) {
 // are visited in the order they will have once `to_flip` is applied (a
 // flipped face's corners 1 and 2 trade places), so the copies are made in
 // the same order as splitting after the flips would. Returns the number of
-// vertex copies made.
+// vertex copies made; marks the faces given a copy kFaceRenumbered in
+// `change` (which holds to_flip's kFaceReversed marks) and keeps their
+// triangles from before in `old_triangles` (for update_edge_groups).
 uint32_t split_fans(Mesh& mesh, const EdgeGroups& groups, const std::vector<Join>& joins,
-                    UnionFind sets, const std::vector<uint8_t>& to_flip) {
+                    UnionFind sets, std::vector<uint8_t>& change,
+                    std::vector<std::pair<uint32_t, Triangle>>& old_triangles) {
   add_joins(mesh, groups, joins, sets);
   const uint32_t corner_count = 3 * mesh.face_count();
-  std::vector<uint32_t> owner(mesh.vertex_count(), kNone);  // fan keeping the original
-  std::vector<uint32_t> root_vertex(corner_count, kNone);
+  // The fan that keeps the original vertex is the first one visited; the
+  // others (few: only at non-manifold vertices) get a copy, found through a
+  // small map, not an array over every corner (12 bytes a face).
+  std::vector<uint32_t> owner(mesh.vertex_count(), kNone);
+  std::unordered_map<uint32_t, uint32_t> copy_of_fan;
   uint32_t copies = 0;
   for (uint32_t visit = 0; visit < corner_count; ++visit) {
     const uint32_t local = visit % 3;
-    const uint32_t c = to_flip[visit / 3] && local != 0 ? visit - local + (3 - local) : visit;
-    const uint32_t v = mesh.triangles[c / 3][c % 3];
+    const uint32_t c =
+        (change[visit / 3] & kFaceReversed) && local != 0 ? visit - local + (3 - local) : visit;
+    uint32_t& corner_vertex = mesh.triangles[c / 3][c % 3];
+    const uint32_t v = corner_vertex;
+    // Each corner is read once, before it is renumbered: v is the original.
     const uint32_t root = sets.find(c);
-    if (root_vertex[root] == kNone) {
-      if (owner[v] == kNone) {
-        owner[v] = root;
-        root_vertex[root] = v;
-      } else {
-        root_vertex[root] = add_copy(mesh, v);
-        ++copies;
-      }
+    if (owner[v] == kNone) {
+      owner[v] = root;
+      continue;
     }
-    mesh.triangles[c / 3][c % 3] = root_vertex[root];
+    if (owner[v] == root) continue;
+    auto [it, added] = copy_of_fan.try_emplace(root, 0u);
+    if (added) {
+      it->second = add_copy(mesh, v);
+      ++copies;
+    }
+    // A face's corners are visited one after the other, so its triangle is
+    // still the old one when its first corner is renumbered.
+    if (!(change[c / 3] & kFaceRenumbered)) {
+      old_triangles.emplace_back(c / 3, mesh.triangles[c / 3]);
+      change[c / 3] |= kFaceRenumbered;
+    }
+    corner_vertex = it->second;
   }
   return copies;
 }
 
-// Step 4. Returns {faces detached, vertex copies made}.
-std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& groups) {
+// Step 4. Returns {faces detached, vertex copies made}; `change` gets
+// kFaceRenumbered for every face given a copy (sized to the faces).
+std::pair<uint32_t, uint32_t> detach_extra_faces(
+    Mesh& mesh, const EdgeGroups& groups, std::vector<uint8_t>& change,
+    std::vector<std::pair<uint32_t, Triangle>>& old_triangles) {
   std::vector<uint8_t> detach(mesh.face_count(), 0);
   bool any = false;
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
@@ -294,6 +335,7 @@ std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& g
     }
   }
   if (!any) return {0, 0};
+  change.assign(mesh.face_count(), kFaceKept);
   std::vector<uint32_t> users(mesh.vertex_count(), 0);
   for (const Triangle& t : mesh.triangles) {
     for (uint32_t v : t) ++users[v];
@@ -302,12 +344,15 @@ std::pair<uint32_t, uint32_t> detach_extra_faces(Mesh& mesh, const EdgeGroups& g
   for (uint32_t f = 0; f < mesh.face_count(); ++f) {
     if (!detach[f]) continue;
     ++faces;
+    const Triangle before = mesh.triangles[f];
     for (uint32_t& v : mesh.triangles[f]) {
       if (users[v] <= 1) continue;  // already only this face's
       --users[v];
       v = add_copy(mesh, v);
       users.push_back(1);
       ++copies;
+      if (change[f] == kFaceKept) old_triangles.emplace_back(f, before);
+      change[f] = kFaceRenumbered;
     }
   }
   return {faces, copies};
@@ -332,7 +377,7 @@ Status check_manifold(const Mesh& mesh) {
                             edge_name(mesh, groups.lo[e], groups.hi[e]) + " in the same direction");
     }
   }
-  UnionFind sets = fans_through(mesh, groups, {});
+  UnionFind sets = two_face_fans(mesh, groups);
   std::vector<uint32_t> first_root(mesh.vertex_count(), kNone);
   for (uint32_t c = 0; c < 3 * mesh.face_count(); ++c) {
     const uint32_t v = mesh.triangles[c / 3][c % 3];
@@ -351,47 +396,86 @@ Result<RepairCounts> make_manifold(Mesh& mesh) {
   return make_manifold(mesh, build_edge_groups(mesh));
 }
 
-Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups) {
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, EdgeGroups* final_groups) {
+  UnionFind fans = two_face_fans(mesh, groups);
+  return make_manifold(mesh, std::move(groups), std::move(fans), final_groups);
+}
+
+// Room for the vertex copies the repair appends, made now: growing the
+// arrays by doubling in the middle of the fan split would hold the old and
+// the new array at once beside everything the split needs (the peak).
+// Pages the copies never reach cost no memory.
+template <class T>
+void leave_room(std::vector<T>& values) {
+  if (values.empty()) return;
+  const size_t room = values.size() + values.size() / 32 + 64;
+  if (values.capacity() < room) values.reserve(room);
+}
+
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind first_fans,
+                                   EdgeGroups* final_groups) {
+  leave_room(mesh.positions);
+  leave_room(mesh.normals);
+  leave_room(mesh.colors);
+  leave_room(mesh.texcoords);
   RepairCounts counts;
   constexpr int kMaxRounds = 32;
   std::string last_problem;
   for (int round = 0; round < kMaxRounds; ++round) {
-    // Old groups are released before new ones are built, never two at once.
-    if (round > 0) {
-      groups = {};
-      groups = build_edge_groups(mesh);
-    }
-    UnionFind fans = fans_through(mesh, groups, {});
+    // `groups` are those of the mesh as it is now: every change below
+    // updates them in place (update_edge_groups), as a fresh build would
+    // give them, instead of building them again (the old and the new
+    // groups are never alive at once).
+    UnionFind fans = round == 0 ? std::move(first_fans) : two_face_fans(mesh, groups);
     std::vector<Join> joins = choose_joins(mesh, groups, fans);
-    std::vector<uint8_t> to_flip;
-    auto flipped = orient(mesh, groups, joins, to_flip);
+    std::vector<uint8_t> change;  // orient's flips, then the split's copies
+    auto flipped = orient(mesh, groups, joins, change);
     if (!flipped) return tl::unexpected(flipped.error());
     counts.flipped_faces += *flipped;
     // The split works on the faces as they are (so the fans' corner numbers
     // still hold), the flips come after it. Flipping changes no vertex of
     // any face, so groups and joins stay valid afterwards too (only the
     // directions recorded in them are stale).
-    const uint32_t split = split_fans(mesh, groups, joins, std::move(fans), to_flip);
-    apply_flips(mesh, to_flip);
-    to_flip = {};
+    std::vector<std::pair<uint32_t, Triangle>> old_triangles;
+    const uint32_t split = split_fans(mesh, groups, joins, std::move(fans), change, old_triangles);
+    apply_flips(mesh, change);
     counts.split_vertices += split;
-    if (split > 0) {
-      groups = {};
-      groups = build_edge_groups(mesh);
-    }
-    const auto [detached, copies] = detach_extra_faces(mesh, groups);
+    joins = {};
+    if (split > 0) update_edge_groups(groups, mesh, change, old_triangles);
+    old_triangles.clear();
+    // Without a split the detaching reads the directions from before the
+    // flips, as it always has (the choice of pair, hence the output, must
+    // not change); they are brought up to date after it.
+    std::vector<uint8_t> detached_change;
+    const auto [detached, copies] =
+        detach_extra_faces(mesh, groups, detached_change, old_triangles);
     counts.detached_faces += detached;
     counts.split_vertices += copies;
+    if (split == 0 && *flipped > 0) flip_uses(groups, change);
+    change = {};
     // Detaching faces nearly always leaves new non-manifold vertices: go
-    // straight to another round. Otherwise the corner table is the judge
-    // (and the cheapest full check).
-    if (detached > 0) continue;
-    // The groups are rebuilt by the next round anyway: never hold them and a
-    // corner table at once (about 42 and 40 bytes per face).
-    groups = {};
-    joins = {};
+    // straight to another round.
+    if (detached > 0) {
+      update_edge_groups(groups, mesh, detached_change, old_triangles);
+      continue;
+    }
+    // Nothing detached: no edge has more than two faces now. Every vertex
+    // (original or copy) is one fan: its corners were one set of this
+    // round's joins, each join is between two faces that now share an edge
+    // of the same two vertices (join_across joins both endpoints), and that
+    // edge has at most two faces, so it is a two-face edge joining them. So
+    // the corner table accepts the mesh exactly when every two-face edge is
+    // walked both ways, which the groups (current again) tell without
+    // building it. When one is not, the table is built for its message.
+    if (two_face_edges_consistent(groups)) {
+      if (final_groups) *final_groups = std::move(groups);
+      return counts;
+    }
     auto adjacency = Adjacency::build(mesh);
-    if (adjacency) return counts;
+    if (adjacency) {
+      if (final_groups) *final_groups = std::move(groups);
+      return counts;
+    }
     last_problem = adjacency.error().message;
     if (*flipped == 0 && split == 0) break;  // stuck
   }

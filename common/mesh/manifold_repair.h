@@ -7,6 +7,7 @@
 #include "common/base/result.h"
 #include "common/mesh/edge_groups.h"
 #include "common/mesh/mesh.h"
+#include "common/mesh/union_find.h"
 
 namespace meshstream {
 
@@ -40,10 +41,19 @@ Status check_manifold(const Mesh& mesh);
 //  repeat until nothing changes. Copies keep the position and attributes.
 // Fails with kNonManifold when a surface is non-orientable through its
 // two-face edges alone (Möbius-like). The result always passes
-// Adjacency::build. O((V + F) * rounds); rounds is small (2-3 on real data).
+// Adjacency::build (checked without building one: see make_manifold's last
+// step). O((V + F) * rounds); rounds is small (2-3 on real data); the edge
+// groups are updated in place between rounds, never rebuilt.
 Result<RepairCounts> make_manifold(Mesh& mesh);
 // The same, starting from build_edge_groups(mesh) already built by the
-// caller (import builds them to decide whether to repair at all).
-Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups);
+// caller (import builds them to decide whether to repair at all). With
+// `final_groups`, the edge groups of the repaired mesh are handed back
+// (import's flap check reads them instead of building them again).
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups,
+                                   EdgeGroups* final_groups = nullptr);
+// The same, with two_face_fans(mesh, groups) too already built by the caller
+// (import counts the non-manifold vertices with them).
+Result<RepairCounts> make_manifold(Mesh& mesh, EdgeGroups groups, UnionFind fans,
+                                   EdgeGroups* final_groups);
 
 }  // namespace meshstream

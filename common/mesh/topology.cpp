@@ -80,32 +80,71 @@ MeshStats compute_stats(const Mesh& mesh) {
   return s;
 }
 
+namespace {
+
+uint32_t corner_at(const Mesh& mesh, uint32_t f, uint32_t v) {
+  const Triangle& t = mesh.triangles[f];
+  return 3 * f + (t[0] == v ? 0 : (t[1] == v ? 1 : 2));
+}
+
+}  // namespace
+
+UnionFind two_face_fans(const Mesh& mesh, const EdgeGroups& groups) {
+  UnionFind sets(3 * mesh.face_count());
+  for (uint32_t e = 0; e < groups.edge_count(); ++e) {
+    if (groups.use_count(e) != 2) continue;
+    const uint32_t fa = groups.uses[groups.begin[e]].face;
+    const uint32_t fb = groups.uses[groups.begin[e] + 1].face;
+    sets.unite(corner_at(mesh, fa, groups.lo[e]), corner_at(mesh, fb, groups.lo[e]));
+    sets.unite(corner_at(mesh, fa, groups.hi[e]), corner_at(mesh, fb, groups.hi[e]));
+  }
+  return sets;
+}
+
 ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups) {
+  UnionFind fans = two_face_fans(mesh, groups);
+  return count_nonmanifold(mesh, groups, fans);
+}
+
+ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups, UnionFind& fans) {
   ManifoldCounts s;
   const uint32_t n = mesh.vertex_count();
   const uint32_t faces = mesh.face_count();
-  // Fans by joining, at each endpoint, the corners of all faces that share
-  // an edge.
-  UnionFind corner_sets(3 * faces);
-  auto corner_at = [&mesh](uint32_t f, uint32_t v) {
-    const Triangle& t = mesh.triangles[f];
-    return 3 * f + (t[0] == v ? 0 : (t[1] == v ? 1 : 2));
-  };
+  // Fans join, at each endpoint, the corners of all faces that share an
+  // edge. `fans` has the two-face edges; the faces of each edge with more
+  // than two are joined here, over the fans they are in (few: a small
+  // union-find over those fans, found by binary search).
+  std::vector<uint8_t> at_crowded_edge(n, 0);
+  std::vector<std::pair<uint32_t, uint32_t>> extra;  // fans to join
   for (uint32_t e = 0; e < groups.edge_count(); ++e) {
     const uint32_t count = groups.use_count(e);
     const EdgeUse* uses = &groups.uses[groups.begin[e]];
-    if (count > 2) {
-      ++s.nonmanifold_edges;
-    } else if (count == 2 && uses[0].forward == uses[1].forward) {
-      ++s.orientation_conflicts;
-    }
+    if (count == 2 && uses[0].forward == uses[1].forward) ++s.orientation_conflicts;
+    if (count <= 2) continue;
+    ++s.nonmanifold_edges;
+    at_crowded_edge[groups.lo[e]] = at_crowded_edge[groups.hi[e]] = 1;
     for (uint32_t k = 1; k < count; ++k) {
-      corner_sets.unite(corner_at(uses[0].face, groups.lo[e]),
-                        corner_at(uses[k].face, groups.lo[e]));
-      corner_sets.unite(corner_at(uses[0].face, groups.hi[e]),
-                        corner_at(uses[k].face, groups.hi[e]));
+      for (const uint32_t v : {groups.lo[e], groups.hi[e]}) {
+        extra.emplace_back(fans.find(corner_at(mesh, uses[0].face, v)),
+                           fans.find(corner_at(mesh, uses[k].face, v)));
+      }
     }
   }
+  std::vector<uint32_t> joined_fans;
+  joined_fans.reserve(2 * extra.size());
+  for (const auto& [a, b] : extra) {
+    joined_fans.push_back(a);
+    joined_fans.push_back(b);
+  }
+  std::sort(joined_fans.begin(), joined_fans.end());
+  joined_fans.erase(std::unique(joined_fans.begin(), joined_fans.end()), joined_fans.end());
+  auto index_of = [&joined_fans](uint32_t root) {
+    return static_cast<uint32_t>(std::lower_bound(joined_fans.begin(), joined_fans.end(), root) -
+                                 joined_fans.begin());
+  };
+  UnionFind joined(static_cast<uint32_t>(joined_fans.size()));
+  for (const auto& [a, b] : extra) joined.unite(index_of(a), index_of(b));
+  extra = {};
 
   // A vertex is non-manifold when its corners fall into more than one set.
   std::vector<uint32_t> first_fan(n, 0xFFFFFFFFu);
@@ -114,8 +153,12 @@ ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups) {
     const Triangle& t = mesh.triangles[f];
     if (!usable(t, n)) continue;
     for (uint32_t i = 0; i < 3; ++i) {
-      const uint32_t root = corner_sets.find(3 * f + i);
+      uint32_t root = fans.find(3 * f + i);
       const uint32_t v = t[i];
+      if (at_crowded_edge[v]) {
+        const uint32_t k = index_of(root);
+        if (k < joined_fans.size() && joined_fans[k] == root) root = joined_fans[joined.find(k)];
+      }
       if (first_fan[v] == 0xFFFFFFFFu) {
         first_fan[v] = root;
       } else if (first_fan[v] != root && !counted[v]) {

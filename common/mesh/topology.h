@@ -7,6 +7,7 @@
 
 #include "common/mesh/edge_groups.h"
 #include "common/mesh/mesh.h"
+#include "common/mesh/union_find.h"
 
 namespace meshstream {
 
@@ -51,5 +52,17 @@ struct ManifoldCounts {
   bool manifold() const { return nonmanifold_edges == 0 && nonmanifold_vertices == 0; }
 };
 ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups);
+
+// The corners of every vertex joined into fans through the two-face edges
+// alone (at both endpoints of each): what the manifold repair's first round
+// starts from. 5 bytes a corner.
+UnionFind two_face_fans(const Mesh& mesh, const EdgeGroups& groups);
+
+// count_nonmanifold from those fans (built by two_face_fans from the same
+// groups): the faces around an edge with more than two faces are joined in
+// a small structure of their own, so import needs one union-find over the
+// corners, not two, and hands `fans` on to the repair (finds compress its
+// paths, the sets stay the same).
+ManifoldCounts count_nonmanifold(const Mesh& mesh, const EdgeGroups& groups, UnionFind& fans);
 
 }  // namespace meshstream

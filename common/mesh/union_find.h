@@ -1,8 +1,10 @@
-// Disjoint sets over 0..n-1 with path halving and union by rank: the
-// workhorse of component, fan and boundary-loop counting. Near O(1) per call;
-// 5 bytes per element (ranks stay below 32, so one byte holds them: import
-// builds these over every corner of big meshes). Callers use the sets, never
-// which element is a root.
+// Disjoint sets over 0..n-1 with path halving, linking the larger root
+// under the smaller: the workhorse of component, fan and boundary-loop
+// counting. 4 bytes per element and no rank beside it: import builds these
+// over every corner of big meshes, where a rank byte was 3 bytes a face
+// and one more cache miss per union. Path halving alone keeps finds
+// amortized O(log n) and in practice a step or two. Callers use the sets,
+// never which element is a root.
 #pragma once
 
 #include <cstdint>
@@ -13,9 +15,7 @@ namespace meshstream {
 
 class UnionFind {
  public:
-  explicit UnionFind(uint32_t n) : parent_(n), rank_(n, 0) {
-    std::iota(parent_.begin(), parent_.end(), 0u);
-  }
+  explicit UnionFind(uint32_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
 
   uint32_t find(uint32_t x) {
     while (parent_[x] != x) {
@@ -30,15 +30,13 @@ class UnionFind {
     a = find(a);
     b = find(b);
     if (a == b) return false;
-    if (rank_[a] < rank_[b]) std::swap(a, b);
+    if (a > b) std::swap(a, b);
     parent_[b] = a;
-    if (rank_[a] == rank_[b]) ++rank_[a];
     return true;
   }
 
  private:
   std::vector<uint32_t> parent_;
-  std::vector<uint8_t> rank_;
 };
 
 }  // namespace meshstream
