@@ -17,6 +17,7 @@
 #include "common/codec/decimate.h"
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/editable_mesh.h"
+#include "common/codec/locality_cells.h"
 #include "common/codec/quantize.h"
 #include "common/codec/rd_measure.h"
 #include "common/codec/record_schedule.h"
@@ -67,6 +68,11 @@ Status check_options(const EncodeOptions& options) {
     return make_error(ErrorCode::kInvalidArgument,
                       "distortion estimate " + std::to_string(int(options.distortion_estimate)) +
                           " is not 0 (automatic), 1 (displacement) or 2 (surface distance)");
+  }
+  if (options.locality_cells > kMaxLocalityCells) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "locality cells " + std::to_string(options.locality_cells) + " is not 0.." +
+                          std::to_string(kMaxLocalityCells));
   }
   if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
     return make_error(ErrorCode::kInvalidArgument,
@@ -373,6 +379,11 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
   dopt.locked = plan->locked;
+  if (options.locality_cells > 0) {
+    dopt.layer_locks = [&options](uint32_t layer, const EditableMesh& m, std::vector<uint8_t>& l) {
+      lock_cell_borders(m, layer, options.locality_cells, options.quant_bits, l);
+    };
+  }
   DecimationResult dec = decimate_layers(std::move(*editable), dopt);
 
   // The candidates.
