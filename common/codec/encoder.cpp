@@ -69,10 +69,13 @@ Status check_options(const EncodeOptions& options) {
                       "distortion estimate " + std::to_string(int(options.distortion_estimate)) +
                           " is not 0 (automatic), 1 (displacement) or 2 (surface distance)");
   }
-  if (options.locality_cells > kMaxLocalityCells) {
+  if (options.locality_cell_vertices != 0 &&
+      (options.locality_cell_vertices < kMinLocalityCellVertices ||
+       options.locality_cell_vertices > kMaxLocalityCellVertices)) {
     return make_error(ErrorCode::kInvalidArgument,
-                      "locality cells " + std::to_string(options.locality_cells) + " is not 0.." +
-                          std::to_string(kMaxLocalityCells));
+                      "locality cell vertices " + std::to_string(options.locality_cell_vertices) +
+                          " is not 0 (off) or " + std::to_string(kMinLocalityCellVertices) + ".." +
+                          std::to_string(kMaxLocalityCellVertices));
   }
   if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
     return make_error(ErrorCode::kInvalidArgument,
@@ -379,9 +382,11 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
   dopt.locked = plan->locked;
-  if (options.locality_cells > 0) {
-    dopt.layer_locks = [&options](uint32_t layer, const EditableMesh& m, std::vector<uint8_t>& l) {
-      lock_cell_borders(m, layer, options.locality_cells, options.quant_bits, l);
+  if (options.locality_cell_vertices > 0) {
+    dopt.layer_locks = [levels = CellLevels(options.locality_cell_vertices),
+                        bits = options.quant_bits](uint32_t, const EditableMesh& m,
+                                                   std::vector<uint8_t>& l) mutable {
+      lock_cell_borders(m, levels.next(live_vertices(m)), bits, l);
     };
   }
   DecimationResult dec = decimate_layers(std::move(*editable), dopt);

@@ -98,12 +98,13 @@ struct EncodeOptions {
   int quant_uv = 12;
   int quant_color = 8;
   // The locality experiment (issue 17, docs/view-dependent-records.md):
-  // 0 = off (the default; the stream is unchanged). n = 1..kMaxLocalityCells
-  // (else kInvalidArgument): each decimation layer keeps the borders of a
-  // grid of n^3 cells (shifted by half a cell on odd layers), so every patch
-  // lies inside one cell (locality_cells.h). The stream is an ordinary
-  // stream; only the decimation is restricted.
-  uint32_t locality_cells = 0;
+  // 0 = off (the default; the stream is unchanged). Else each decimation
+  // layer keeps the borders of a grid of cells of at least about this many
+  // of its vertices (one grid a level of layers, locality_cells.h), so every
+  // patch lies inside one cell; kMinLocalityCellVertices ..
+  // kMaxLocalityCellVertices, else kInvalidArgument. The stream is an
+  // ordinary stream; only the decimation is restricted.
+  uint32_t locality_cell_vertices = 0;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each

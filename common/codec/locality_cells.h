@@ -1,12 +1,20 @@
 // Spatial cells for the locality experiment of issue 17 (view-dependent
-// streaming; docs/view-dependent-records.md): a grid of `per_axis`^3 cells
-// over the quantization grid, shifted by half a cell on odd decimation
-// layers (so a border locked in one layer is free in the next, as the
-// alternating partitions of Nexus's batched multi-triangulation). A vertex
-// with a neighbour in another cell is a border vertex and is not removed in
-// that layer: every removal's patch then lies inside one cell, so a cell's
-// refinements of one layer depend only on coarser refinements of the same
-// cell. `EncodeOptions::locality_cells`; off by default.
+// streaming; docs/view-dependent-records.md). Each decimation layer gets a
+// grid of n^3 cells over the quantization grid, n a power of two chosen
+// from the vertices the layer starts with so a cell holds at least about
+// `cell_vertices` of them. The layers with the same n form a *level* and
+// share its grid (so a cell's patches of one level build only on that
+// cell); n halves as the mesh coarsens by about 4x, as the levels of
+// Nexus's batched multi-triangulation coarsen, and each level's grid is
+// shifted by a golden-ratio share of its cell (borders of consecutive
+// levels do not coincide: a border locked in one level is free in the
+// next). Measured against one grid a layer shifted every other layer:
+// bench/REPORT.md, "View-dependent records". A vertex of a face
+// whose corners lie in different cells is a border vertex and is not
+// removed in that layer: every removal's patch then lies inside one cell,
+// so a cell's refinements of one layer depend only on coarser refinements
+// of the same region. `EncodeOptions::locality_cell_vertices`; off by
+// default.
 #pragma once
 
 #include <cstdint>
@@ -17,15 +25,44 @@
 namespace meshstream {
 
 inline constexpr uint32_t kMaxLocalityCells = 64;  // per axis
+inline constexpr uint32_t kMinLocalityCellVertices = 16;
+inline constexpr uint32_t kMaxLocalityCellVertices = 1u << 20;
 
-// The cell of grid point q in decimation layer `layer` (0 = the first
-// removed, the finest), for a grid of `quant_bits` and `per_axis` >= 1
-// cells an axis.
-uint32_t locality_cell(Vec3i q, uint32_t layer, uint32_t per_axis, int quant_bits);
+// n for a layer that starts with `alive` vertices: the largest power of two
+// at most sqrt(alive / (3 x cell_vertices)) — a surface meets about 3 n^2
+// cells of an n^3 grid — and at most kMaxLocalityCells; 1 (one cell,
+// nothing locked) below 2. 0 cell_vertices: 1.
+uint32_t cells_per_axis(uint32_t alive, uint32_t cell_vertices);
 
-// Sets locked[v] = 1 (locked sized to the mesh's vertices) for every vertex
-// of a live face whose corners lie in different cells of `layer`. O(faces).
-void lock_cell_borders(const EditableMesh& mesh, uint32_t layer, uint32_t per_axis, int quant_bits,
+// The cell of grid point q in the grid of `per_axis` >= 2 cells an axis
+// (a power of two) over a grid of `quant_bits`, shifted by frac(log2(n) x
+// 0.618...) of a cell.
+uint32_t locality_cell(Vec3i q, uint32_t per_axis, int quant_bits);
+
+// The grid of each decimation layer, from the vertices each starts with
+// (the same sequence on the encoder and on a reader that counts the
+// vertices after each restored layer): cells_per_axis, never more than the
+// layer before; and half of the layer before's when that layer removed
+// under 1/12 of its vertices (its cells' insides are used up: the
+// level's borders must go, or the decimation would stall on them).
+class CellLevels {
+ public:
+  explicit CellLevels(uint32_t cell_vertices) : cell_vertices_(cell_vertices) {}
+  uint32_t next(uint32_t alive);
+
+ private:
+  uint32_t cell_vertices_;
+  uint32_t previous_alive_ = 0;
+  uint32_t per_axis_ = kMaxLocalityCells;
+};
+
+// Sets locked[v] = 1 (locked sized to the mesh's vertices) for every
+// corner of a live face of `mesh` whose corners lie in different cells of
+// the grid of `per_axis` cells an axis (nothing below 2). O(faces).
+void lock_cell_borders(const EditableMesh& mesh, uint32_t per_axis, int quant_bits,
                        std::vector<uint8_t>& locked);
+
+// Vertices of `mesh` still in a face (removed ones are isolated). O(vertices).
+uint32_t live_vertices(const EditableMesh& mesh);
 
 }  // namespace meshstream
