@@ -12,20 +12,24 @@
 //   - elements: the same at the finest grain the stream has (one inserted
 //     vertex, one vertex's plane step), closed under the element needs:
 //     the bound any grouping of today's layers can reach;
-//   - cells: the elements regrouped into records by (layer, cell of a
-//     grid of cells) for structure and (layer of the vertex, plane
-//     step, cell) for planes — the cells the encoder's option draws for
-//     cells of about n vertices (locality_cells.h) — their bytes the
-//     elements' shares: what
-//     records local by construction would fetch (an estimate: the coding
-//     of regrouped records is not measured).
-// The same for the stream encoded with `EncodeOptions::locality_cell_vertices = n`
-// (cell borders locked per layer, locality_cells.h), with its size and its
+//   - cells: the elements regrouped into records by (layer, cell) for
+//     structure and (layer of the vertex, plane step, cell) for planes,
+//     with the cells the encoder's option draws for cells of about n
+//     vertices (locality_cells.h: one grid a level of layers), their bytes
+//     the elements' shares: what records local by construction would
+//     fetch (an estimate: the coding of regrouped records is not measured).
+// Also the mean number of needs a record. The same for the stream encoded
+// with `EncodeOptions::locality_cell_vertices = n` (cell borders locked,
+// locality_cells.h), with its size and its
 // rate-distortion against the default: the geometric mean, over 7
 // log-spaced budgets from 1/64 to 1/2 of the default stream's size, of the
 // RMS ratio at equal bytes (rd_measure.h).
 //
-//   record_graph_bench [--meshes a,b] [--cell-vertices 256,1024] [--views 8] [--out FILE]
+//   record_graph_bench [--meshes a,b] [--cell-vertices 32,512] [--views 8] [--out FILE]
+//
+// The meshes are found in $MESHSTREAM_TEST_MESHES (else ../shared/meshes);
+// bench/REPORT.md ran 32,128 and 512,2048 on the 13 real meshes and
+// 512,2048 on /work/big's dragon_x1.ply.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -129,6 +133,7 @@ double closed_bytes(const std::vector<double>& bytes, const std::vector<uint32_t
 
 struct Locality {
   size_t records = 0, groups = 0;
+  double needs_per_record = 0;
   double structure_radius_median = 0, structure_radius_p90 = 0, plane_radius_median = 0;
   double visible = 0, closed = 0, elements = 0, cells = 0;  // medians over views, shares
   double closed_max = 0, cells_max = 0, cells_visible = 0;
@@ -150,6 +155,7 @@ Locality locality_of(const std::vector<uint8_t>& stream, uint32_t cell_vertices,
   std::vector<double> sr, pr;
   uint32_t layers_seen = 0;
   for (const RecordTableEntry& e : table->records) {
+    out.needs_per_record += double(e.needs.size()) / double(table->records.size());
     if (e.kind == RecordKind::kStructure) sr.push_back(e.sphere.radius / model);
     if (e.kind == RecordKind::kPlane) pr.push_back(e.sphere.radius / model);
     layers_seen = std::max(layers_seen, e.layer);
@@ -292,7 +298,7 @@ double rd_score(const RdMeasure& measure, const std::vector<uint8_t>& stream, ui
 
 int main(int argc, char** argv) {
   std::vector<std::string> meshes = bench::kRealMeshes;
-  std::vector<uint32_t> cells{256, 1024};
+  std::vector<uint32_t> cells{32, 512};
   int view_count = 8;
   std::string out_path;
   for (int i = 1; i < argc; ++i) {
@@ -315,17 +321,18 @@ int main(int argc, char** argv) {
       out_path = value();
     } else {
       std::fprintf(stderr,
-                   "usage: record_graph_bench [--meshes a,b] [--cell-vertices 256,1024] [--views "
+                   "usage: record_graph_bench [--meshes a,b] [--cell-vertices 32,512] [--views "
                    "8] [--out FILE]\n");
       return 2;
     }
   }
   std::ostringstream report;
-  report << "| mesh | records | struct. radius med / p90 | plane radius med | view: visible | "
+  report << "| mesh | records | needs a record | struct. radius med / p90 | plane radius med | "
+            "view: visible | "
             "records closed (max) | elements | cell vertices | groups | cells visible | cells "
             "closed (max) | "
             "locked: bytes | RD | records closed | elements | cells closed (max) |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const std::string& name : meshes) {
     auto imported = import_mesh(mesh_dir() + "/" + name);
     if (!imported) {
@@ -373,14 +380,15 @@ int main(int argc, char** argv) {
             ia->header.layer_count, ib->header.layer_count, ia->records.size(), ib->records.size());
       }
       char line[1024];
-      std::snprintf(line, sizeof line,
-                    "| %s | %zu | %.3f / %.3f | %.3f | %.3f | %.3f (%.3f) | %.3f | %u | %zu | "
-                    "%.3f | %.3f (%.3f) | %.4f | %.3f | %.3f | %.3f | %.3f (%.3f) |\n",
-                    name.c_str(), a.records, a.structure_radius_median, a.structure_radius_p90,
-                    a.plane_radius_median, a.visible, a.closed, a.closed_max, a.elements, n,
-                    a.groups, a.cells_visible, a.cells, a.cells_max,
-                    double(locked->size()) / double(plain->size()), rd, b.closed, b.elements,
-                    b.cells, b.cells_max);
+      std::snprintf(
+          line, sizeof line,
+          "| %s | %zu | %.1f | %.3f / %.3f | %.3f | %.3f | %.3f (%.3f) | %.3f | %u | %zu | "
+          "%.3f | %.3f (%.3f) | %.4f | %.3f | %.3f | %.3f | %.3f (%.3f) |\n",
+          name.c_str(), a.records, a.needs_per_record, a.structure_radius_median,
+          a.structure_radius_p90, a.plane_radius_median, a.visible, a.closed, a.closed_max,
+          a.elements, n, a.groups, a.cells_visible, a.cells, a.cells_max,
+          double(locked->size()) / double(plain->size()), rd, b.closed, b.elements, b.cells,
+          b.cells_max);
       report << line;
       std::fputs(line, stdout);
       std::fflush(stdout);
