@@ -25,8 +25,11 @@
 // log-spaced budgets from 1/64 to 1/2 of the default stream's size, of the
 // RMS ratio at equal bytes (rd_measure.h).
 //
-//   record_graph_bench [--meshes a,b] [--cell-vertices 32,512] [--views 8] [--out FILE]
+//   record_graph_bench [--meshes a,b] [--cell-vertices 32,512] [--unlocked-share S] [--views 8]
+//   [--out FILE]
 //
+// --unlocked-share S: cells only in the layers that start with more than S
+// of the vertices (EncodeOptions::locality_unlocked_share; default 0).
 // The meshes are found in $MESHSTREAM_TEST_MESHES (else ../shared/meshes);
 // bench/REPORT.md ran 32,128 and 512,2048 on the 13 real meshes and
 // 512,2048 on /work/big's dragon_x1.ply.
@@ -139,7 +142,8 @@ struct Locality {
   double closed_max = 0, cells_max = 0, cells_visible = 0;
 };
 
-Locality locality_of(const std::vector<uint8_t>& stream, uint32_t cell_vertices, int view_count) {
+Locality locality_of(const std::vector<uint8_t>& stream, uint32_t cell_vertices,
+                     double unlocked_share, int view_count) {
   Locality out;
   RecordTrace trace;
   auto table = build_record_table(stream, &trace);
@@ -203,7 +207,7 @@ Locality locality_of(const std::vector<uint8_t>& stream, uint32_t cell_vertices,
   // The grids as the encoder's CellLevels drew them, finest layer first.
   std::vector<uint32_t> layer_cells(header.layer_count + 1, 1);
   {
-    CellLevels levels(cell_vertices);
+    CellLevels levels(cell_vertices, unlocked_for_share(header.vertex_count, unlocked_share));
     for (uint32_t L = header.layer_count; L >= 1; --L)
       layer_cells[L] = levels.next(layer_vertices[L]);
   }
@@ -300,6 +304,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> meshes = bench::kRealMeshes;
   std::vector<uint32_t> cells{32, 512};
   int view_count = 8;
+  double unlocked_share = 0;
   std::string out_path;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -315,13 +320,16 @@ int main(int argc, char** argv) {
     } else if (arg == "--cell-vertices") {
       cells.clear();
       for (const std::string& c : bench::split_commas(value())) cells.push_back(std::stoul(c));
+    } else if (arg == "--unlocked-share") {
+      unlocked_share = std::stod(value());
     } else if (arg == "--views") {
       view_count = std::stoi(value());
     } else if (arg == "--out") {
       out_path = value();
     } else {
       std::fprintf(stderr,
-                   "usage: record_graph_bench [--meshes a,b] [--cell-vertices 32,512] [--views "
+                   "usage: record_graph_bench [--meshes a,b] [--cell-vertices 32,512] "
+                   "[--unlocked-share S] [--views "
                    "8] [--out FILE]\n");
       return 2;
     }
@@ -361,15 +369,16 @@ int main(int argc, char** argv) {
     auto measure = RdMeasure::prepare(reference, rd_options);
     const double plain_score = rd_score(*measure, *plain, plain->size());
     for (uint32_t n : cells) {
-      const Locality a = locality_of(*plain, n, view_count);
+      const Locality a = locality_of(*plain, n, unlocked_share, view_count);
       options.locality_cell_vertices = n;
+      options.locality_unlocked_share = unlocked_share;
       auto locked = encode_hcs(mesh, options);
       options.locality_cell_vertices = 0;
       if (!locked) {
         std::fprintf(stderr, "%s: %s\n", name.c_str(), locked.error().message.c_str());
         return 1;
       }
-      const Locality b = locality_of(*locked, n, view_count);
+      const Locality b = locality_of(*locked, n, unlocked_share, view_count);
       const double rd = std::exp(rd_score(*measure, *locked, plain->size()) - plain_score);
       {
         auto ia = read_stream_index(*plain);

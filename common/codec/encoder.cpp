@@ -77,6 +77,11 @@ Status check_options(const EncodeOptions& options) {
                           " is not 0 (off) or " + std::to_string(kMinLocalityCellVertices) + ".." +
                           std::to_string(kMaxLocalityCellVertices));
   }
+  if (!(options.locality_unlocked_share >= 0 && options.locality_unlocked_share <= 1)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "locality unlocked share " + std::to_string(options.locality_unlocked_share) +
+                          " is not in 0..1");
+  }
   if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
     return make_error(ErrorCode::kInvalidArgument,
                       "base shift " + std::to_string(*options.base_shift) + " is not 0.." +
@@ -383,7 +388,9 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   dopt.progress = progress.within_function();
   dopt.locked = plan->locked;
   if (options.locality_cell_vertices > 0) {
-    dopt.layer_locks = [levels = CellLevels(options.locality_cell_vertices),
+    dopt.layer_locks = [levels = CellLevels(options.locality_cell_vertices,
+                                            unlocked_for_share(static_cast<uint32_t>(q.size()),
+                                                               options.locality_unlocked_share)),
                         bits = options.quant_bits](uint32_t, const EditableMesh& m,
                                                    std::vector<uint8_t>& l) mutable {
       lock_cell_borders(m, levels.next(live_vertices(m)), bits, l);

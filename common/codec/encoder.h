@@ -105,6 +105,10 @@ struct EncodeOptions {
   // kMaxLocalityCellVertices, else kInvalidArgument. The stream is an
   // ordinary stream; only the decimation is restricted.
   uint32_t locality_cell_vertices = 0;
+  // With locality cells: layers that start with fewer than this share of
+  // the vertices (0..1, else kInvalidArgument) lock nothing (CellLevels);
+  // 0 = cells down to the coarsest level.
+  double locality_unlocked_share = 0;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each

@@ -27,6 +27,7 @@ uint32_t locality_cell(Vec3i q, uint32_t per_axis, int quant_bits) {
 }
 
 uint32_t CellLevels::next(uint32_t alive) {
+  if (alive < unlocked_below_) per_axis_ = 1;
   uint32_t n = std::min(per_axis_, cells_per_axis(alive, cell_vertices_));
   if (previous_alive_ > 0 && n > 1 && n == per_axis_ &&
       uint64_t(previous_alive_ - std::min(alive, previous_alive_)) * 12 < previous_alive_)

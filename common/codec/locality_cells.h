@@ -44,17 +44,27 @@ uint32_t locality_cell(Vec3i q, uint32_t per_axis, int quant_bits);
 // vertices after each restored layer): cells_per_axis, never more than the
 // layer before; and half of the layer before's when that layer removed
 // under 1/12 of its vertices (its cells' insides are used up: the
-// level's borders must go, or the decimation would stall on them).
+// level's borders must go, or the decimation would stall on them); 1 for
+// good once a layer starts with fewer than `unlocked_below` vertices (the
+// coarse layers, few bytes, then decimate freely: unlocked_for_share).
 class CellLevels {
  public:
-  explicit CellLevels(uint32_t cell_vertices) : cell_vertices_(cell_vertices) {}
+  explicit CellLevels(uint32_t cell_vertices, uint32_t unlocked_below = 0)
+      : cell_vertices_(cell_vertices), unlocked_below_(unlocked_below) {}
   uint32_t next(uint32_t alive);
 
  private:
   uint32_t cell_vertices_;
+  uint32_t unlocked_below_;
   uint32_t previous_alive_ = 0;
   uint32_t per_axis_ = kMaxLocalityCells;
 };
+
+// CellLevels' `unlocked_below` for a mesh of `vertices` whose layers lock
+// cells only while they start with more than `share` (0..1) of them.
+inline uint32_t unlocked_for_share(uint32_t vertices, double share) {
+  return static_cast<uint32_t>(share * double(vertices));
+}
 
 // Sets locked[v] = 1 (locked sized to the mesh's vertices) for every
 // corner of a live face of `mesh` whose corners lie in different cells of

@@ -298,7 +298,12 @@ Result<RecordTable> build_record_table(std::span<const uint8_t> stream, RecordTr
         if (!w.appended) {
           for (uint32_t v : w.before) {
             auto& list = vertex_faces[v];
-            list.erase(std::find(list.begin(), list.end(), w.slot));
+            const auto at = std::find(list.begin(), list.end(), w.slot);
+            if (at == list.end())
+              return make_error(ErrorCode::kInternal,
+                                "record table: record " + std::to_string(r) +
+                                    " rewrites a face its table copy does not hold");
+            list.erase(at);
           }
         }
         for (uint32_t v : w.after) vertex_faces[v].push_back(w.slot);

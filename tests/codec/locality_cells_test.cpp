@@ -31,6 +31,11 @@ TEST(LocalityCells, CellsGrowAsTheMeshCoarsens) {
   EXPECT_EQ(levels.next(70000), 4u);
   EXPECT_EQ(levels.next(66000), 2u);  // 4000 of 70000 removed: stalled
   EXPECT_EQ(levels.next(60000), 2u);  // 6000 of 66000 removed; never finer again
+  // Unlocked below a share of the vertices.
+  CellLevels fine_only(512, unlocked_for_share(100000, 0.5));
+  EXPECT_EQ(fine_only.next(100000), 8u);
+  EXPECT_EQ(fine_only.next(49000), 1u);
+  EXPECT_EQ(fine_only.next(48000), 1u);
 }
 
 TEST(LocalityCells, GridsOfConsecutiveLevelsAreShifted) {
@@ -104,6 +109,11 @@ TEST(LocalityCells, StreamDecodesExactly) {
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
   options.locality_cell_vertices = kMaxLocalityCellVertices + 1;
+  refused = encode_hcs(mesh, options);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
+  options.locality_cell_vertices = 16;
+  options.locality_unlocked_share = 1.5;
   refused = encode_hcs(mesh, options);
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument);
