@@ -358,11 +358,17 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
   std::vector<double> cost(n, -1);
   std::vector<Candidate> candidates;
   std::vector<uint32_t> ring, corners, ring_start;
+  std::vector<uint8_t> layer_locked;
   while (alive_count > target && result.layers.size() < options.max_layers) {
     update_costs(mesh, field, alive, cost, threads);
+    if (options.layer_locks) {
+      layer_locked.assign(n, 0);
+      options.layer_locks(static_cast<uint32_t>(result.layers.size()), mesh, layer_locked);
+    }
     candidates.clear();
     for (uint32_t v = 0; v < n; ++v) {
-      const bool locked = v < options.locked.size() && options.locked[v] != 0;
+      const bool locked = (v < options.locked.size() && options.locked[v] != 0) ||
+                          (v < layer_locked.size() && layer_locked[v] != 0);
       if (alive[v] && cost[v] >= 0 && !locked) candidates.push_back({cost[v], v});
     }
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {

@@ -97,6 +97,12 @@ struct DecimateOptions {
   // attribute seam or a material border passes (attribute_layout.h): the
   // patches then never cross a seam. Empty = none locked.
   std::vector<uint8_t> locked;
+  // Optional: called before each layer (0 = the first removed) to lock
+  // more vertices for that layer only (`locked` comes sized to the mesh's
+  // vertices, all 0): the locality experiment's cell borders
+  // (locality_cells.h). Empty = none.
+  std::function<void(uint32_t layer, const EditableMesh& mesh, std::vector<uint8_t>& locked)>
+      layer_locks;
 };
 
 inline constexpr uint32_t kMinBaseTarget = 32;

@@ -17,6 +17,7 @@
 #include "common/codec/decimate.h"
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/editable_mesh.h"
+#include "common/codec/locality_cells.h"
 #include "common/codec/quantize.h"
 #include "common/codec/rd_measure.h"
 #include "common/codec/record_schedule.h"
@@ -67,6 +68,19 @@ Status check_options(const EncodeOptions& options) {
     return make_error(ErrorCode::kInvalidArgument,
                       "distortion estimate " + std::to_string(int(options.distortion_estimate)) +
                           " is not 0 (automatic), 1 (displacement) or 2 (surface distance)");
+  }
+  if (options.locality_cell_vertices != 0 &&
+      (options.locality_cell_vertices < kMinLocalityCellVertices ||
+       options.locality_cell_vertices > kMaxLocalityCellVertices)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "locality cell vertices " + std::to_string(options.locality_cell_vertices) +
+                          " is not 0 (off) or " + std::to_string(kMinLocalityCellVertices) + ".." +
+                          std::to_string(kMaxLocalityCellVertices));
+  }
+  if (!(options.locality_unlocked_share >= 0 && options.locality_unlocked_share <= 1)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "locality unlocked share " + std::to_string(options.locality_unlocked_share) +
+                          " is not in 0..1");
   }
   if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
     return make_error(ErrorCode::kInvalidArgument,
@@ -397,6 +411,15 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
   dopt.locked = plan->locked;
+  if (options.locality_cell_vertices > 0) {
+    dopt.layer_locks = [levels = CellLevels(options.locality_cell_vertices,
+                                            unlocked_for_share(static_cast<uint32_t>(q.size()),
+                                                               options.locality_unlocked_share)),
+                        bits = options.quant_bits](uint32_t, const EditableMesh& m,
+                                                   std::vector<uint8_t>& l) mutable {
+      lock_cell_borders(m, levels.next(live_vertices(m)), bits, l);
+    };
+  }
   DecimationResult dec = decimate_layers(std::move(*editable), dopt);
 
   // The candidates.

@@ -98,6 +98,18 @@ struct EncodeOptions {
   int quant_normal = 8;
   int quant_uv = 12;
   int quant_color = 8;
+  // The locality experiment (issue 17, docs/view-dependent-records.md):
+  // 0 = off (the default; the stream is unchanged). Else each decimation
+  // layer keeps the borders of a grid of cells of at least about this many
+  // of its vertices (one grid a level of layers, locality_cells.h), so every
+  // patch lies inside one cell; kMinLocalityCellVertices ..
+  // kMaxLocalityCellVertices, else kInvalidArgument. The stream is an
+  // ordinary stream; only the decimation is restricted.
+  uint32_t locality_cell_vertices = 0;
+  // With locality cells: layers that start with fewer than this share of
+  // the vertices (0..1, else kInvalidArgument) lock nothing (CellLevels);
+  // 0 = cells down to the coarsest level.
+  double locality_unlocked_share = 0;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each
