@@ -18,7 +18,9 @@
 // geometry records and carry the exact values of every vertex inserted
 // since the previous one, coded on the decoder's mesh of that moment with
 // models that persist from one values record to the next; they are sized
-// like the geometry records (at most 1.5 % of the stream each). The last
+// like the geometry records (at most 1.5 % of the stream each). From
+// version 12 on they leave the normals out; normals records after the last
+// geometry record carry them, predicted on the complete mesh. The last
 // record carries the exact values of the vertices inserted after the last
 // values record (version 10: of every inserted vertex) and the extra
 // attributes (zstd). Until its values arrive the decoder shows each
@@ -49,6 +51,16 @@ namespace meshstream {
 inline constexpr uint8_t kAttributePartBase = 0;    // record 1
 inline constexpr uint8_t kAttributePartFinal = 1;   // the last record
 inline constexpr uint8_t kAttributePartValues = 2;  // after geometry records (version 11 on)
+// Version 12 on: values records without the normals (which a values record
+// would predict from the coarse stars the decoder has then), and normals
+// records after the last geometry record with the normals of the vertices
+// of those values records, predicted on the complete mesh.
+inline constexpr uint8_t kAttributePartValuesLateNormals = 3;
+inline constexpr uint8_t kAttributePartNormals = 4;
+inline bool is_values_part(uint8_t part) {
+  return part == kAttributePartValues || part == kAttributePartValuesLateNormals ||
+         part == kAttributePartNormals;
+}
 // A values record is closed at about this share of the expected stream
 // (the record-size rule: no record beyond the base above 2 % of it).
 inline constexpr double kValuesRecordShare = 0.015;
@@ -163,9 +175,13 @@ class AttributeDecoder {
   // A values record, on the decoder's mesh now: the exact values of every
   // vertex inserted since the previous values (or record 1).
   Status read_values(std::span<const uint8_t> payload, const EditableMesh& m);
+  // A normals record (kAttributePartNormals), on the complete mesh: the
+  // exact normals of the next vertices whose values came without them.
+  Status read_normals(std::span<const uint8_t> payload, const EditableMesh& full);
   // Vertices whose exact values have come (the base's and the values
-  // records').
+  // records'; their normals may still be to come: normals_exact_vertices).
   uint32_t exact_vertices() const { return exact_vertices_; }
+  uint32_t normals_exact_vertices() const { return normals_exact_; }
   // The last record, on the complete mesh.
   Status read_final(std::span<const uint8_t> payload, const EditableMesh& full);
   // Writes every attribute array of `out` for `m` (whose vertices all have
@@ -190,6 +206,7 @@ class AttributeDecoder {
   AttributeValues values_;
   uint32_t base_vertices_ = 0;
   uint32_t exact_vertices_ = 0;
+  uint32_t normals_exact_ = 0;  // vertices whose normals are exact (<= exact_vertices_)
   std::vector<AttributeChannelModels> values_models_;  // the values records', persistent
   std::vector<ExtraAttribute> extras_;
 };

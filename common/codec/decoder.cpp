@@ -137,10 +137,17 @@ struct IncrementalDecoder::State {
       if (geometry_records > 0)
         return make_error(ErrorCode::kParse, "base attribute record after a geometry record");
       if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
-    } else if (part == kAttributePartValues) {
+    } else if (part == kAttributePartValues || part == kAttributePartValuesLateNormals) {
       if (attributes_final)
         return make_error(ErrorCode::kParse, "attribute values record after the final one");
       if (auto s = attributes.read_values(payload, refine->mesh); !s) return s;
+    } else if (part == kAttributePartNormals) {
+      if (attributes_final)
+        return make_error(ErrorCode::kParse, "attribute normals record after the final one");
+      if (refine->mesh.vertex_count() != h.vertex_count ||
+          refine->mesh.face_slot_count() != h.face_count)
+        return make_error(ErrorCode::kParse, "normals record before the mesh is complete");
+      if (auto s = attributes.read_normals(payload, refine->mesh); !s) return s;
     } else {
       if (attributes_final) return make_error(ErrorCode::kParse, "a second final attribute record");
       if (refine->mesh.vertex_count() != h.vertex_count ||

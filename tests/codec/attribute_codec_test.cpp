@@ -234,6 +234,49 @@ TEST(AttributeCodec, UvSphereRoundTripsExactly) {
   expect_valid_prefixes(*stream);
 }
 
+// Version 12: values records leave the normals out (part 3) and normals
+// records after the last geometry record bring them, coded on the complete
+// mesh; the round trip stays exact and every prefix valid.
+TEST(AttributeCodec, NormalsComeInNormalsRecordsAfterTheGeometry) {
+  Mesh sphere = uv_sphere(24, 32);
+  sphere.normals.clear();  // per vertex, smooth: the geometric prediction's case
+  for (const Vec3f& p : sphere.positions) {
+    const float l = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+    sphere.normals.push_back({p.x / l, p.y / l, p.z / l});
+  }
+  ASSERT_TRUE(check_attribute_counts(sphere)) << check_attribute_counts(sphere).error().message;
+  EncodeOptions o;
+  o.asa_guidance = false;
+  auto stream = encode_hcs(sphere, o);
+  ASSERT_TRUE(stream) << stream.error().message;
+  auto index = read_stream_index(*stream);
+  ASSERT_TRUE(index);
+  size_t late_values = 0, old_values = 0, normals_records = 0, last_geometry = 0;
+  size_t first_normals = index->records.size();
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const RecordEntry& r = index->records[i];
+    const auto payload = record_payload(r, {stream->data() + r.offset, r.size});
+    if (payload.empty() || payload[0] != kRecordAttributes) {
+      if (payload.empty() || payload[0] != kRecordTexture) last_geometry = i;
+      continue;
+    }
+    late_values += payload[1] == kAttributePartValuesLateNormals;
+    old_values += payload[1] == kAttributePartValues;
+    if (payload[1] == kAttributePartNormals) {
+      ++normals_records;
+      first_normals = std::min(first_normals, i);
+    }
+  }
+  EXPECT_GT(late_values, 0u);
+  EXPECT_EQ(old_values, 0u);
+  EXPECT_GT(normals_records, 0u);
+  EXPECT_GT(first_normals, last_geometry) << "normals records follow every geometry record";
+  auto decoded = decode_hcs(*stream);
+  ASSERT_TRUE(decoded) << decoded.error().message;
+  EXPECT_TRUE(faces_of(*decoded) == faces_of(expected_mesh(sphere, o)));
+  expect_valid_prefixes(*stream);
+}
+
 TEST(AttributeCodec, EightBitColoursComeBackExactly) {
   std::filesystem::path file;
   if (!testing::test_mesh_dir().empty())
