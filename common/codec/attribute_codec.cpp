@@ -64,11 +64,43 @@ const int32_t* corner_value(const EditableMesh& m, const AttributeValues& a,
   return &a.data[ch][size_t(idx) * channel.components()];
 }
 
+// How a value is predicted: from the neighbours' values in the channel's
+// own integers (parallelograms, means), from the geometry (normals: the
+// geometric normal of the wedge), or (normals, record 1 from version 12 on
+// when it codes smaller) from the mean of the decoded neighbours' unit
+// normals at the wedge's faces.
+enum class Prediction { kValues, kGeometric, kNeighbourNormals };
+
+// The mean direction of the decoded (lower id) neighbours' normals at the
+// corners of wedge w of v; false when none is decoded.
+bool neighbour_normal_mean(const EditableMesh& m, const AttributeValues& a,
+                           const AttributeChannel& channel, size_t ch, uint32_t v, uint32_t w,
+                           const std::vector<uint32_t>& corners, double* d) {
+  d[0] = d[1] = d[2] = 0;
+  int count = 0;
+  for (uint32_t c : corners) {
+    if (channel.per_corner && a.wedge_start[v + 1] - a.wedge_start[v] > 1 &&
+        wedge_of_corner(m, a, c) != w)
+      continue;
+    for (uint32_t nc : {EditableMesh::next(c), EditableMesh::prev(c)}) {
+      if (m.vertex(nc) >= v) continue;
+      const int32_t* u = corner_value(m, a, channel, ch, nc);
+      const Vec3f n = dequantize_normal({u[0], u[1]}, channel.bits);
+      d[0] += n.x;
+      d[1] += n.y;
+      d[2] += n.z;
+      ++count;
+    }
+  }
+  return count > 0 && (d[0] != 0 || d[1] != 0 || d[2] != 0);
+}
+
 // The prediction of vertex v's value (wedge w of a per-corner channel) from
 // vertices below v; returns its context.
 int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayout& layout,
-            size_t ch, uint32_t v, uint32_t w, bool geometric, int32_t* out,
+            size_t ch, uint32_t v, uint32_t w, Prediction how, int32_t* out,
             std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) {
+  const bool geometric = how != Prediction::kValues;
   const AttributeChannel& channel = layout.channels[ch];
   const uint32_t n = channel.components();
   const int32_t max = layout.max_value(channel);
@@ -116,13 +148,22 @@ int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayo
       ++near_count;
     }
   }
+  if (how == Prediction::kNeighbourNormals) {
+    double d[3];
+    if (neighbour_normal_mean(m, a, channel, ch, v, w, corners, d)) {
+      const auto q = quantize_direction(d[0], d[1], d[2], channel.bits);
+      out[0] = q[0];
+      out[1] = q[1];
+      return 3;
+    }
+  }
   if (geometric && (normal[0] != 0 || normal[1] != 0 || normal[2] != 0)) {
     const auto q = quantize_direction(normal[0], normal[1], normal[2], channel.bits);
     out[0] = q[0];
     out[1] = q[1];
     return 3;
   }
-  if (geometric) return predict(m, a, layout, ch, v, w, false, out, ring, corners);
+  if (geometric) return predict(m, a, layout, ch, v, w, Prediction::kValues, out, ring, corners);
   int context = 2;
   for (uint32_t i = 0; i < n; ++i) out[i] = 0;
   if (para_count > 0) {
@@ -167,10 +208,12 @@ bool value_of(const AttributeChannel& c, int32_t max, int32_t pred, int64_t r, i
   return true;
 }
 
-// Normals are predicted from the geometry: in the last record from the exact
-// positions, in record 1 from the base's coarse ones (what the decoder has).
-bool use_geometric(const AttributeChannel& c, bool /*final_record*/) {
-  return c.kind == AttributeKind::kNormal;
+// Normals are predicted from the geometry (in the last record and normals
+// records from the exact positions, in record 1 from the base's coarse ones:
+// what the decoder has) or, where record 1 names it, from the neighbours'
+// normals.
+Prediction prediction_of(const AttributeChannel& c, Prediction normals) {
+  return c.kind == AttributeKind::kNormal ? normals : Prediction::kValues;
 }
 
 // The wedges of every vertex of `m` from per-corner values (all corner
@@ -378,7 +421,7 @@ void put_section(std::vector<uint8_t>& out, const std::vector<uint8_t>& bytes) {
 // the models to continue (values records), else fresh ones.
 struct ValueCoder {
   const AttributeLayout& layout;
-  bool final_record;
+  Prediction normals = Prediction::kGeometric;
   std::vector<uint32_t> ring, corners;
 
   std::vector<uint8_t> encode(const EditableMesh& m, const AttributeValues& truth, size_t ch,
@@ -394,8 +437,8 @@ struct ValueCoder {
       const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
       const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
-        const int ctx = predict(m, truth, layout, ch, v, w, use_geometric(c, final_record), pred,
-                                ring, corners);
+        const int ctx =
+            predict(m, truth, layout, ch, v, w, prediction_of(c, normals), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i)
           models.residual[ctx][i].encode(enc,
                                          residual_of(c, max, truth.data[ch][w * n + i], pred[i]));
@@ -418,7 +461,7 @@ struct ValueCoder {
       const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
         const int ctx =
-            predict(m, a, layout, ch, v, w, use_geometric(c, final_record), pred, ring, corners);
+            predict(m, a, layout, ch, v, w, prediction_of(c, normals), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
           const int64_t r = models.residual[ctx][i].decode(dec);
           if (!value_of(c, max, pred[i], r, a.data[ch][w * n + i]))
@@ -743,7 +786,12 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     put_section(first, bytes);
     local_parts["seams"] += bytes.size();
   }
-  ValueCoder base_coder{layout, false, {}, {}};
+  // Record 1's normals: the geometric normal of the coarse base, or the
+  // neighbours' normals where that codes smaller (record part 5; the base's
+  // positions miss their low bits, and on a base as fine as the mesh, as
+  // where every vertex is locked, the neighbours are close).
+  ValueCoder base_coder{layout};
+  ValueCoder neighbour_coder{layout, Prediction::kNeighbourNormals};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
     // The base's values predicted over the base mesh (the decoder's state
     // after record 0); the wedge tables of base vertices are the same.
@@ -757,7 +805,14 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     const size_t count =
         size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
     base_truth.data[ch].assign(truth.data[ch].begin(), truth.data[ch].begin() + count);
-    const std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
+    std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
+    if (c.kind == AttributeKind::kNormal) {
+      std::vector<uint8_t> other = neighbour_coder.encode(*base, base_truth, ch, 0, base_n);
+      if (other.size() < bytes.size()) {
+        bytes = std::move(other);
+        first[1] = kAttributePartBaseNeighbourNormals;
+      }
+    }
     put_section(first, bytes);
     local_parts[attribute_kind_name(c.kind)] += bytes.size();
   }
@@ -787,7 +842,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   };
   uint64_t all_inserted_bytes = 0, values_inserted_bytes = 0, normal_inserted_bytes = 0;
   {
-    ValueCoder estimate{layout, true, {}, {}};
+    ValueCoder estimate{layout};
     for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
       const uint64_t b = estimate.encode(*full, truth, ch, base_n, n).size();
       all_inserted_bytes += b;
@@ -806,7 +861,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     if (!replay) return tl::unexpected(replay.error());
     if (format) replay->format = *format;
     std::vector<ChannelModels> models(layout.channels.size());
-    ValueCoder values_coder{layout, false, {}, {}};
+    ValueCoder values_coder{layout};
     // The last geometry record's vertices go into the last record.
     for (size_t i = 1; i + 1 < idx.records.size(); ++i) {
       const RecordEntry& r = idx.records[i];
@@ -842,7 +897,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     const uint32_t chunk =
         std::max<uint32_t>(1, per_normal > 0 ? uint32_t(target / per_normal) : done - base_n);
     std::vector<ChannelModels> models(layout.channels.size());
-    ValueCoder normals_coder{layout, true, {}, {}};
+    ValueCoder normals_coder{layout};
     for (uint32_t from = base_n; from < done;) {
       const uint32_t to = std::min(done, from + chunk);
       std::vector<uint8_t> payload{kRecordAttributes, kAttributePartNormals};
@@ -862,7 +917,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   // The last record: the values of the vertices inserted since the last
   // values record, then the extra attributes.
   std::vector<uint8_t> last{kRecordAttributes, kAttributePartFinal};
-  ValueCoder final_coder{layout, true, {}, {}};
+  ValueCoder final_coder{layout};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
     const std::vector<uint8_t> bytes = final_coder.encode(*full, truth, ch, done, n);
     put_section(last, bytes);
@@ -921,7 +976,7 @@ Result<AttributeParts> attribute_record_parts(
     std::span<const uint8_t> final_payload) {
   AttributeParts parts;
   if (base_payload.size() < 2 || base_payload[0] != kRecordAttributes ||
-      base_payload[1] != kAttributePartBase)
+      !is_base_part(base_payload[1]))
     return tl::unexpected(parse_error("record 1 is not the base attribute record"));
   Reader r{base_payload, 2};
   auto layout_bytes = r.section();
@@ -968,7 +1023,7 @@ Result<AttributeParts> attribute_record_parts(
 
 Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const EditableMesh& base) {
   if (active_) return tl::unexpected(parse_error("a second base attribute record"));
-  if (payload.size() < 2 || payload[1] != kAttributePartBase)
+  if (payload.size() < 2 || !is_base_part(payload[1]))
     return tl::unexpected(parse_error("the first attribute record is not the base part"));
   Reader r{payload, 2};
   auto layout_bytes = r.section();
@@ -1017,7 +1072,9 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
       values_.wedge_start.push_back(v + 1);
     }
   }
-  ValueCoder coder{layout_, false, {}, {}};
+  ValueCoder coder{layout_, payload[1] == kAttributePartBaseNeighbourNormals
+                                ? Prediction::kNeighbourNormals
+                                : Prediction::kGeometric};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),
@@ -1059,7 +1116,7 @@ Status AttributeDecoder::read_values(std::span<const uint8_t> payload, const Edi
     for (size_t ch = 0; ch < layout_.channels.size(); ++ch)
       values_.data[ch].resize(values_.data[ch].size() + layout_.channels[ch].components());
   }
-  ValueCoder coder{layout_, false, {}, {}};
+  ValueCoder coder{layout_};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     if (!carried_in(part, layout_.channels[ch])) continue;
     auto bytes = r.section();
@@ -1084,7 +1141,7 @@ Status AttributeDecoder::read_normals(std::span<const uint8_t> payload, const Ed
     return tl::unexpected(
         parse_error("normals record for " + std::to_string(count) + " vertices where " +
                     std::to_string(exact_vertices_ - normals_exact_) + " wait for their normals"));
-  ValueCoder coder{layout_, true, {}, {}};
+  ValueCoder coder{layout_};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     if (!carried_in(kAttributePartNormals, layout_.channels[ch])) continue;
     auto bytes = r.section();
@@ -1113,7 +1170,8 @@ void AttributeDecoder::preview(const EditableMesh& m) {
       values_.data[ch].resize(values_.data[ch].size() + nc);
       // Normals: the geometric normal of the mesh now (what a values
       // record's normals, version 12 on, no longer correct until the end).
-      predict(m, values_, layout_, ch, v, w, c.kind == AttributeKind::kNormal, pred, ring, corners);
+      predict(m, values_, layout_, ch, v, w, prediction_of(c, Prediction::kGeometric), pred, ring,
+              corners);
       std::copy(pred, pred + nc, values_.data[ch].end() - nc);
     }
   }
@@ -1134,7 +1192,7 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
     values_.wedge_key.push_back(kNone);
     values_.wedge_start.push_back(uint32_t(values_.wedge_key.size()));
   }
-  ValueCoder coder{layout_, true, {}, {}};
+  ValueCoder coder{layout_};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].resize(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components());

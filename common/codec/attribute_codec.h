@@ -57,6 +57,13 @@ inline constexpr uint8_t kAttributePartValues = 2;  // after geometry records (v
 // of those values records, predicted on the complete mesh.
 inline constexpr uint8_t kAttributePartValuesLateNormals = 3;
 inline constexpr uint8_t kAttributePartNormals = 4;
+// Version 12 on: record 1 whose normals are predicted from the decoded
+// neighbours' normals instead of the base's geometric normals (the encoder
+// takes whichever codes smaller).
+inline constexpr uint8_t kAttributePartBaseNeighbourNormals = 5;
+inline bool is_base_part(uint8_t part) {
+  return part == kAttributePartBase || part == kAttributePartBaseNeighbourNormals;
+}
 inline bool is_values_part(uint8_t part) {
   return part == kAttributePartValues || part == kAttributePartValuesLateNormals ||
          part == kAttributePartNormals;
