@@ -1177,6 +1177,39 @@ void AttributeDecoder::preview(const EditableMesh& m) {
   }
 }
 
+void AttributeDecoder::refresh_normal_previews(const EditableMesh& m) {
+  if (!active_ || complete_) return;
+  const uint32_t now = std::min(m.vertex_count(), values_.vertices());
+  if (normals_exact_ >= now) {
+    normals_refreshed_ = std::max(normals_refreshed_, now);
+    return;
+  }
+  std::vector<uint32_t> ring, corners, stale;
+  // A star changes when a neighbour is inserted: the vertices inserted since
+  // the last refresh, and their rings.
+  for (uint32_t u = std::max(normals_refreshed_, normals_exact_); u < now; ++u) {
+    stale.push_back(u);
+    m.star(u, ring, corners);
+    for (uint32_t v : ring)
+      if (v >= normals_exact_ && v < now) stale.push_back(v);
+  }
+  std::sort(stale.begin(), stale.end());
+  stale.erase(std::unique(stale.begin(), stale.end()), stale.end());
+  int32_t pred[4];
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    if (c.kind != AttributeKind::kNormal) continue;
+    for (uint32_t v : stale) {
+      // Inserted vertices have one wedge.
+      const uint32_t w = c.per_corner ? values_.wedge_start[v] : v;
+      predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+      values_.data[ch][2 * size_t(w)] = pred[0];
+      values_.data[ch][2 * size_t(w) + 1] = pred[1];
+    }
+  }
+  normals_refreshed_ = now;
+}
+
 Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const EditableMesh& full) {
   if (!active_) return tl::unexpected(parse_error("final attribute record before the base one"));
   if (complete_) return tl::unexpected(parse_error("a second final attribute record"));

@@ -179,6 +179,12 @@ class AttributeDecoder {
   Status read_base(std::span<const uint8_t> payload, const EditableMesh& base);
   // Predicted values for the vertices of `m` beyond those known.
   void preview(const EditableMesh& m);
+  // The previewed normals of vertices whose exact normals have not come
+  // (version 12's values records leave them to the end), recomputed as the
+  // geometric normal of their wedge on `m` where their star changed since
+  // the last call: the vertices inserted since, and their rings. Display
+  // only (nothing is predicted from previews); O(inserted x valence).
+  void refresh_normal_previews(const EditableMesh& m);
   // A values record, on the decoder's mesh now: the exact values of every
   // vertex inserted since the previous values (or record 1).
   Status read_values(std::span<const uint8_t> payload, const EditableMesh& m);
@@ -213,7 +219,8 @@ class AttributeDecoder {
   AttributeValues values_;
   uint32_t base_vertices_ = 0;
   uint32_t exact_vertices_ = 0;
-  uint32_t normals_exact_ = 0;  // vertices whose normals are exact (<= exact_vertices_)
+  uint32_t normals_exact_ = 0;      // vertices whose normals are exact (<= exact_vertices_)
+  uint32_t normals_refreshed_ = 0;  // refresh_normal_previews saw the vertices below
   std::vector<AttributeChannelModels> values_models_;  // the values records', persistent
   std::vector<ExtraAttribute> extras_;
 };

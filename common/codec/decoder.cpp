@@ -158,6 +158,7 @@ struct IncrementalDecoder::State {
     }
     if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
       attributes.preview(refine->mesh);
+      attributes.refresh_normal_previews(refine->mesh);
       attributes.write_mesh(refine->mesh, mesh);
       known_attribute_vertices = refine->mesh.vertex_count();
     }
@@ -420,6 +421,7 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
     out.textures = std::move(s.textures);
     // Attributes need the faces still in the decoder's table.
     s.attributes.preview(s.refine->mesh);
+    s.attributes.refresh_normal_previews(s.refine->mesh);
     s.attributes.write_mesh(s.refine->mesh, out);
     // The decoder only inserts, so every face slot is a live face.
     out.triangles = s.refine->mesh.release_faces();
