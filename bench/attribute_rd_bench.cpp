@@ -33,8 +33,10 @@
 //       texture coordinates: the Euclidean distance in UV units (1e-3 is one
 //         texel of a 1 000-texel texture),
 //       colours: the Euclidean RGB distance in 8-bit steps (0..255 a channel).
-//     Near a UV seam the closest point may land across it (another chart):
-//     both sides pay that alike.
+//     Near a UV seam the closest point may land across it (another chart),
+//     and on coincident or two-sided parts on the other side: both sides pay
+//     that alike, and the full-rate rows (both exactly the quantized input)
+//     show the measure's floor per model.
 //
 // Usage: attribute_rd_bench [MODELS_DIR] [--out FILE.md] [--samples N]
 #include <draco/io/mesh_io.h>

@@ -69,7 +69,12 @@ const int32_t* corner_value(const EditableMesh& m, const AttributeValues& a,
 // geometric normal of the wedge), or (normals, record 1 from version 12 on
 // when it codes smaller) from the mean of the decoded neighbours' unit
 // normals at the wedge's faces.
-enum class Prediction { kValues, kGeometric, kNeighbourNormals };
+// kNeighbourMean (previews only, never coded against): the mean of the
+// decoded neighbours' values, no parallelogram; an inserted vertex's value
+// interpolated, not extrapolated from the coarse faces around it (its UV
+// error at SheenCloth's prefixes 24-30 -> 16-17 x 1e-3 before the values
+// records come, bench/REPORT.md).
+enum class Prediction { kValues, kGeometric, kNeighbourNormals, kNeighbourMean };
 
 // The mean direction of the decoded (lower id) neighbours' normals at the
 // corners of wedge w of v; false when none is decoded.
@@ -100,7 +105,7 @@ bool neighbour_normal_mean(const EditableMesh& m, const AttributeValues& a,
 int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayout& layout,
             size_t ch, uint32_t v, uint32_t w, Prediction how, int32_t* out,
             std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) {
-  const bool geometric = how != Prediction::kValues;
+  const bool geometric = how == Prediction::kGeometric || how == Prediction::kNeighbourNormals;
   const AttributeChannel& channel = layout.channels[ch];
   const uint32_t n = channel.components();
   const int32_t max = layout.max_value(channel);
@@ -126,7 +131,7 @@ int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayo
       continue;
     }
     const bool a_known = va < v, b_known = vb < v;
-    if (a_known && b_known) {
+    if (a_known && b_known && how != Prediction::kNeighbourMean) {
       const uint32_t o = m.opposite(c);
       if (o != kNone && m.vertex(o) < v) {
         const int32_t* A = corner_value(m, a, channel, ch, na);
@@ -1168,10 +1173,13 @@ void AttributeDecoder::preview(const EditableMesh& m) {
       const AttributeChannel& c = layout_.channels[ch];
       const uint32_t nc = c.components();
       values_.data[ch].resize(values_.data[ch].size() + nc);
-      // Normals: the geometric normal of the mesh now (what a values
-      // record's normals, version 12 on, no longer correct until the end).
-      predict(m, values_, layout_, ch, v, w, prediction_of(c, Prediction::kGeometric), pred, ring,
-              corners);
+      // Normals: the geometric normal of the mesh now (version 12's values
+      // records leave them to the end; refresh_normal_previews updates it);
+      // the others: the mean of the decoded neighbours' values.
+      predict(
+          m, values_, layout_, ch, v, w,
+          c.kind == AttributeKind::kNormal ? Prediction::kGeometric : Prediction::kNeighbourMean,
+          pred, ring, corners);
       std::copy(pred, pred + nc, values_.data[ch].end() - nc);
     }
   }

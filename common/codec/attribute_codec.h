@@ -24,7 +24,8 @@
 // record carries the exact values of the vertices inserted after the last
 // values record (version 10: of every inserted vertex) and the extra
 // attributes (zstd). Until its values arrive the decoder shows each
-// inserted vertex with its prediction (from its neighbours at insertion),
+// inserted vertex with a preview (its decoded neighbours' mean; normals: the
+// geometric normal of its wedge on the mesh the decoder has),
 // so every prefix after record 1 has attributes. Values are predicted in
 // exact integers from what the decoder has (parallelograms over the
 // connectivity, neighbours; normals: the geometric normal of the wedge's
