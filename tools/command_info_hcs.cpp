@@ -65,7 +65,7 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
       positions += r.size;
     } else if (k == "attributes") {
       const uint8_t part = payload.size() > 1 ? payload[1] : kAttributePartFinal;
-      if (is_base_part(part))
+      if (part == kAttributePartBase)
         base_attributes = payload;
       else if (is_values_part(part))
         values_attributes.push_back(payload);

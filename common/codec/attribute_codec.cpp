@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <unordered_map>
 
@@ -74,7 +75,7 @@ const int32_t* corner_value(const EditableMesh& m, const AttributeValues& a,
 // interpolated, not extrapolated from the coarse faces around it (its UV
 // error at SheenCloth's prefixes 24-30 -> 16-17 x 1e-3 before the values
 // records come, bench/REPORT.md).
-enum class Prediction { kValues, kGeometric, kNeighbourNormals, kNeighbourMean };
+enum class Prediction { kValues, kGeometric, kNeighbourNormals, kNeighbourMean, kGeometricUv };
 
 // The mean direction of the decoded (lower id) neighbours' normals at the
 // corners of wedge w of v; false when none is decoded.
@@ -98,6 +99,34 @@ bool neighbour_normal_mean(const EditableMesh& m, const AttributeValues& a,
     }
   }
   return count > 0 && (d[0] != 0 || d[1] != 0 || d[2] != 0);
+}
+
+// Texture coordinates of v in face (v, a, b) from the geometry (as Draco's
+// texture-coordinate predictor): v's position projected on the edge (a, b)
+// gives a ratio along it and a distance from it (relative to its length);
+// the same in UV from A and B, on the side of the edge away from X (the
+// third corner of the face across (a, b)). False when the edge is
+// degenerate in space or UV, or X lies on it.
+bool texcoord_from_geometry(const Vec3i& pv, const Vec3i& pa, const Vec3i& pb, const int32_t* A,
+                            const int32_t* B, const int32_t* X, int32_t* out) {
+  const double ex = double(pb.x) - pa.x, ey = double(pb.y) - pa.y, ez = double(pb.z) - pa.z;
+  const double dx = double(pv.x) - pa.x, dy = double(pv.y) - pa.y, dz = double(pv.z) - pa.z;
+  const double len2 = ex * ex + ey * ey + ez * ez;
+  if (!(len2 > 0)) return false;
+  const double t = (dx * ex + dy * ey + dz * ez) / len2;
+  const double px = dx - t * ex, py = dy - t * ey, pz = dz - t * ez;
+  const double h = std::sqrt((px * px + py * py + pz * pz) / len2);
+  const double Eu = double(B[0]) - A[0], Ev = double(B[1]) - A[1];
+  if (Eu == 0 && Ev == 0) return false;
+  const double fu = A[0] + t * Eu, fv = A[1] + t * Ev;
+  // Normal of the UV edge, and X's side of it.
+  const double nu = -Ev, nv = Eu;
+  const double side = (X[0] - A[0]) * nu + (X[1] - A[1]) * nv;
+  if (side == 0) return false;
+  const double s = side > 0 ? -h : h;
+  out[0] = int32_t(std::lround(fu + s * nu));
+  out[1] = int32_t(std::lround(fv + s * nv));
+  return true;
 }
 
 // The prediction of vertex v's value (wedge w of a per-corner channel) from
@@ -137,6 +166,15 @@ int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayo
         const int32_t* A = corner_value(m, a, channel, ch, na);
         const int32_t* B = corner_value(m, a, channel, ch, pb);
         const int32_t* X = corner_value(m, a, channel, ch, o);
+        int32_t uv[2];
+        if (how == Prediction::kGeometricUv &&
+            texcoord_from_geometry(m.positions()[v], m.positions()[va], m.positions()[vb], A, B, X,
+                                   uv)) {
+          para[0] += uv[0];
+          para[1] += uv[1];
+          ++para_count;
+          continue;
+        }
         for (uint32_t i = 0; i < n; ++i) para[i] += int64_t(A[i]) + B[i] - X[i];
         ++para_count;
         continue;
@@ -213,12 +251,20 @@ bool value_of(const AttributeChannel& c, int32_t max, int32_t pred, int64_t r, i
   return true;
 }
 
-// Normals are predicted from the geometry (in the last record and normals
-// records from the exact positions, in record 1 from the base's coarse ones:
-// what the decoder has) or, where record 1 names it, from the neighbours'
-// normals.
-Prediction prediction_of(const AttributeChannel& c, Prediction normals) {
-  return c.kind == AttributeKind::kNormal ? normals : Prediction::kValues;
+// How channel c is predicted in record 1 (`base_record`) or in the later
+// records, as its layout flags say. Normals: the geometric normal (in the
+// last and normals records from the exact positions, in record 1 from the
+// base's coarse ones: what the decoder has), or in record 1 the
+// neighbours' normals. Texture coordinates: parallelograms, or the
+// geometry-based prediction. The encoder sets the flags where they code
+// smaller (record 1) or always (later records: version 12).
+Prediction prediction_of(const AttributeChannel& c, bool base_record) {
+  const bool alternative =
+      (c.flags & (base_record ? kPredictBaseAlternative : kPredictLaterFromGeometry)) != 0;
+  if (c.kind == AttributeKind::kNormal)
+    return base_record && alternative ? Prediction::kNeighbourNormals : Prediction::kGeometric;
+  if (c.kind == AttributeKind::kTexcoord && alternative) return Prediction::kGeometricUv;
+  return Prediction::kValues;
 }
 
 // The wedges of every vertex of `m` from per-corner values (all corner
@@ -282,7 +328,7 @@ std::vector<uint8_t> write_layout(const AttributeLayout& l) {
   out.push_back(uint8_t(l.channels.size()));
   for (const AttributeChannel& c : l.channels) {
     out.push_back(uint8_t(c.kind));
-    out.push_back(c.per_corner ? 1 : 0);
+    out.push_back(uint8_t((c.per_corner ? 1 : 0) | c.flags));
     out.push_back(c.bits);
     if (c.kind == AttributeKind::kTexcoord) {
       put_f32(out, c.uv.min.x);
@@ -371,13 +417,20 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
     const uint8_t kind = r.u8();
     if (kind < 1 || kind > 4) return tl::unexpected(parse_error("unknown attribute kind"));
     c.kind = AttributeKind(kind);
-    c.per_corner = r.u8() != 0;
+    const uint8_t flags = r.u8();
+    c.per_corner = (flags & 1) != 0;
+    c.flags = uint8_t(flags & ~1);
     c.bits = r.u8();
     for (const AttributeChannel& other : l.channels)
       if (other.kind == c.kind) return tl::unexpected(parse_error("an attribute kind repeats"));
     if (c.kind != AttributeKind::kMaterial &&
         (c.bits < kMinAttributeBits || c.bits > kMaxAttributeBits))
       return tl::unexpected(parse_error("quantization bits out of 2..16"));
+    const uint8_t allowed = c.kind == AttributeKind::kTexcoord
+                                ? kPredictBaseAlternative | kPredictLaterFromGeometry
+                            : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative
+                                                               : 0;
+    if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
     if (c.kind == AttributeKind::kTexcoord) {
@@ -426,7 +479,7 @@ void put_section(std::vector<uint8_t>& out, const std::vector<uint8_t>& bytes) {
 // the models to continue (values records), else fresh ones.
 struct ValueCoder {
   const AttributeLayout& layout;
-  Prediction normals = Prediction::kGeometric;
+  bool base_record = false;  // record 1 (its prediction flags)
   std::vector<uint32_t> ring, corners;
 
   std::vector<uint8_t> encode(const EditableMesh& m, const AttributeValues& truth, size_t ch,
@@ -443,7 +496,7 @@ struct ValueCoder {
       const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
         const int ctx =
-            predict(m, truth, layout, ch, v, w, prediction_of(c, normals), pred, ring, corners);
+            predict(m, truth, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i)
           models.residual[ctx][i].encode(enc,
                                          residual_of(c, max, truth.data[ch][w * n + i], pred[i]));
@@ -466,7 +519,7 @@ struct ValueCoder {
       const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
         const int ctx =
-            predict(m, a, layout, ch, v, w, prediction_of(c, normals), pred, ring, corners);
+            predict(m, a, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
           const int64_t r = models.residual[ctx][i].decode(dec);
           if (!value_of(c, max, pred[i], r, a.data[ch][w * n + i]))
@@ -702,7 +755,12 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
 
   // The values in decoder terms: wedges from the full mesh, named as the
   // base's stars give them.
-  const AttributeLayout& layout = plan.layout;
+  // The layout as coded: texture coordinates after record 1 predicted from
+  // the geometry (version 12; the positions are exact or nearly there);
+  // record 1's choices are made below.
+  AttributeLayout layout = plan.layout;
+  for (AttributeChannel& c : layout.channels)
+    if (c.kind == AttributeKind::kTexcoord) c.flags |= kPredictLaterFromGeometry;
   AttributeValues truth;
   truth.data.resize(layout.channels.size());
   const auto seams = seams_of(*full, plan.input_values, layout, &corner_map);
@@ -766,12 +824,11 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     }
   }
 
-  // Record 1: layout, seams, base values.
+  // Record 1: layout, seams, base values (the layout last: its flags say
+  // which prediction record 1's values took).
   AttributeParts local_parts;
   std::vector<uint8_t> first{kRecordAttributes, kAttributePartBase};
-  const std::vector<uint8_t> layout_bytes = write_layout(layout);
-  put_section(first, layout_bytes);
-  local_parts["layout"] += layout_bytes.size();
+  std::vector<uint8_t> after_layout;
   if (any_corner_channel(layout)) {
     RangeEncoder enc;
     SeamModels models;
@@ -788,15 +845,17 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
       }
     }
     const std::vector<uint8_t> bytes = enc.finish();
-    put_section(first, bytes);
+    put_section(after_layout, bytes);
     local_parts["seams"] += bytes.size();
   }
-  // Record 1's normals: the geometric normal of the coarse base, or the
-  // neighbours' normals where that codes smaller (record part 5; the base's
-  // positions miss their low bits, and on a base as fine as the mesh, as
-  // where every vertex is locked, the neighbours are close).
-  ValueCoder base_coder{layout};
-  ValueCoder neighbour_coder{layout, Prediction::kNeighbourNormals};
+  // Record 1's normals and texture coordinates: each both ways (the
+  // geometric normal of the coarse base or the neighbours' normals;
+  // parallelograms or the geometry-based UV prediction), the smaller kept
+  // and named by the layout flag kPredictBaseAlternative. The base's
+  // positions miss their low bits, which spoils the geometry-based guesses
+  // where the base is as fine as the mesh (every vertex locked: Draco's
+  // textured sphere); on a coarse base of exact-enough positions they win.
+  ValueCoder base_coder{layout, true};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
     // The base's values predicted over the base mesh (the decoder's state
     // after record 0); the wedge tables of base vertices are the same.
@@ -811,16 +870,21 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
         size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
     base_truth.data[ch].assign(truth.data[ch].begin(), truth.data[ch].begin() + count);
     std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
-    if (c.kind == AttributeKind::kNormal) {
-      std::vector<uint8_t> other = neighbour_coder.encode(*base, base_truth, ch, 0, base_n);
-      if (other.size() < bytes.size()) {
+    if (c.kind == AttributeKind::kNormal || c.kind == AttributeKind::kTexcoord) {
+      layout.channels[ch].flags |= kPredictBaseAlternative;
+      std::vector<uint8_t> other = base_coder.encode(*base, base_truth, ch, 0, base_n);
+      if (other.size() < bytes.size())
         bytes = std::move(other);
-        first[1] = kAttributePartBaseNeighbourNormals;
-      }
+      else
+        layout.channels[ch].flags &= uint8_t(~kPredictBaseAlternative);
     }
-    put_section(first, bytes);
+    put_section(after_layout, bytes);
     local_parts[attribute_kind_name(c.kind)] += bytes.size();
   }
+  const std::vector<uint8_t> layout_bytes = write_layout(layout);
+  put_section(first, layout_bytes);
+  first.insert(first.end(), after_layout.begin(), after_layout.end());
+  local_parts["layout"] += layout_bytes.size();
 
   // Values records: the geometry stream replayed as the decoder reads it,
   // and after a geometry record, once the vertices inserted since the last
@@ -981,7 +1045,7 @@ Result<AttributeParts> attribute_record_parts(
     std::span<const uint8_t> final_payload) {
   AttributeParts parts;
   if (base_payload.size() < 2 || base_payload[0] != kRecordAttributes ||
-      !is_base_part(base_payload[1]))
+      base_payload[1] != kAttributePartBase)
     return tl::unexpected(parse_error("record 1 is not the base attribute record"));
   Reader r{base_payload, 2};
   auto layout_bytes = r.section();
@@ -1028,7 +1092,7 @@ Result<AttributeParts> attribute_record_parts(
 
 Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const EditableMesh& base) {
   if (active_) return tl::unexpected(parse_error("a second base attribute record"));
-  if (payload.size() < 2 || !is_base_part(payload[1]))
+  if (payload.size() < 2 || payload[1] != kAttributePartBase)
     return tl::unexpected(parse_error("the first attribute record is not the base part"));
   Reader r{payload, 2};
   auto layout_bytes = r.section();
@@ -1077,9 +1141,7 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
       values_.wedge_start.push_back(v + 1);
     }
   }
-  ValueCoder coder{layout_, payload[1] == kAttributePartBaseNeighbourNormals
-                                ? Prediction::kNeighbourNormals
-                                : Prediction::kGeometric};
+  ValueCoder coder{layout_, true};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),

@@ -28,7 +28,8 @@
 // geometric normal of its wedge on the mesh the decoder has),
 // so every prefix after record 1 has attributes. Values are predicted in
 // exact integers from what the decoder has (parallelograms over the
-// connectivity, neighbours; normals: the geometric normal of the wedge's
+// connectivity, neighbours; texture coordinates after record 1: from the
+// geometry as Draco's predictor; normals: the geometric normal of the wedge's
 // faces) and the residuals range-coded with adaptive models.
 #pragma once
 
@@ -58,13 +59,6 @@ inline constexpr uint8_t kAttributePartValues = 2;  // after geometry records (v
 // of those values records, predicted on the complete mesh.
 inline constexpr uint8_t kAttributePartValuesLateNormals = 3;
 inline constexpr uint8_t kAttributePartNormals = 4;
-// Version 12 on: record 1 whose normals are predicted from the decoded
-// neighbours' normals instead of the base's geometric normals (the encoder
-// takes whichever codes smaller).
-inline constexpr uint8_t kAttributePartBaseNeighbourNormals = 5;
-inline bool is_base_part(uint8_t part) {
-  return part == kAttributePartBase || part == kAttributePartBaseNeighbourNormals;
-}
 inline bool is_values_part(uint8_t part) {
   return part == kAttributePartValues || part == kAttributePartValuesLateNormals ||
          part == kAttributePartNormals;
@@ -79,11 +73,19 @@ inline constexpr uint32_t kBoundaryKey = 0xFFFFFFFEu;
 enum class AttributeKind : uint8_t { kNormal = 1, kTexcoord = 2, kColor = 3, kMaterial = 4 };
 const char* attribute_kind_name(AttributeKind kind);
 
+// Prediction flags of a channel (the layout's per-channel byte, bit 0 of
+// which is "per corner"; version 12 on): record 1 predicts normals from the
+// decoded neighbours' normals, texture coordinates from the geometry; the
+// records after it predict texture coordinates from the geometry.
+inline constexpr uint8_t kPredictBaseAlternative = 2;
+inline constexpr uint8_t kPredictLaterFromGeometry = 4;
+
 struct AttributeChannel {
   AttributeKind kind = AttributeKind::kColor;
   bool per_corner = false;
   uint8_t bits = 8;  // quantization bits (normals: per octahedral coordinate); unused for materials
   TexcoordGrid uv;   // texture coordinates only
+  uint8_t flags = 0;  // kPredict* bits (last: the aggregate initializers above it)
   uint32_t components() const {
     return kind == AttributeKind::kColor ? 4 : kind == AttributeKind::kMaterial ? 1 : 2;
   }

@@ -133,7 +133,7 @@ struct IncrementalDecoder::State {
   Status apply_attribute_record(std::span<const uint8_t> payload) {
     const StreamHeader& h = index->header;
     const uint8_t part = payload.size() >= 2 ? payload[1] : 0xFF;
-    if (is_base_part(part)) {
+    if (part == kAttributePartBase) {
       if (geometry_records > 0)
         return make_error(ErrorCode::kParse, "base attribute record after a geometry record");
       if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
