@@ -17,7 +17,7 @@
 // is given the same: SheenCloth's tangents and second UV set are left out of
 // both).
 //
-// Usage: attribute_bench [MODELS_DIR] [--out FILE.md]
+// Usage: attribute_bench [MODELS_DIR] [--out FILE.md] [--report-dir DIR]
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/io/mesh_io.h>
@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -67,14 +68,22 @@ double median_ms(F&& f, int runs = 5) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string dir = "/work/shared/models", out_path;
+  // The models folder: the argument, else ../models beside
+  // MESHSTREAM_TEST_MESHES (as the tests find them), else the shared one.
+  std::string dir = "/work/shared/models", out_path, report_dir;
+  if (const char* meshes = std::getenv("MESHSTREAM_TEST_MESHES"))
+    if (fs::exists(fs::path(meshes) / ".." / "models"))
+      dir = (fs::path(meshes) / ".." / "models").string();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc)
       out_path = argv[++i];
+    else if (a == "--report-dir" && i + 1 < argc)  // bench/run's convention
+      report_dir = argv[++i];
     else
       dir = a;
   }
+  if (out_path.empty() && !report_dir.empty()) out_path = report_dir + "/attributes.md";
   std::vector<fs::path> files;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     const std::string ext = e.path().extension().string();
@@ -208,6 +217,10 @@ int main(int argc, char** argv) {
     table += row;
   }
   std::printf("\n%s", table.c_str());
-  if (!out_path.empty()) std::ofstream(out_path) << table;
+  if (!out_path.empty())
+    std::ofstream(out_path) << (report_dir.empty()
+                                    ? ""
+                                    : "## Attributes against Draco (attribute_bench)\n\n")
+                            << table;
   return 0;
 }

@@ -38,7 +38,7 @@
 //     that alike, and the full-rate rows (both exactly the quantized input)
 //     show the measure's floor per model.
 //
-// Usage: attribute_rd_bench [MODELS_DIR] [--out FILE.md] [--samples N]
+// Usage: attribute_rd_bench [MODELS_DIR] [--out FILE.md] [--report-dir DIR] [--samples N]
 #include <draco/io/mesh_io.h>
 #include <draco/mesh/mesh_cleanup.h>
 #include <meshoptimizer.h>
@@ -47,6 +47,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -275,17 +276,25 @@ std::string cells(const Point& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string dir = "/work/shared/models", out_path;
+  // The models folder: the argument, else ../models beside
+  // MESHSTREAM_TEST_MESHES (as the tests find them), else the shared one.
+  std::string dir = "/work/shared/models", out_path, report_dir;
+  if (const char* meshes = std::getenv("MESHSTREAM_TEST_MESHES"))
+    if (fs::exists(fs::path(meshes) / ".." / "models"))
+      dir = (fs::path(meshes) / ".." / "models").string();
   uint32_t samples = 20000;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc)
       out_path = argv[++i];
+    else if (a == "--report-dir" && i + 1 < argc)  // bench/run's convention
+      report_dir = argv[++i];
     else if (a == "--samples" && i + 1 < argc)
       samples = uint32_t(std::stoul(argv[++i]));
     else
       dir = a;
   }
+  if (out_path.empty() && !report_dir.empty()) out_path = report_dir + "/attributes_rd.md";
   std::vector<fs::path> files;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     const std::string ext = e.path().extension().string();
@@ -407,6 +416,12 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   std::printf("\n%s\n%s", table.c_str(), curves.c_str());
-  if (!out_path.empty()) std::ofstream(out_path) << table << "\n" << curves;
+  if (!out_path.empty())
+    std::ofstream(out_path)
+        << (report_dir.empty()
+                ? ""
+                : "## Attributes: rate-distortion against an LOD chain (attribute_rd_bench)\n\n")
+        << table << "\n"
+        << curves;
   return 0;
 }
