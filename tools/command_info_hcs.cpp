@@ -67,7 +67,7 @@ nlohmann::json part_bytes(const std::vector<uint8_t>& bytes, const StreamIndex& 
       const uint8_t part = payload.size() > 1 ? payload[1] : kAttributePartFinal;
       if (part == kAttributePartBase)
         base_attributes = payload;
-      else if (part == kAttributePartValues)
+      else if (is_values_part(part))
         values_attributes.push_back(payload);
       else
         final_attributes = payload;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <unordered_map>
 
@@ -64,11 +65,76 @@ const int32_t* corner_value(const EditableMesh& m, const AttributeValues& a,
   return &a.data[ch][size_t(idx) * channel.components()];
 }
 
+// How a value is predicted: from the neighbours' values in the channel's
+// own integers (parallelograms, means), from the geometry (normals: the
+// geometric normal of the wedge), or (normals, record 1 from version 12 on
+// when it codes smaller) from the mean of the decoded neighbours' unit
+// normals at the wedge's faces.
+// kNeighbourMean (previews only, never coded against): the mean of the
+// decoded neighbours' values, no parallelogram; an inserted vertex's value
+// interpolated, not extrapolated from the coarse faces around it (its UV
+// error at SheenCloth's prefixes 24-30 -> 16-17 x 1e-3 before the values
+// records come, bench/REPORT.md).
+enum class Prediction { kValues, kGeometric, kNeighbourNormals, kNeighbourMean, kGeometricUv };
+
+// The mean direction of the decoded (lower id) neighbours' normals at the
+// corners of wedge w of v; false when none is decoded.
+bool neighbour_normal_mean(const EditableMesh& m, const AttributeValues& a,
+                           const AttributeChannel& channel, size_t ch, uint32_t v, uint32_t w,
+                           const std::vector<uint32_t>& corners, double* d) {
+  d[0] = d[1] = d[2] = 0;
+  int count = 0;
+  for (uint32_t c : corners) {
+    if (channel.per_corner && a.wedge_start[v + 1] - a.wedge_start[v] > 1 &&
+        wedge_of_corner(m, a, c) != w)
+      continue;
+    for (uint32_t nc : {EditableMesh::next(c), EditableMesh::prev(c)}) {
+      if (m.vertex(nc) >= v) continue;
+      const int32_t* u = corner_value(m, a, channel, ch, nc);
+      const Vec3f n = dequantize_normal({u[0], u[1]}, channel.bits);
+      d[0] += n.x;
+      d[1] += n.y;
+      d[2] += n.z;
+      ++count;
+    }
+  }
+  return count > 0 && (d[0] != 0 || d[1] != 0 || d[2] != 0);
+}
+
+// Texture coordinates of v in face (v, a, b) from the geometry (as Draco's
+// texture-coordinate predictor): v's position projected on the edge (a, b)
+// gives a ratio along it and a distance from it (relative to its length);
+// the same in UV from A and B, on the side of the edge away from X (the
+// third corner of the face across (a, b)). False when the edge is
+// degenerate in space or UV, or X lies on it.
+bool texcoord_from_geometry(const Vec3i& pv, const Vec3i& pa, const Vec3i& pb, const int32_t* A,
+                            const int32_t* B, const int32_t* X, int32_t* out) {
+  const double ex = double(pb.x) - pa.x, ey = double(pb.y) - pa.y, ez = double(pb.z) - pa.z;
+  const double dx = double(pv.x) - pa.x, dy = double(pv.y) - pa.y, dz = double(pv.z) - pa.z;
+  const double len2 = ex * ex + ey * ey + ez * ez;
+  if (!(len2 > 0)) return false;
+  const double t = (dx * ex + dy * ey + dz * ez) / len2;
+  const double px = dx - t * ex, py = dy - t * ey, pz = dz - t * ez;
+  const double h = std::sqrt((px * px + py * py + pz * pz) / len2);
+  const double Eu = double(B[0]) - A[0], Ev = double(B[1]) - A[1];
+  if (Eu == 0 && Ev == 0) return false;
+  const double fu = A[0] + t * Eu, fv = A[1] + t * Ev;
+  // Normal of the UV edge, and X's side of it.
+  const double nu = -Ev, nv = Eu;
+  const double side = (X[0] - A[0]) * nu + (X[1] - A[1]) * nv;
+  if (side == 0) return false;
+  const double s = side > 0 ? -h : h;
+  out[0] = int32_t(std::lround(fu + s * nu));
+  out[1] = int32_t(std::lround(fv + s * nv));
+  return true;
+}
+
 // The prediction of vertex v's value (wedge w of a per-corner channel) from
 // vertices below v; returns its context.
 int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayout& layout,
-            size_t ch, uint32_t v, uint32_t w, bool geometric, int32_t* out,
+            size_t ch, uint32_t v, uint32_t w, Prediction how, int32_t* out,
             std::vector<uint32_t>& ring, std::vector<uint32_t>& corners) {
+  const bool geometric = how == Prediction::kGeometric || how == Prediction::kNeighbourNormals;
   const AttributeChannel& channel = layout.channels[ch];
   const uint32_t n = channel.components();
   const int32_t max = layout.max_value(channel);
@@ -94,12 +160,21 @@ int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayo
       continue;
     }
     const bool a_known = va < v, b_known = vb < v;
-    if (a_known && b_known) {
+    if (a_known && b_known && how != Prediction::kNeighbourMean) {
       const uint32_t o = m.opposite(c);
       if (o != kNone && m.vertex(o) < v) {
         const int32_t* A = corner_value(m, a, channel, ch, na);
         const int32_t* B = corner_value(m, a, channel, ch, pb);
         const int32_t* X = corner_value(m, a, channel, ch, o);
+        int32_t uv[2];
+        if (how == Prediction::kGeometricUv &&
+            texcoord_from_geometry(m.positions()[v], m.positions()[va], m.positions()[vb], A, B, X,
+                                   uv)) {
+          para[0] += uv[0];
+          para[1] += uv[1];
+          ++para_count;
+          continue;
+        }
         for (uint32_t i = 0; i < n; ++i) para[i] += int64_t(A[i]) + B[i] - X[i];
         ++para_count;
         continue;
@@ -116,13 +191,22 @@ int predict(const EditableMesh& m, const AttributeValues& a, const AttributeLayo
       ++near_count;
     }
   }
+  if (how == Prediction::kNeighbourNormals) {
+    double d[3];
+    if (neighbour_normal_mean(m, a, channel, ch, v, w, corners, d)) {
+      const auto q = quantize_direction(d[0], d[1], d[2], channel.bits);
+      out[0] = q[0];
+      out[1] = q[1];
+      return 3;
+    }
+  }
   if (geometric && (normal[0] != 0 || normal[1] != 0 || normal[2] != 0)) {
     const auto q = quantize_direction(normal[0], normal[1], normal[2], channel.bits);
     out[0] = q[0];
     out[1] = q[1];
     return 3;
   }
-  if (geometric) return predict(m, a, layout, ch, v, w, false, out, ring, corners);
+  if (geometric) return predict(m, a, layout, ch, v, w, Prediction::kValues, out, ring, corners);
   int context = 2;
   for (uint32_t i = 0; i < n; ++i) out[i] = 0;
   if (para_count > 0) {
@@ -167,10 +251,20 @@ bool value_of(const AttributeChannel& c, int32_t max, int32_t pred, int64_t r, i
   return true;
 }
 
-// Normals are predicted from the geometry: in the last record from the exact
-// positions, in record 1 from the base's coarse ones (what the decoder has).
-bool use_geometric(const AttributeChannel& c, bool /*final_record*/) {
-  return c.kind == AttributeKind::kNormal;
+// How channel c is predicted in record 1 (`base_record`) or in the later
+// records, as its layout flags say. Normals: the geometric normal (in the
+// last and normals records from the exact positions, in record 1 from the
+// base's coarse ones: what the decoder has), or in record 1 the
+// neighbours' normals. Texture coordinates: parallelograms, or the
+// geometry-based prediction. The encoder sets the flags where they code
+// smaller (record 1) or always (later records: version 12).
+Prediction prediction_of(const AttributeChannel& c, bool base_record) {
+  const bool alternative =
+      (c.flags & (base_record ? kPredictBaseAlternative : kPredictLaterFromGeometry)) != 0;
+  if (c.kind == AttributeKind::kNormal)
+    return base_record && alternative ? Prediction::kNeighbourNormals : Prediction::kGeometric;
+  if (c.kind == AttributeKind::kTexcoord && alternative) return Prediction::kGeometricUv;
+  return Prediction::kValues;
 }
 
 // The wedges of every vertex of `m` from per-corner values (all corner
@@ -207,6 +301,14 @@ bool any_corner_channel(const AttributeLayout& l) {
                      [](const AttributeChannel& c) { return c.per_corner; });
 }
 
+// Whether a values-kind record of this part has a section for channel c.
+bool carried_in(uint8_t part, const AttributeChannel& c) {
+  const bool normal = c.kind == AttributeKind::kNormal;
+  if (part == kAttributePartNormals) return normal;
+  if (part == kAttributePartValuesLateNormals) return !normal;
+  return true;
+}
+
 // ---- layout bytes ----
 
 void put_f64(std::vector<uint8_t>& out, double d) {
@@ -226,7 +328,7 @@ std::vector<uint8_t> write_layout(const AttributeLayout& l) {
   out.push_back(uint8_t(l.channels.size()));
   for (const AttributeChannel& c : l.channels) {
     out.push_back(uint8_t(c.kind));
-    out.push_back(c.per_corner ? 1 : 0);
+    out.push_back(uint8_t((c.per_corner ? 1 : 0) | c.flags));
     out.push_back(c.bits);
     if (c.kind == AttributeKind::kTexcoord) {
       put_f32(out, c.uv.min.x);
@@ -315,13 +417,20 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
     const uint8_t kind = r.u8();
     if (kind < 1 || kind > 4) return tl::unexpected(parse_error("unknown attribute kind"));
     c.kind = AttributeKind(kind);
-    c.per_corner = r.u8() != 0;
+    const uint8_t flags = r.u8();
+    c.per_corner = (flags & 1) != 0;
+    c.flags = uint8_t(flags & ~1);
     c.bits = r.u8();
     for (const AttributeChannel& other : l.channels)
       if (other.kind == c.kind) return tl::unexpected(parse_error("an attribute kind repeats"));
     if (c.kind != AttributeKind::kMaterial &&
         (c.bits < kMinAttributeBits || c.bits > kMaxAttributeBits))
       return tl::unexpected(parse_error("quantization bits out of 2..16"));
+    const uint8_t allowed = c.kind == AttributeKind::kTexcoord
+                                ? kPredictBaseAlternative | kPredictLaterFromGeometry
+                            : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative
+                                                               : 0;
+    if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
     if (c.kind == AttributeKind::kTexcoord) {
@@ -370,7 +479,7 @@ void put_section(std::vector<uint8_t>& out, const std::vector<uint8_t>& bytes) {
 // the models to continue (values records), else fresh ones.
 struct ValueCoder {
   const AttributeLayout& layout;
-  bool final_record;
+  bool base_record = false;  // record 1 (its prediction flags)
   std::vector<uint32_t> ring, corners;
 
   std::vector<uint8_t> encode(const EditableMesh& m, const AttributeValues& truth, size_t ch,
@@ -386,8 +495,8 @@ struct ValueCoder {
       const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
       const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
-        const int ctx = predict(m, truth, layout, ch, v, w, use_geometric(c, final_record), pred,
-                                ring, corners);
+        const int ctx =
+            predict(m, truth, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i)
           models.residual[ctx][i].encode(enc,
                                          residual_of(c, max, truth.data[ch][w * n + i], pred[i]));
@@ -410,7 +519,7 @@ struct ValueCoder {
       const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
       for (uint32_t w = w0; w < w1; ++w) {
         const int ctx =
-            predict(m, a, layout, ch, v, w, use_geometric(c, final_record), pred, ring, corners);
+            predict(m, a, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
           const int64_t r = models.residual[ctx][i].decode(dec);
           if (!value_of(c, max, pred[i], r, a.data[ch][w * n + i]))
@@ -646,7 +755,12 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
 
   // The values in decoder terms: wedges from the full mesh, named as the
   // base's stars give them.
-  const AttributeLayout& layout = plan.layout;
+  // The layout as coded: texture coordinates after record 1 predicted from
+  // the geometry (version 12; the positions are exact or nearly there);
+  // record 1's choices are made below.
+  AttributeLayout layout = plan.layout;
+  for (AttributeChannel& c : layout.channels)
+    if (c.kind == AttributeKind::kTexcoord) c.flags |= kPredictLaterFromGeometry;
   AttributeValues truth;
   truth.data.resize(layout.channels.size());
   const auto seams = seams_of(*full, plan.input_values, layout, &corner_map);
@@ -710,12 +824,11 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     }
   }
 
-  // Record 1: layout, seams, base values.
+  // Record 1: layout, seams, base values (the layout last: its flags say
+  // which prediction record 1's values took).
   AttributeParts local_parts;
   std::vector<uint8_t> first{kRecordAttributes, kAttributePartBase};
-  const std::vector<uint8_t> layout_bytes = write_layout(layout);
-  put_section(first, layout_bytes);
-  local_parts["layout"] += layout_bytes.size();
+  std::vector<uint8_t> after_layout;
   if (any_corner_channel(layout)) {
     RangeEncoder enc;
     SeamModels models;
@@ -732,10 +845,17 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
       }
     }
     const std::vector<uint8_t> bytes = enc.finish();
-    put_section(first, bytes);
+    put_section(after_layout, bytes);
     local_parts["seams"] += bytes.size();
   }
-  ValueCoder base_coder{layout, false, {}, {}};
+  // Record 1's normals and texture coordinates: each both ways (the
+  // geometric normal of the coarse base or the neighbours' normals;
+  // parallelograms or the geometry-based UV prediction), the smaller kept
+  // and named by the layout flag kPredictBaseAlternative. The base's
+  // positions miss their low bits, which spoils the geometry-based guesses
+  // where the base is as fine as the mesh (every vertex locked: Draco's
+  // textured sphere); on a coarse base of exact-enough positions they win.
+  ValueCoder base_coder{layout, true};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
     // The base's values predicted over the base mesh (the decoder's state
     // after record 0); the wedge tables of base vertices are the same.
@@ -749,10 +869,22 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     const size_t count =
         size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
     base_truth.data[ch].assign(truth.data[ch].begin(), truth.data[ch].begin() + count);
-    const std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
-    put_section(first, bytes);
+    std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
+    if (c.kind == AttributeKind::kNormal || c.kind == AttributeKind::kTexcoord) {
+      layout.channels[ch].flags |= kPredictBaseAlternative;
+      std::vector<uint8_t> other = base_coder.encode(*base, base_truth, ch, 0, base_n);
+      if (other.size() < bytes.size())
+        bytes = std::move(other);
+      else
+        layout.channels[ch].flags &= uint8_t(~kPredictBaseAlternative);
+    }
+    put_section(after_layout, bytes);
     local_parts[attribute_kind_name(c.kind)] += bytes.size();
   }
+  const std::vector<uint8_t> layout_bytes = write_layout(layout);
+  put_section(first, layout_bytes);
+  first.insert(first.end(), after_layout.begin(), after_layout.end());
+  local_parts["layout"] += layout_bytes.size();
 
   // Values records: the geometry stream replayed as the decoder reads it,
   // and after a geometry record, once the vertices inserted since the last
@@ -760,16 +892,35 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   // values coded on the mesh the decoder holds then. Their size per vertex
   // is estimated from coding them all on the full mesh (version 10's last
   // record).
+  //
+  // Normals go late (version 12): their prediction is the geometric normal
+  // of the vertex's wedge, which on the coarse stars of a values record's
+  // moment missed by far more than on the complete mesh (SheenCloth: 45 240
+  // normal bytes against 27 952 on the complete mesh's stars with the same
+  // positions; the positions were already exact there). So values records
+  // leave them out (part 3) and normals records after the last geometry
+  // record carry them, coded on the complete mesh, in records of the same
+  // size rule; until then the decoder previews a vertex's normal with the
+  // geometric normal of its wedge on the mesh it has.
   const uint32_t inserted = n - base_n;
-  uint64_t all_inserted_bytes = 0;
+  const bool late_normals =
+      std::any_of(layout.channels.begin(), layout.channels.end(),
+                  [](const AttributeChannel& c) { return c.kind == AttributeKind::kNormal; });
+  auto deferred = [&](size_t ch) {
+    return late_normals && layout.channels[ch].kind == AttributeKind::kNormal;
+  };
+  uint64_t all_inserted_bytes = 0, values_inserted_bytes = 0, normal_inserted_bytes = 0;
   {
-    ValueCoder estimate{layout, true, {}, {}};
-    for (size_t ch = 0; ch < layout.channels.size(); ++ch)
-      all_inserted_bytes += estimate.encode(*full, truth, ch, base_n, n).size();
+    ValueCoder estimate{layout};
+    for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+      const uint64_t b = estimate.encode(*full, truth, ch, base_n, n).size();
+      all_inserted_bytes += b;
+      (deferred(ch) ? normal_inserted_bytes : values_inserted_bytes) += b;
+    }
   }
   uint64_t fixed_bytes = stream.size() + first.size();
   for (const ExtraAttribute& e : *plan.extras) fixed_bytes += e.bytes.size() / 4;  // a guess
-  const double per_vertex = inserted ? double(all_inserted_bytes) / inserted : 0;
+  const double per_vertex = inserted ? double(values_inserted_bytes) / inserted : 0;
   const double target = kValuesRecordShare * double(fixed_bytes + all_inserted_bytes);
   std::vector<std::vector<uint8_t>> values_after(idx.records.size());
   uint32_t done = base_n;
@@ -779,7 +930,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     if (!replay) return tl::unexpected(replay.error());
     if (format) replay->format = *format;
     std::vector<ChannelModels> models(layout.channels.size());
-    ValueCoder values_coder{layout, false, {}, {}};
+    ValueCoder values_coder{layout};
     // The last geometry record's vertices go into the last record.
     for (size_t i = 1; i + 1 < idx.records.size(); ++i) {
       const RecordEntry& r = idx.records[i];
@@ -792,9 +943,11 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
         return internal("replaying record " + std::to_string(i) + ": " + s.error().message);
       const uint32_t now = replay->mesh.vertex_count();
       if (now <= done || double(now - done) * per_vertex < target) continue;
-      std::vector<uint8_t> payload{kRecordAttributes, kAttributePartValues};
+      std::vector<uint8_t> payload{
+          kRecordAttributes, late_normals ? kAttributePartValuesLateNormals : kAttributePartValues};
       put_varint(payload, now - done);
       for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+        if (deferred(ch)) continue;
         const std::vector<uint8_t> bytes =
             values_coder.encode(replay->mesh, truth, ch, done, now, &models[ch]);
         put_section(payload, bytes);
@@ -805,10 +958,35 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     }
   }
 
+  // Normals records: the normals the values records left out, on the
+  // complete mesh, each about kValuesRecordShare of the stream.
+  std::vector<std::vector<uint8_t>> normals_records;
+  if (late_normals && done > base_n) {
+    const double per_normal = double(normal_inserted_bytes) / inserted;
+    const uint32_t chunk =
+        std::max<uint32_t>(1, per_normal > 0 ? uint32_t(target / per_normal) : done - base_n);
+    std::vector<ChannelModels> models(layout.channels.size());
+    ValueCoder normals_coder{layout};
+    for (uint32_t from = base_n; from < done;) {
+      const uint32_t to = std::min(done, from + chunk);
+      std::vector<uint8_t> payload{kRecordAttributes, kAttributePartNormals};
+      put_varint(payload, to - from);
+      for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+        if (!deferred(ch)) continue;
+        const std::vector<uint8_t> bytes =
+            normals_coder.encode(*full, truth, ch, from, to, &models[ch]);
+        put_section(payload, bytes);
+        local_parts[attribute_kind_name(layout.channels[ch].kind)] += bytes.size();
+      }
+      normals_records.push_back(std::move(payload));
+      from = to;
+    }
+  }
+
   // The last record: the values of the vertices inserted since the last
   // values record, then the extra attributes.
   std::vector<uint8_t> last{kRecordAttributes, kAttributePartFinal};
-  ValueCoder final_coder{layout, true, {}, {}};
+  ValueCoder final_coder{layout};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
     const std::vector<uint8_t> bytes = final_coder.encode(*full, truth, ch, done, n);
     put_section(last, bytes);
@@ -852,6 +1030,7 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     if (i == 0) add_attributes(std::move(first));
     if (!values_after[i].empty()) add_attributes(std::move(values_after[i]));
   }
+  for (std::vector<uint8_t>& r : normals_records) add_attributes(std::move(r));
   add_attributes(std::move(last));
   auto written = write_container(idx.header, payloads, counts);
   if (!written) return tl::unexpected(written.error());
@@ -879,12 +1058,12 @@ Result<AttributeParts> attribute_record_parts(
     parts[attribute_kind_name(c.kind)] += r.section().size();
   if (!r.ok) return tl::unexpected(parse_error("base attribute record truncated"));
   for (std::span<const uint8_t> values : values_payloads) {
-    if (values.size() < 2 || values[0] != kRecordAttributes || values[1] != kAttributePartValues)
+    if (values.size() < 2 || values[0] != kRecordAttributes || !is_values_part(values[1]))
       return tl::unexpected(parse_error("not a values record"));
     Reader v{values, 2};
     v.varint();
     for (const AttributeChannel& c : layout->channels)
-      parts[attribute_kind_name(c.kind)] += v.section().size();
+      if (carried_in(values[1], c)) parts[attribute_kind_name(c.kind)] += v.section().size();
     if (!v.ok) return tl::unexpected(parse_error("values record truncated"));
   }
   if (final_payload.empty()) return parts;
@@ -962,7 +1141,7 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
       values_.wedge_start.push_back(v + 1);
     }
   }
-  ValueCoder coder{layout_, false, {}, {}};
+  ValueCoder coder{layout_, true};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),
@@ -973,6 +1152,7 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the base part"));
   exact_vertices_ = n;
+  normals_exact_ = n;
   values_models_.assign(layout_.channels.size(), ChannelModels{});
   active_ = true;
   return {};
@@ -982,6 +1162,11 @@ Status AttributeDecoder::read_values(std::span<const uint8_t> payload, const Edi
   if (!active_)
     return tl::unexpected(parse_error("values record before the base attribute record"));
   if (complete_) return tl::unexpected(parse_error("values record after the final one"));
+  const uint8_t part = payload.size() > 1 ? payload[1] : 0xFF;
+  if (part != kAttributePartValues && part != kAttributePartValuesLateNormals)
+    return tl::unexpected(parse_error("not a values record"));
+  if (part == kAttributePartValues && normals_exact_ != exact_vertices_)
+    return tl::unexpected(parse_error("values record with normals after one without"));
   Reader r{payload, 2};
   const uint32_t count = r.varint();
   if (!r.ok) return tl::unexpected(parse_error("values record truncated"));
@@ -998,15 +1183,43 @@ Status AttributeDecoder::read_values(std::span<const uint8_t> payload, const Edi
     for (size_t ch = 0; ch < layout_.channels.size(); ++ch)
       values_.data[ch].resize(values_.data[ch].size() + layout_.channels[ch].components());
   }
-  ValueCoder coder{layout_, false, {}, {}};
+  ValueCoder coder{layout_};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    if (!carried_in(part, layout_.channels[ch])) continue;
     auto bytes = r.section();
     if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
     if (auto s = coder.decode(m, values_, ch, exact_vertices_, now, bytes, &values_models_[ch]); !s)
       return s;
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after a values record"));
+  if (part == kAttributePartValues) normals_exact_ = now;
   exact_vertices_ = now;
+  return {};
+}
+
+Status AttributeDecoder::read_normals(std::span<const uint8_t> payload, const EditableMesh& full) {
+  if (!active_)
+    return tl::unexpected(parse_error("normals record before the base attribute record"));
+  if (complete_) return tl::unexpected(parse_error("normals record after the final one"));
+  Reader r{payload, 2};
+  const uint32_t count = r.varint();
+  if (!r.ok) return tl::unexpected(parse_error("normals record truncated"));
+  if (count == 0 || uint64_t(normals_exact_) + count > exact_vertices_)
+    return tl::unexpected(
+        parse_error("normals record for " + std::to_string(count) + " vertices where " +
+                    std::to_string(exact_vertices_ - normals_exact_) + " wait for their normals"));
+  ValueCoder coder{layout_};
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    if (!carried_in(kAttributePartNormals, layout_.channels[ch])) continue;
+    auto bytes = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("normal section truncated"));
+    if (auto s = coder.decode(full, values_, ch, normals_exact_, normals_exact_ + count, bytes,
+                              &values_models_[ch]);
+        !s)
+      return s;
+  }
+  if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after a normals record"));
+  normals_exact_ += count;
   return {};
 }
 
@@ -1022,10 +1235,49 @@ void AttributeDecoder::preview(const EditableMesh& m) {
       const AttributeChannel& c = layout_.channels[ch];
       const uint32_t nc = c.components();
       values_.data[ch].resize(values_.data[ch].size() + nc);
-      predict(m, values_, layout_, ch, v, w, false, pred, ring, corners);
+      // Normals: the geometric normal of the mesh now (version 12's values
+      // records leave them to the end; refresh_normal_previews updates it);
+      // the others: the mean of the decoded neighbours' values.
+      predict(
+          m, values_, layout_, ch, v, w,
+          c.kind == AttributeKind::kNormal ? Prediction::kGeometric : Prediction::kNeighbourMean,
+          pred, ring, corners);
       std::copy(pred, pred + nc, values_.data[ch].end() - nc);
     }
   }
+}
+
+void AttributeDecoder::refresh_normal_previews(const EditableMesh& m) {
+  if (!active_ || complete_) return;
+  const uint32_t now = std::min(m.vertex_count(), values_.vertices());
+  if (normals_exact_ >= now) {
+    normals_refreshed_ = std::max(normals_refreshed_, now);
+    return;
+  }
+  std::vector<uint32_t> ring, corners, stale;
+  // A star changes when a neighbour is inserted: the vertices inserted since
+  // the last refresh, and their rings.
+  for (uint32_t u = std::max(normals_refreshed_, normals_exact_); u < now; ++u) {
+    stale.push_back(u);
+    m.star(u, ring, corners);
+    for (uint32_t v : ring)
+      if (v >= normals_exact_ && v < now) stale.push_back(v);
+  }
+  std::sort(stale.begin(), stale.end());
+  stale.erase(std::unique(stale.begin(), stale.end()), stale.end());
+  int32_t pred[4];
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    if (c.kind != AttributeKind::kNormal) continue;
+    for (uint32_t v : stale) {
+      // Inserted vertices have one wedge.
+      const uint32_t w = c.per_corner ? values_.wedge_start[v] : v;
+      predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+      values_.data[ch][2 * size_t(w)] = pred[0];
+      values_.data[ch][2 * size_t(w) + 1] = pred[1];
+    }
+  }
+  normals_refreshed_ = now;
 }
 
 Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const EditableMesh& full) {
@@ -1043,13 +1295,16 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
     values_.wedge_key.push_back(kNone);
     values_.wedge_start.push_back(uint32_t(values_.wedge_key.size()));
   }
-  ValueCoder coder{layout_, true, {}, {}};
+  ValueCoder coder{layout_};
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].resize(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components());
     auto bytes = r.section();
     if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
-    if (auto s = coder.decode(full, values_, ch, exact_vertices_, n, bytes); !s) return s;
+    // Normals from the first vertex whose normal has not come (version 12's
+    // values records leave them to normals records and this one).
+    const uint32_t from = c.kind == AttributeKind::kNormal ? normals_exact_ : exact_vertices_;
+    if (auto s = coder.decode(full, values_, ch, from, n, bytes); !s) return s;
   }
   const uint32_t extra_count = r.varint();
   if (!r.ok || extra_count > 64) return tl::unexpected(parse_error("bad extra attribute count"));
@@ -1083,6 +1338,7 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the final part"));
   exact_vertices_ = n;
+  normals_exact_ = n;
   complete_ = true;
   return {};
 }

@@ -18,14 +18,18 @@
 // geometry records and carry the exact values of every vertex inserted
 // since the previous one, coded on the decoder's mesh of that moment with
 // models that persist from one values record to the next; they are sized
-// like the geometry records (at most 1.5 % of the stream each). The last
+// like the geometry records (at most 1.5 % of the stream each). From
+// version 12 on they leave the normals out; normals records after the last
+// geometry record carry them, predicted on the complete mesh. The last
 // record carries the exact values of the vertices inserted after the last
 // values record (version 10: of every inserted vertex) and the extra
 // attributes (zstd). Until its values arrive the decoder shows each
-// inserted vertex with its prediction (from its neighbours at insertion),
+// inserted vertex with a preview (its decoded neighbours' mean; normals: the
+// geometric normal of its wedge on the mesh the decoder has),
 // so every prefix after record 1 has attributes. Values are predicted in
 // exact integers from what the decoder has (parallelograms over the
-// connectivity, neighbours; normals: the geometric normal of the wedge's
+// connectivity, neighbours; texture coordinates after record 1: from the
+// geometry as Draco's predictor; normals: the geometric normal of the wedge's
 // faces) and the residuals range-coded with adaptive models.
 #pragma once
 
@@ -49,6 +53,16 @@ namespace meshstream {
 inline constexpr uint8_t kAttributePartBase = 0;    // record 1
 inline constexpr uint8_t kAttributePartFinal = 1;   // the last record
 inline constexpr uint8_t kAttributePartValues = 2;  // after geometry records (version 11 on)
+// Version 12 on: values records without the normals (which a values record
+// would predict from the coarse stars the decoder has then), and normals
+// records after the last geometry record with the normals of the vertices
+// of those values records, predicted on the complete mesh.
+inline constexpr uint8_t kAttributePartValuesLateNormals = 3;
+inline constexpr uint8_t kAttributePartNormals = 4;
+inline bool is_values_part(uint8_t part) {
+  return part == kAttributePartValues || part == kAttributePartValuesLateNormals ||
+         part == kAttributePartNormals;
+}
 // A values record is closed at about this share of the expected stream
 // (the record-size rule: no record beyond the base above 2 % of it).
 inline constexpr double kValuesRecordShare = 0.015;
@@ -59,11 +73,19 @@ inline constexpr uint32_t kBoundaryKey = 0xFFFFFFFEu;
 enum class AttributeKind : uint8_t { kNormal = 1, kTexcoord = 2, kColor = 3, kMaterial = 4 };
 const char* attribute_kind_name(AttributeKind kind);
 
+// Prediction flags of a channel (the layout's per-channel byte, bit 0 of
+// which is "per corner"; version 12 on): record 1 predicts normals from the
+// decoded neighbours' normals, texture coordinates from the geometry; the
+// records after it predict texture coordinates from the geometry.
+inline constexpr uint8_t kPredictBaseAlternative = 2;
+inline constexpr uint8_t kPredictLaterFromGeometry = 4;
+
 struct AttributeChannel {
   AttributeKind kind = AttributeKind::kColor;
   bool per_corner = false;
   uint8_t bits = 8;  // quantization bits (normals: per octahedral coordinate); unused for materials
   TexcoordGrid uv;   // texture coordinates only
+  uint8_t flags = 0;  // kPredict* bits (last: the aggregate initializers above it)
   uint32_t components() const {
     return kind == AttributeKind::kColor ? 4 : kind == AttributeKind::kMaterial ? 1 : 2;
   }
@@ -160,12 +182,22 @@ class AttributeDecoder {
   Status read_base(std::span<const uint8_t> payload, const EditableMesh& base);
   // Predicted values for the vertices of `m` beyond those known.
   void preview(const EditableMesh& m);
+  // The previewed normals of vertices whose exact normals have not come
+  // (version 12's values records leave them to the end), recomputed as the
+  // geometric normal of their wedge on `m` where their star changed since
+  // the last call: the vertices inserted since, and their rings. Display
+  // only (nothing is predicted from previews); O(inserted x valence).
+  void refresh_normal_previews(const EditableMesh& m);
   // A values record, on the decoder's mesh now: the exact values of every
   // vertex inserted since the previous values (or record 1).
   Status read_values(std::span<const uint8_t> payload, const EditableMesh& m);
+  // A normals record (kAttributePartNormals), on the complete mesh: the
+  // exact normals of the next vertices whose values came without them.
+  Status read_normals(std::span<const uint8_t> payload, const EditableMesh& full);
   // Vertices whose exact values have come (the base's and the values
-  // records').
+  // records'; their normals may still be to come: normals_exact_vertices).
   uint32_t exact_vertices() const { return exact_vertices_; }
+  uint32_t normals_exact_vertices() const { return normals_exact_; }
   // The last record, on the complete mesh.
   Status read_final(std::span<const uint8_t> payload, const EditableMesh& full);
   // Writes every attribute array of `out` for `m` (whose vertices all have
@@ -190,6 +222,8 @@ class AttributeDecoder {
   AttributeValues values_;
   uint32_t base_vertices_ = 0;
   uint32_t exact_vertices_ = 0;
+  uint32_t normals_exact_ = 0;      // vertices whose normals are exact (<= exact_vertices_)
+  uint32_t normals_refreshed_ = 0;  // refresh_normal_previews saw the vertices below
   std::vector<AttributeChannelModels> values_models_;  // the values records', persistent
   std::vector<ExtraAttribute> extras_;
 };

@@ -137,10 +137,17 @@ struct IncrementalDecoder::State {
       if (geometry_records > 0)
         return make_error(ErrorCode::kParse, "base attribute record after a geometry record");
       if (auto s = attributes.read_base(payload, refine->mesh); !s) return s;
-    } else if (part == kAttributePartValues) {
+    } else if (part == kAttributePartValues || part == kAttributePartValuesLateNormals) {
       if (attributes_final)
         return make_error(ErrorCode::kParse, "attribute values record after the final one");
       if (auto s = attributes.read_values(payload, refine->mesh); !s) return s;
+    } else if (part == kAttributePartNormals) {
+      if (attributes_final)
+        return make_error(ErrorCode::kParse, "attribute normals record after the final one");
+      if (refine->mesh.vertex_count() != h.vertex_count ||
+          refine->mesh.face_slot_count() != h.face_count)
+        return make_error(ErrorCode::kParse, "normals record before the mesh is complete");
+      if (auto s = attributes.read_normals(payload, refine->mesh); !s) return s;
     } else {
       if (attributes_final) return make_error(ErrorCode::kParse, "a second final attribute record");
       if (refine->mesh.vertex_count() != h.vertex_count ||
@@ -151,6 +158,7 @@ struct IncrementalDecoder::State {
     }
     if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
       attributes.preview(refine->mesh);
+      attributes.refresh_normal_previews(refine->mesh);
       attributes.write_mesh(refine->mesh, mesh);
       known_attribute_vertices = refine->mesh.vertex_count();
     }
@@ -413,6 +421,7 @@ Result<Mesh> IncrementalDecoder::release_mesh() {
     out.textures = std::move(s.textures);
     // Attributes need the faces still in the decoder's table.
     s.attributes.preview(s.refine->mesh);
+    s.attributes.refresh_normal_previews(s.refine->mesh);
     s.attributes.write_mesh(s.refine->mesh, out);
     // The decoder only inserts, so every face slot is a live face.
     out.triangles = s.refine->mesh.release_faces();
