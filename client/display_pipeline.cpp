@@ -58,6 +58,35 @@ AsaOptions options_with_view(const PipelineSettings& settings,
   return options;
 }
 
+// The topology of the newest display mesh (held, so a pool cannot reuse
+// it while it is cached): a re-run that shows the same mesh (the complete
+// mesh without ASA, seen from a new camera) analyses it once.
+struct TopologyCache {
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const DisplayTopology> topology;
+};
+
+// View-dependent mode: the renderer gets the faces the frame's camera can
+// see (display_cull.h); else the display mesh itself. O(V + F) of the
+// display mesh.
+void cull_for_renderer(DisplayFrame& frame, bool cull, TopologyCache& cache) {
+  frame.drawn = frame.display;
+  frame.drawn_face_kind = frame.face_kind;
+  frame.cull = {};
+  frame.topology.reset();
+  if (!cull || !frame.camera || !frame.display) return;
+  if (cache.mesh != frame.display) {
+    cache.mesh = frame.display;
+    cache.topology = analyze_display_topology(*frame.display);
+  }
+  CulledDisplay culled =
+      cull_display(frame.display, frame.face_kind, *cache.topology, *frame.camera);
+  frame.drawn = std::move(culled.mesh);
+  frame.drawn_face_kind = std::move(culled.face_kind);
+  frame.cull = culled.region;
+  frame.topology = cache.topology;
+}
+
 // The options differ in more than the camera and tolerance.
 bool asa_settings_changed(const PipelineSettings& a, const PipelineSettings& b) {
   const AsaOptions &x = a.asa, &y = b.asa;
@@ -172,6 +201,7 @@ void DisplayPipeline::loop() {
   std::optional<PipelineSettings> used;  // the settings of the last build
   bool fresh_builder = false;            // the builder was replaced: its first build is a full one
   MeshViewFacts view_facts;              // of the newest decoded mesh (it holds it, as `last` does)
+  TopologyCache topology;                // of the newest display mesh
   while (decoded_.wait(seen_pokes, outcome_seen, std::chrono::milliseconds(200))) {
     const uint64_t pokes = decoded_.pokes();
     const bool rerun = pokes != seen_pokes;
@@ -334,6 +364,10 @@ void DisplayPipeline::loop() {
     frame.asa_ms = info.build.asa_ms;
     frame.pixel_tolerance = effective.asa_enabled ? info.build.pixel_tolerance : 0;
     frame.budget_limited = info.build.budget_limited;
+    // Runs with ASA hand the renderer what the camera sees (--no-asa and
+    // --view-independent draw the whole mesh, as before).
+    cull_for_renderer(
+        frame, settings.view.dependent && (settings.asa_enabled || settings.asa_guided), topology);
     info.elapsed_ms = elapsed();
     publish(frame, info);
     last = frame;
