@@ -62,6 +62,7 @@ std::string fmt(const char* f, double v) {
 }
 
 float g_tolerance = 2;  // --pixel-tolerance
+CullMargins g_margins;  // --cull-eye-share, --cull-angle
 
 AsaOptions view_options(const Mesh& mesh, const AsaCamera& camera) {
   AsaOptions o;  // the client's defaults: 1 level, t = 0.85, tolerance 2 px
@@ -153,8 +154,8 @@ PictureRow picture_row(const std::string& name, const Prefix& p, int width, int 
   row.vd_faces = b->mesh.face_count();
   auto display = std::make_shared<const Mesh>(std::move(b->mesh));
   t0 = Clock::now();
-  const auto topology = analyze_display_topology(*display);
-  const CulledDisplay culled = cull_display(display, nullptr, *topology, camera);
+  const auto topology = analyze_display_topology(*display, *analyze_source_topology(p.mesh));
+  const CulledDisplay culled = cull_display(display, nullptr, *topology, camera, 0, g_margins);
   row.cull_ms = ms_since(t0);
   row.drawn_faces = culled.mesh->face_count();
   if (row.with_pictures) {
@@ -284,6 +285,7 @@ OrbitStats orbit(const Mesh& mesh, int width, int height, int steps) {
   if (!builder.build(shared, none, true, o, true, report)) return out;
   none.full = false;
   const Vec3f offset = fit.eye - fit.target;
+  const auto source = analyze_source_topology(mesh);
   for (int s = 1; s <= steps; ++s) {
     const float a = 2.0f * static_cast<float>(s) * 3.14159265f / 180.0f;
     AsaOptions step = o;
@@ -300,9 +302,10 @@ OrbitStats orbit(const Mesh& mesh, int width, int height, int steps) {
     if (!display) continue;
     const auto t1 = Clock::now();
     const double c1 = thread_cpu_ms();
-    const auto topology = analyze_display_topology(*display->mesh);
+    // The source's topology is the pipeline's once per decoded mesh.
+    const auto topology = analyze_display_topology(*display->mesh, *source);
     const CulledDisplay culled =
-        cull_display(display->mesh, display->face_kind, *topology, step.view.camera);
+        cull_display(display->mesh, display->face_kind, *topology, step.view.camera, 0, g_margins);
     out.cull_ms.push_back(ms_since(t1));
     out.cull_cpu_ms.push_back(thread_cpu_ms() - c1);
     out.drawn_faces.push_back(culled.mesh->face_count());
@@ -330,6 +333,8 @@ int main(int argc, char** argv) {
     if (a == "--streams" && i + 1 < argc) streams = argv[++i];
     if (a == "--pixel-tolerance" && i + 1 < argc) g_tolerance = std::stof(argv[++i]);
     if (a == "--no-orbit") orbit_wanted = false;
+    if (a == "--cull-eye-share" && i + 1 < argc) g_margins.eye_share = std::stof(argv[++i]);
+    if (a == "--cull-angle" && i + 1 < argc) g_margins.angle_degrees = std::stof(argv[++i]);
     if (a == "--no-updates") updates_wanted = false;
   }
   std::vector<PictureRow> pictures, faces_rows;

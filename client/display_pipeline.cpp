@@ -58,33 +58,42 @@ AsaOptions options_with_view(const PipelineSettings& settings,
   return options;
 }
 
-// The topology of the newest display mesh (held, so a pool cannot reuse
-// it while it is cached): a re-run that shows the same mesh (the complete
-// mesh without ASA, seen from a new camera) analyses it once.
+// The topologies of the newest ASA input and display mesh (held, so a
+// pool cannot reuse them while they are cached): camera moves on an
+// unchanged decoded mesh analyse it once, and a re-run that shows the same
+// display (the complete mesh without ASA) reuses all of it.
 struct TopologyCache {
-  std::shared_ptr<const Mesh> mesh;
-  std::shared_ptr<const DisplayTopology> topology;
+  std::shared_ptr<const Mesh> source_mesh, display_mesh;
+  std::shared_ptr<const SourceTopology> source;
+  std::shared_ptr<const DisplayTopology> display;
 };
 
 // View-dependent mode: the renderer gets the faces the frame's camera can
-// see (display_cull.h); else the display mesh itself. O(V + F) of the
-// display mesh.
-void cull_for_renderer(DisplayFrame& frame, bool cull, TopologyCache& cache) {
+// see (display_cull.h); else the display mesh itself. `source`: the mesh
+// ASA refined (its vertices are the display's first ones). O(V + F) of the
+// display mesh, plus O(V + F) of the source when it changed.
+void cull_for_renderer(DisplayFrame& frame, const std::shared_ptr<const Mesh>& source, bool cull,
+                       TopologyCache& cache) {
   frame.drawn = frame.display;
   frame.drawn_face_kind = frame.face_kind;
   frame.cull = {};
   frame.topology.reset();
-  if (!cull || !frame.camera || !frame.display) return;
-  if (cache.mesh != frame.display) {
-    cache.mesh = frame.display;
-    cache.topology = analyze_display_topology(*frame.display);
+  if (!cull || !frame.camera || !frame.display || !source) return;
+  if (cache.source_mesh != source) {
+    cache.source_mesh = source;
+    cache.source = analyze_source_topology(*source);
+    cache.display_mesh.reset();
+  }
+  if (cache.display_mesh != frame.display) {
+    cache.display_mesh = frame.display;
+    cache.display = analyze_display_topology(*frame.display, *cache.source);
   }
   CulledDisplay culled =
-      cull_display(frame.display, frame.face_kind, *cache.topology, *frame.camera);
+      cull_display(frame.display, frame.face_kind, *cache.display, *frame.camera);
   frame.drawn = std::move(culled.mesh);
   frame.drawn_face_kind = std::move(culled.face_kind);
   frame.cull = culled.region;
-  frame.topology = cache.topology;
+  frame.topology = cache.display;
 }
 
 // The options differ in more than the camera and tolerance.
@@ -366,8 +375,9 @@ void DisplayPipeline::loop() {
     frame.budget_limited = info.build.budget_limited;
     // Runs with ASA hand the renderer what the camera sees (--no-asa and
     // --view-independent draw the whole mesh, as before).
-    cull_for_renderer(
-        frame, settings.view.dependent && (settings.asa_enabled || settings.asa_guided), topology);
+    cull_for_renderer(frame, effective.asa_enabled ? asa_input : frame.decoded,
+                      settings.view.dependent && (settings.asa_enabled || settings.asa_guided),
+                      topology);
     info.elapsed_ms = elapsed();
     publish(frame, info);
     last = frame;

@@ -14,19 +14,6 @@ constexpr float kDegrees = static_cast<float>(std::numbers::pi) / 180.0f;
 // the apex at infinity).
 constexpr float kMaxHalfAngle = 85.0f * kDegrees;
 
-uint64_t mix(uint64_t x) {  // splitmix64's finalizer
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-// A directed edge's term: the sum over a component is zero when every edge
-// is used as often a -> b as b -> a (a closed, consistently oriented surface).
-uint64_t directed(uint32_t a, uint32_t b) {
-  return mix((uint64_t(a) << 32) | b) - mix((uint64_t(b) << 32) | a);
-}
-
 uint32_t find(std::vector<uint32_t>& parent, uint32_t v) {
   while (parent[v] != v) {
     parent[v] = parent[parent[v]];
@@ -34,6 +21,19 @@ uint32_t find(std::vector<uint32_t>& parent, uint32_t v) {
   }
   return v;
 }
+
+double det(Vec3f a, Vec3f b, Vec3f c) {
+  return double(a.x) * (double(b.y) * c.z - double(b.z) * c.y) +
+         double(a.y) * (double(b.z) * c.x - double(b.x) * c.z) +
+         double(a.z) * (double(b.x) * c.y - double(b.y) * c.x);
+}
+
+void grow(BoundingBox& b, Vec3f p) {
+  b.min = {std::min(b.min.x, p.x), std::min(b.min.y, p.y), std::min(b.min.z, p.z)};
+  b.max = {std::max(b.max.x, p.x), std::max(b.max.y, p.y), std::max(b.max.z, p.z)};
+}
+
+constexpr BoundingBox kEmptyBox{{1e30f, 1e30f, 1e30f}, {-1e30f, -1e30f, -1e30f}};
 
 float distance_to_box(Vec3f p, const BoundingBox& b) {
   const float dx = std::max({b.min.x - p.x, 0.0f, p.x - b.max.x});
@@ -51,8 +51,9 @@ float corner_half_angle(const AsaCamera& c) {
 
 }  // namespace
 
-std::shared_ptr<const DisplayTopology> analyze_display_topology(const Mesh& mesh) {
-  auto topo = std::make_shared<DisplayTopology>();
+std::shared_ptr<const SourceTopology> analyze_source_topology(const Mesh& mesh) {
+  auto topo = std::make_shared<SourceTopology>();
+  constexpr uint32_t kNone = SourceTopology::kNone;
   const uint32_t V = mesh.vertex_count(), F = mesh.face_count();
   std::vector<uint32_t> parent(V);
   for (uint32_t v = 0; v < V; ++v) parent[v] = v;
@@ -63,52 +64,180 @@ std::shared_ptr<const DisplayTopology> analyze_display_topology(const Mesh& mesh
     }
   }
   // Components numbered by their smallest vertex.
-  std::vector<uint32_t> component(V, DisplayTopology::kOpen);
+  std::vector<uint32_t>& component = topo->vertex_component;
+  component.assign(V, kNone);
   uint32_t count = 0;
   for (uint32_t v = 0; v < V; ++v) {
     const uint32_t root = find(parent, v);
-    if (component[root] == DisplayTopology::kOpen) component[root] = count++;
+    if (component[root] == kNone) component[root] = count++;
     component[v] = component[root];
   }
-  struct Facts {
-    BoundingBox box{{1e30f, 1e30f, 1e30f}, {-1e30f, -1e30f, -1e30f}};
-    double volume = 0;
-    uint64_t balance = 0;
-  };
-  std::vector<Facts> facts(count);
-  for (uint32_t v = 0; v < V; ++v) {
-    BoundingBox& b = facts[component[v]].box;
-    const Vec3f p = mesh.positions[v];
-    b.min = {std::min(b.min.x, p.x), std::min(b.min.y, p.y), std::min(b.min.z, p.z)};
-    b.max = {std::max(b.max.x, p.x), std::max(b.max.y, p.y), std::max(b.max.z, p.z)};
-  }
+  std::vector<uint8_t> unusable(count, 0);
+  std::vector<double> volume(count, 0);
+  std::vector<BoundingBox> box(count, kEmptyBox);
+  for (uint32_t v = 0; v < V; ++v) grow(box[component[v]], mesh.positions[v]);
   const BoundingBox all = bounding_box(mesh);
   const Vec3f o = (all.min + all.max) * 0.5f;
-  topo->face_component.resize(F);
+  // The directed edges out of each vertex (counting sort by tail).
+  std::vector<uint32_t> first(V + 1, 0), head(3 * size_t(F));
+  for (const Triangle& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) ++first[t[k] + 1];
+  for (uint32_t v = 0; v < V; ++v) first[v + 1] += first[v];
+  {
+    std::vector<uint32_t> at(first.begin(), first.end() - 1);
+    for (const Triangle& t : mesh.triangles)
+      for (int k = 0; k < 3; ++k) head[at[t[k]]++] = t[(k + 1) % 3];
+  }
+  auto uses = [&](uint32_t a, uint32_t b) {
+    uint32_t n = 0;
+    for (uint32_t i = first[a]; i < first[a + 1]; ++i) n += head[i] == b;
+    return n;
+  };
   for (uint32_t f = 0; f < F; ++f) {
     const Triangle& t = mesh.triangles[f];
-    Facts& c = facts[component[t[0]]];
-    const Vec3f a = mesh.positions[t[0]] - o, b = mesh.positions[t[1]] - o,
-                d = mesh.positions[t[2]] - o;
-    c.volume += double(a.x) * (double(b.y) * d.z - double(b.z) * d.y) +
-                double(a.y) * (double(b.z) * d.x - double(b.x) * d.z) +
-                double(a.z) * (double(b.x) * d.y - double(b.y) * d.x);
-    c.balance += directed(t[0], t[1]) + directed(t[1], t[2]) + directed(t[2], t[0]);
-    topo->face_component[f] = component[t[0]];
+    volume[component[t[0]]] +=
+        det(mesh.positions[t[0]] - o, mesh.positions[t[1]] - o, mesh.positions[t[2]] - o);
   }
-  // Closed components get a dense index; the rest are open.
-  std::vector<uint32_t> closed_index(count, DisplayTopology::kOpen);
+  // Boundary edges (used once, never the other way): the next boundary
+  // vertex of each; anything else that is not used once each way makes the
+  // component unusable.
+  std::vector<uint32_t> next(V, kNone);
+  for (uint32_t a = 0; a < V; ++a) {
+    for (uint32_t i = first[a]; i < first[a + 1]; ++i) {
+      const uint32_t b = head[i];
+      const uint32_t forward = uses(a, b), backward = uses(b, a);
+      if (forward == 1 && backward == 0) {
+        if (next[a] != kNone) unusable[component[a]] = 1;  // two loops through a
+        next[a] = b;
+      } else if (forward != 1 || backward != 1) {
+        unusable[component[a]] = 1;
+      }
+    }
+  }
+  // Each loop: a ball around it, and the volume of its cap (a fan from its
+  // centroid, wound against the boundary edges so the capped surface closes).
+  struct LoopHole {
+    uint32_t component;
+    SourceTopology::Hole hole;
+  };
+  std::vector<LoopHole> loops;
+  std::vector<uint32_t> loop_vertices;
+  for (uint32_t start = 0; start < V; ++start) {
+    if (next[start] == kNone) continue;
+    loop_vertices.clear();
+    uint32_t v = start;
+    bool closed = false;
+    while (next[v] != kNone && loop_vertices.size() <= V) {
+      loop_vertices.push_back(v);
+      const uint32_t w = next[v];
+      next[v] = kNone;  // visited
+      v = w;
+      if (v == start) {
+        closed = true;
+        break;
+      }
+    }
+    const uint32_t c = component[start];
+    if (!closed) {
+      unusable[c] = 1;
+      continue;
+    }
+    Vec3f centre{0, 0, 0};
+    for (uint32_t u : loop_vertices) centre = centre + mesh.positions[u];
+    centre = centre / float(loop_vertices.size());
+    float radius = 0, longest = 0;
+    for (size_t i = 0; i < loop_vertices.size(); ++i) {
+      const Vec3f a = mesh.positions[loop_vertices[i]];
+      const Vec3f b = mesh.positions[loop_vertices[(i + 1) % loop_vertices.size()]];
+      radius = std::max(radius, length(a - centre));
+      longest = std::max(longest, length(b - a));
+      volume[c] += det(centre - o, b - o, a - o);
+    }
+    loops.push_back({c, {centre, radius + 2 * longest}});
+  }
+  std::stable_sort(loops.begin(), loops.end(),
+                   [](const LoopHole& a, const LoopHole& b) { return a.component < b.component; });
+  topo->components.resize(count);
   for (uint32_t c = 0; c < count; ++c) {
-    const Facts& x = facts[c];
-    const double diag = x.box.diagonal();
-    // A closed surface with (nearly) no volume, e.g. a sheet and its
+    const double diag = box[c].diagonal();
+    SourceTopology::Component& k = topo->components[c];
+    // A capped surface with (nearly) no volume, e.g. a sheet and its
     // reverse, has no inside that hides its back faces.
-    if (x.balance != 0 || !(std::fabs(x.volume) > 1e-6 * diag * diag * diag)) continue;
-    closed_index[c] = static_cast<uint32_t>(topo->closed.size());
-    topo->closed.push_back({x.box, x.volume < 0 ? -1.0f : 1.0f});
+    k.usable = !unusable[c] && std::fabs(volume[c]) > 1e-6 * diag * diag * diag;
+    k.sign = volume[c] < 0 ? -1.0f : 1.0f;
   }
-  for (uint32_t& c : topo->face_component) c = closed_index[c];
+  for (size_t i = 0; i < loops.size(); ++i) {
+    SourceTopology::Component& k = topo->components[loops[i].component];
+    if (k.holes == 0) k.first_hole = static_cast<uint32_t>(i);
+    ++k.holes;
+    topo->holes.push_back(loops[i].hole);
+  }
   return topo;
+}
+
+std::shared_ptr<const DisplayTopology> analyze_display_topology(const Mesh& mesh,
+                                                                const SourceTopology& source) {
+  auto topo = std::make_shared<DisplayTopology>();
+  constexpr uint32_t kNone = SourceTopology::kNone;
+  const uint32_t V = mesh.vertex_count(), F = mesh.face_count();
+  const uint32_t Vs = std::min<uint32_t>(V, uint32_t(source.vertex_component.size()));
+  // Old vertices keep their component; a new one takes that of a face it
+  // shares with a vertex that has one (one pass per ASA level).
+  std::vector<uint32_t> component(V, kNone);
+  std::copy(source.vertex_component.begin(), source.vertex_component.begin() + Vs,
+            component.begin());
+  std::vector<uint32_t>& face_component = topo->face_component;
+  face_component.assign(F, kNone);
+  for (int pass = 0; pass < 8; ++pass) {
+    bool missing = false, progress = false;
+    for (uint32_t f = 0; f < F; ++f) {
+      if (face_component[f] != kNone) continue;
+      const Triangle& t = mesh.triangles[f];
+      uint32_t c = kNone;
+      for (uint32_t v : t)
+        if (component[v] != kNone) c = component[v];
+      if (c == kNone) {
+        missing = true;
+        continue;
+      }
+      face_component[f] = c;
+      progress = true;
+      for (uint32_t v : t)
+        if (component[v] == kNone) component[v] = c;
+    }
+    if (!missing || !progress) break;
+  }
+  // Dense indices for the usable components; their boxes over the display.
+  std::vector<uint32_t> dense(source.components.size(), DisplayTopology::kOpen);
+  for (size_t c = 0; c < source.components.size(); ++c) {
+    const SourceTopology::Component& k = source.components[c];
+    if (!k.usable) continue;
+    dense[c] = static_cast<uint32_t>(topo->closed.size());
+    DisplayTopology::Component d;
+    d.box = kEmptyBox;
+    d.sign = k.sign;
+    d.first_hole = static_cast<uint32_t>(topo->holes.size());
+    d.holes = k.holes;
+    topo->holes.insert(topo->holes.end(), source.holes.begin() + k.first_hole,
+                       source.holes.begin() + k.first_hole + k.holes);
+    topo->closed.push_back(d);
+  }
+  for (uint32_t v = 0; v < V; ++v)
+    if (component[v] != kNone && dense[component[v]] != DisplayTopology::kOpen)
+      grow(topo->closed[dense[component[v]]].box, mesh.positions[v]);
+  for (uint32_t f = 0; f < F; ++f) {
+    const Triangle& t = mesh.triangles[f];
+    const uint32_t c = face_component[f];
+    // A face whose vertices disagree (not a display of this source) hides nothing.
+    const bool agree =
+        c != kNone && component[t[0]] == c && component[t[1]] == c && component[t[2]] == c;
+    face_component[f] = agree ? dense[c] : DisplayTopology::kOpen;
+  }
+  return topo;
+}
+
+std::shared_ptr<const DisplayTopology> analyze_display_topology(const Mesh& mesh) {
+  return analyze_display_topology(mesh, *analyze_source_topology(mesh));
 }
 
 CulledDisplay cull_display(const std::shared_ptr<const Mesh>& mesh_shared,
@@ -138,17 +267,113 @@ CulledDisplay cull_display(const std::shared_ptr<const Mesh>& mesh_shared,
   const Vec3f planes[4] = {axis * sin_h - right * cos_h, axis * sin_h + right * cos_h,
                            axis * sin_h - up * cos_h, axis * sin_h + up * cos_h};
 
-  // Which closed components hide their back faces from every valid eye.
+  // Which closed components hide their back faces from every valid eye,
+  // and the cone of lines from those eyes through each of their holes
+  // (apex the eye, tan of its half-angle (r + radius) / (distance - radius
+  // - r): a point seen through the hole from any eye within r lies inside).
+  struct HoleCone {
+    Vec3f axis;
+    float sin = 0, cos = 1;
+  };
+  std::vector<HoleCone> cones(topology.holes.size());
   std::vector<uint8_t> hides(topology.closed.size(), 0);
   float near_limit = 1e30f;
   for (size_t c = 0; c < topology.closed.size(); ++c) {
-    const float clear = (distance_to_box(eye, topology.closed[c].box) - r) * cos_h;
-    if (clear > 0 && clear > near_plane) {
-      hides[c] = 1;
-      near_limit = std::min(near_limit, clear);
+    const DisplayTopology::Component& k = topology.closed[c];
+    const float clear = (distance_to_box(eye, k.box) - r) * cos_h;
+    if (!(clear > 0 && clear > near_plane)) continue;
+    bool ok = true;
+    for (uint32_t h = k.first_hole; h < k.first_hole + k.holes; ++h) {
+      const SourceTopology::Hole& hole = topology.holes[h];
+      const Vec3f to = hole.centre - eye;
+      const float d = length(to), room = d - hole.radius - r;
+      if (!(room > 0)) {
+        ok = false;  // the eye may be in the hole
+        break;
+      }
+      const float t = (r + hole.radius) / room;
+      cones[h] = {to / d, t / std::sqrt(1 + t * t), 1 / std::sqrt(1 + t * t)};
+    }
+    if (!ok) continue;
+    hides[c] = 1;
+    near_limit = std::min(near_limit, clear);
+  }
+  // The hole cones drawn into a grid over the image plane at depth 1 (the
+  // eye's frame, the widened cone's square): a face whose footprint there
+  // touches a marked cell may be seen through a hole and stays. Each cone
+  // and footprint is drawn conservatively: an angle a at angle phi from the
+  // axis moves the image-plane point by at most a / cos^2(phi + a).
+  constexpr int kGrid = 512;
+  const float extent = std::tan(half);
+  const float cell = 2 * extent / kGrid;
+  std::vector<uint8_t> through;
+  auto image_point = [&](Vec3f rel, float& x, float& y, float& z) {
+    z = dot(rel, axis);
+    x = dot(rel, right) / z;
+    y = dot(rel, up) / z;
+  };
+  auto spread = [](float phi, float a) {
+    const float c = std::cos(std::min(phi + a, kMaxHalfAngle));
+    return a / (c * c);
+  };
+  for (size_t c = 0; c < topology.closed.size(); ++c) {
+    if (!hides[c]) continue;
+    const DisplayTopology::Component& k = topology.closed[c];
+    for (uint32_t h = k.first_hole; h < k.first_hole + k.holes; ++h) {
+      if (through.empty()) through.assign(size_t(kGrid) * kGrid, 0);
+      const HoleCone& cone = cones[h];
+      float x, y, z;
+      image_point(cone.axis, x, y, z);
+      const float phi = std::acos(std::clamp(z, -1.0f, 1.0f));
+      const float a = std::asin(std::clamp(cone.sin, 0.0f, 1.0f));
+      if (z <= 0 || phi + a >= kMaxHalfAngle) {
+        std::fill(through.begin(), through.end(), 1);  // a cone beside the view: keep all
+        continue;
+      }
+      const float reach = spread(phi, a) + cell;
+      const int x0 = std::max(0, int((x - reach + extent) / cell));
+      const int x1 = std::min(kGrid - 1, int((x + reach + extent) / cell));
+      const int y0 = std::max(0, int((y - reach + extent) / cell));
+      const int y1 = std::min(kGrid - 1, int((y + reach + extent) / cell));
+      for (int j = y0; j <= y1; ++j)
+        for (int i = x0; i <= x1; ++i) {
+          const float cx = -extent + (i + 0.5f) * cell - x, cy = -extent + (j + 0.5f) * cell - y;
+          if (cx * cx + cy * cy <= reach * reach) through[size_t(j) * kGrid + i] = 1;
+        }
     }
   }
-
+  auto through_a_hole = [&](const DisplayTopology::Component& k, Vec3f a, Vec3f b, Vec3f c) {
+    if (k.holes == 0) return false;
+    const Vec3f centre = (a + b + c) / 3.0f;
+    const float ball =
+        std::max({length(a - centre), length(b - centre), length(c - centre)}) * 1.0001f;
+    const Vec3f rel = centre - eye;
+    const float dist = length(rel);
+    if (!(dist > 2 * ball)) return true;
+    float x, y, z;
+    image_point(rel, x, y, z);
+    if (!(z > ball)) return true;
+    const float phi = std::acos(std::clamp(z / dist, -1.0f, 1.0f));
+    const float a_face = std::asin(ball / dist);
+    if (phi + a_face >= kMaxHalfAngle) return true;
+    const float reach = spread(phi, a_face);
+    const int x0 = int((x - reach + extent) / cell), x1 = int((x + reach + extent) / cell);
+    const int y0 = int((y - reach + extent) / cell), y1 = int((y + reach + extent) / cell);
+    if (x0 < 0 || y0 < 0 || x1 >= kGrid || y1 >= kGrid) return true;
+    bool marked = false;
+    for (int j = y0; j <= y1 && !marked; ++j)
+      for (int i = x0; i <= x1 && !marked; ++i) marked = through[size_t(j) * kGrid + i] != 0;
+    if (!marked) return false;
+    // Near a hole's cone: the distance to each cone's surface in the
+    // meridian plane (never more than the true distance).
+    for (uint32_t h = k.first_hole; h < k.first_hole + k.holes; ++h) {
+      const HoleCone& cone = cones[h];
+      const float along = dot(rel, cone.axis);
+      const float off = length(rel - cone.axis * along);
+      if (off * cone.cos - along * cone.sin <= ball) return true;
+    }
+    return false;
+  };
   std::vector<uint8_t> visible(F), mark(V, 0);
   uint32_t visible_count = 0;
   for (uint32_t f = 0; f < F; ++f) {
@@ -166,7 +391,8 @@ CulledDisplay cull_display(const std::shared_ptr<const Mesh>& mesh_shared,
     if (seen && comp != DisplayTopology::kOpen && hides[comp]) {
       const Vec3f normal = cross(b - a, c - a);
       const float side = topology.closed[comp].sign * dot(normal, eye - a);
-      if (side < 0 && side * side > r * r * dot(normal, normal)) {
+      if (side < 0 && side * side > r * r * dot(normal, normal) &&
+          !through_a_hole(topology.closed[comp], a, b, c)) {
         seen = false;
         ++out.back_culled;
       }

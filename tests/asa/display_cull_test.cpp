@@ -207,11 +207,11 @@ TEST(DisplayCull, TheRegionHoldsNearTheCameraAndNotFarFromIt) {
                                   offset.x * std::sin(a) + offset.z * std::cos(a)};
     return t;
   };
-  EXPECT_TRUE(cull_valid_for(c.cull.region, turned(2), 0));
+  EXPECT_TRUE(cull_valid_for(c.cull.region, turned(1), 0));
   EXPECT_FALSE(cull_valid_for(c.cull.region, turned(30), 0));
   EXPECT_FALSE(cull_valid_for(c.cull.region, camera, 1e6f)) << "a near plane cutting the model";
   // Every face a camera within the region sees from the front is kept.
-  const AsaCamera moved = turned(2);
+  const AsaCamera moved = turned(1);
   const std::vector<bool> kept = kept_faces(torus, *c.cull.mesh);
   for (uint32_t f = 0; f < torus.face_count(); ++f)
     if (in_view(torus, f, moved) && faces_eye(torus, f, moved.eye)) {
@@ -234,6 +234,42 @@ TEST(DisplayCull, AnOpenComponentBesideAClosedOneKeepsItsFaces) {
       EXPECT_TRUE(kept[f]) << "grid face " << f;
     }
   EXPECT_GT(c.cull.back_culled, 0u);
+}
+
+// A sphere with a hole around its +z pole, seen from +z: the far inside
+// (back faces) shows through the hole and stays; back faces that no line
+// through the hole reaches go.
+TEST(DisplayCull, BackFacesSeenThroughAHoleStay) {
+  const Mesh sphere = make_icosphere(4);
+  Mesh holed;
+  holed.positions = sphere.positions;
+  for (const Triangle& t : sphere.triangles) {
+    const Vec3f c =
+        (sphere.positions[t[0]] + sphere.positions[t[1]] + sphere.positions[t[2]]) / 3.0f;
+    if (c.z < 0.97f) holed.triangles.push_back(t);
+  }
+  ASSERT_LT(holed.face_count(), sphere.face_count());
+  AsaCamera above;
+  above.eye = {0, 0, 6};
+  above.target = {0, 0, 0};
+  above.fov_degrees = 30;
+  above.width = 400;
+  above.height = 400;
+  const Culled c = cull_of(holed, above);
+  EXPECT_GT(c.cull.back_culled, 0u) << "the holed sphere should still hide some back faces";
+  const std::vector<bool> kept = kept_faces(holed, *c.cull.mesh);
+  uint32_t far_inside = 0;
+  for (uint32_t f = 0; f < holed.face_count(); ++f) {
+    const Triangle& t = holed.triangles[f];
+    const Vec3f centre =
+        (holed.positions[t[0]] + holed.positions[t[1]] + holed.positions[t[2]]) / 3.0f;
+    // Straight below the hole (within its cone from the eye): seen.
+    if (centre.z < -0.9f && std::hypot(centre.x, centre.y) < 0.2f) {
+      ++far_inside;
+      EXPECT_TRUE(kept[f]) << "face " << f << " shows through the hole";
+    }
+  }
+  EXPECT_GT(far_inside, 0u);
 }
 
 }  // namespace
