@@ -60,13 +60,13 @@ AsaCamera turned(const AsaCamera& c, float degrees) {
 }
 
 TEST(DisplayCullPicture, ClosedModelsFromOutside) {
-  const Mesh demo = make_demo_mesh(8000);
-  const AsaCamera camera = fit_camera(demo, 320, 240);
+  const Mesh demo = make_demo_mesh(4000);
+  const AsaCamera camera = fit_camera(demo, 200, 150);
   EXPECT_GT(expect_same_picture(demo, camera, camera, "demo"), 0.25);
   EXPECT_GT(expect_same_picture(demo, camera, turned(camera, 1), "demo, turned 1 degree"), 0.25);
   auto bunny = import_mesh(testing::test_mesh("bunny.off"));  // closed scan
   ASSERT_TRUE(bunny);
-  const AsaCamera bc = fit_camera(bunny->mesh, 320, 240);
+  const AsaCamera bc = fit_camera(bunny->mesh, 200, 150);
   EXPECT_GT(expect_same_picture(bunny->mesh, bc, bc, "bunny.off"), 0.25);
 }
 
@@ -75,7 +75,7 @@ TEST(DisplayCullPicture, OpenSurfacesFromBehind) {
     auto m = import_mesh(testing::test_mesh(name));
     ASSERT_TRUE(m) << name;
     for (float degrees : {0.0f, 180.0f}) {
-      const AsaCamera camera = turned(fit_camera(m->mesh, 320, 240), degrees);
+      const AsaCamera camera = turned(fit_camera(m->mesh, 200, 150), degrees);
       expect_same_picture(m->mesh, camera, camera,
                           std::string(name) + " turned " + std::to_string(int(degrees)));
     }
@@ -96,15 +96,15 @@ TEST(DisplayCullPicture, ThroughAHole) {
     AsaCamera camera;
     camera.eye = eye;
     camera.target = {0, 0, 0};
-    camera.width = 320;
-    camera.height = 240;
+    camera.width = 200;
+    camera.height = 150;
     expect_same_picture(holed, camera, camera, "holed sphere");
   }
 }
 
 TEST(DisplayCullPicture, ZoomedIn) {
-  const Mesh demo = make_demo_mesh(8000);
-  AsaCamera camera = fit_camera(demo, 320, 240);
+  const Mesh demo = make_demo_mesh(4000);
+  AsaCamera camera = fit_camera(demo, 200, 150);
   camera.eye = camera.target + (camera.eye - camera.target) * 0.3f;
   camera.fov_degrees = 12;
   EXPECT_GT(expect_same_picture(demo, camera, camera, "demo zoomed in"), 0.5);
