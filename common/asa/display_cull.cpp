@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "common/base/parallel_blocks.h"
+
 namespace meshstream {
 namespace {
 
@@ -302,8 +304,10 @@ CulledDisplay cull_display(const std::shared_ptr<const Mesh>& mesh_shared,
   // eye's frame, the widened cone's square): a face whose footprint there
   // touches a marked cell may be seen through a hole and stays. Each cone
   // and footprint is drawn conservatively: an angle a at angle phi from the
-  // axis moves the image-plane point by at most a / cos^2(phi + a).
-  constexpr int kGrid = 512;
+  // axis moves the image-plane point by at most a / cos^2(phi + a). (An
+  // exact cone test per hole where a cell is marked trimmed 12 % more faces
+  // of dragon_res2, at a cost that grew with the holes.)
+  constexpr int kGrid = 1024;  // cells of about a tenth of a degree
   const float extent = std::tan(half);
   const float cell = 2 * extent / kGrid;
   std::vector<uint8_t> through;
@@ -345,63 +349,73 @@ CulledDisplay cull_display(const std::shared_ptr<const Mesh>& mesh_shared,
   auto through_a_hole = [&](const DisplayTopology::Component& k, Vec3f a, Vec3f b, Vec3f c) {
     if (k.holes == 0) return false;
     const Vec3f centre = (a + b + c) / 3.0f;
-    const float ball =
-        std::max({length(a - centre), length(b - centre), length(c - centre)}) * 1.0001f;
+    const float ball = std::sqrt(std::max({dot(a - centre, a - centre), dot(b - centre, b - centre),
+                                           dot(c - centre, c - centre)})) *
+                       1.0001f;
     const Vec3f rel = centre - eye;
     const float dist = length(rel);
     if (!(dist > 2 * ball)) return true;
     float x, y, z;
     image_point(rel, x, y, z);
     if (!(z > ball)) return true;
-    const float phi = std::acos(std::clamp(z / dist, -1.0f, 1.0f));
-    const float a_face = std::asin(ball / dist);
-    if (phi + a_face >= kMaxHalfAngle) return true;
-    const float reach = spread(phi, a_face);
+    // spread() without trigonometry: a <= tan a, and 1 / cos^2 = 1 + tan^2
+    // with tan(phi + a) from the image point's distance to the centre.
+    const float tan_a = ball / std::sqrt(dist * dist - ball * ball);
+    const float t = std::sqrt(x * x + y * y);
+    const float below = 1 - t * tan_a;
+    if (!(below > 0.05f)) return true;
+    const float tan_sum = (t + tan_a) / below;
+    const float reach = tan_a * (1 + tan_sum * tan_sum);
     const int x0 = int((x - reach + extent) / cell), x1 = int((x + reach + extent) / cell);
     const int y0 = int((y - reach + extent) / cell), y1 = int((y + reach + extent) / cell);
     if (x0 < 0 || y0 < 0 || x1 >= kGrid || y1 >= kGrid) return true;
-    bool marked = false;
-    for (int j = y0; j <= y1 && !marked; ++j)
-      for (int i = x0; i <= x1 && !marked; ++i) marked = through[size_t(j) * kGrid + i] != 0;
-    if (!marked) return false;
-    // Near a hole's cone: the distance to each cone's surface in the
-    // meridian plane (never more than the true distance).
-    for (uint32_t h = k.first_hole; h < k.first_hole + k.holes; ++h) {
-      const HoleCone& cone = cones[h];
-      const float along = dot(rel, cone.axis);
-      const float off = length(rel - cone.axis * along);
-      if (off * cone.cos - along * cone.sin <= ball) return true;
-    }
+    for (int j = y0; j <= y1; ++j)
+      for (int i = x0; i <= x1; ++i)
+        if (through[size_t(j) * kGrid + i]) return true;
     return false;
   };
+  // Which faces show: on both cores, in blocks that each write their own
+  // flags and counts (the result does not depend on the thread count).
   std::vector<uint8_t> visible(F), mark(V, 0);
+  constexpr uint32_t kBlock = 1u << 16;
+  const size_t blocks = (size_t(F) + kBlock - 1) / kBlock;
+  std::vector<uint32_t> frustum_out(blocks, 0), back_out(blocks, 0);
+  for_each_block(blocks, F >= 4 * kBlock ? 0 : 1, [&](size_t block) {
+    const uint32_t begin = uint32_t(block * kBlock), end = std::min(F, begin + kBlock);
+    for (uint32_t f = begin; f < end; ++f) {
+      const Triangle& t = mesh.triangles[f];
+      const Vec3f a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+      bool seen = true;
+      for (const Vec3f& n : planes) {
+        if (dot(n, a - apex) < 0 && dot(n, b - apex) < 0 && dot(n, c - apex) < 0) {
+          seen = false;
+          ++frustum_out[block];
+          break;
+        }
+      }
+      const uint32_t comp = topology.face_component[f];
+      if (seen && comp != DisplayTopology::kOpen && hides[comp]) {
+        const Vec3f normal = cross(b - a, c - a);
+        const float side = topology.closed[comp].sign * dot(normal, eye - a);
+        if (side < 0 && side * side > r * r * dot(normal, normal) &&
+            !through_a_hole(topology.closed[comp], a, b, c)) {
+          seen = false;
+          ++back_out[block];
+        }
+      }
+      visible[f] = seen;
+    }
+  });
   uint32_t visible_count = 0;
+  for (size_t block = 0; block < blocks; ++block) {
+    out.frustum_culled += frustum_out[block];
+    out.back_culled += back_out[block];
+  }
   for (uint32_t f = 0; f < F; ++f) {
+    if (!visible[f]) continue;
+    ++visible_count;
     const Triangle& t = mesh.triangles[f];
-    const Vec3f a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
-    bool seen = true;
-    for (const Vec3f& n : planes) {
-      if (dot(n, a - apex) < 0 && dot(n, b - apex) < 0 && dot(n, c - apex) < 0) {
-        seen = false;
-        ++out.frustum_culled;
-        break;
-      }
-    }
-    const uint32_t comp = topology.face_component[f];
-    if (seen && comp != DisplayTopology::kOpen && hides[comp]) {
-      const Vec3f normal = cross(b - a, c - a);
-      const float side = topology.closed[comp].sign * dot(normal, eye - a);
-      if (side < 0 && side * side > r * r * dot(normal, normal) &&
-          !through_a_hole(topology.closed[comp], a, b, c)) {
-        seen = false;
-        ++out.back_culled;
-      }
-    }
-    visible[f] = seen;
-    if (seen) {
-      ++visible_count;
-      mark[t[0]] = mark[t[1]] = mark[t[2]] = 1;
-    }
+    mark[t[0]] = mark[t[1]] = mark[t[2]] = 1;
   }
   out.visible_faces = visible_count;
   // The skirt: every face around a vertex of a visible face, so that vertex
