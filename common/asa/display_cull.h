@@ -41,8 +41,9 @@ struct CullMargins {
   // eye_radius = this x the camera's eye-target distance. Every hole's cone
   // widens with it (on the 107-hole dragon_res2, 0.1 kept 98 % of the
   // display, 0.03 82 %, 0.01 70 %), while the window culls again when its
-  // eye has moved this far (1.7 degrees of orbit at 0.03).
-  float eye_share = 0.03f;
+  // eye has moved this far (0.6 degrees of orbit at 0.01: an orbit of a
+  // degree or more a frame culls again each frame whatever this is).
+  float eye_share = 0.01f;
 };
 
 // Per component facts of a manifold source mesh (the decoded mesh ASA

@@ -207,11 +207,11 @@ TEST(DisplayCull, TheRegionHoldsNearTheCameraAndNotFarFromIt) {
                                   offset.x * std::sin(a) + offset.z * std::cos(a)};
     return t;
   };
-  EXPECT_TRUE(cull_valid_for(c.cull.region, turned(1), 0));
+  EXPECT_TRUE(cull_valid_for(c.cull.region, turned(0.4f), 0));
   EXPECT_FALSE(cull_valid_for(c.cull.region, turned(30), 0));
   EXPECT_FALSE(cull_valid_for(c.cull.region, camera, 1e6f)) << "a near plane cutting the model";
   // Every face a camera within the region sees from the front is kept.
-  const AsaCamera moved = turned(1);
+  const AsaCamera moved = turned(0.4f);
   const std::vector<bool> kept = kept_faces(torus, *c.cull.mesh);
   for (uint32_t f = 0; f < torus.face_count(); ++f)
     if (in_view(torus, f, moved) && faces_eye(torus, f, moved.eye)) {
