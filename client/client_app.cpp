@@ -204,6 +204,7 @@ class StreamingRun {
     settings.view.height = o.height;
     settings.view.pixel_tolerance = o.pixel_tolerance;
     settings.view.max_display_faces = o.max_display_faces;
+    settings.view.cull_for_renderer = o.view || !o.snapshot_png.empty();
     // Records that must each be shown (barriers, check_header) keep every
     // run of ASA; otherwise the final frame need not wait for a stale one.
     settings.drop_stale_asa_at_end = o.out_at.empty() && !o.snapshot_at && o.out_every == 0;

@@ -373,10 +373,11 @@ void DisplayPipeline::loop() {
     frame.asa_ms = info.build.asa_ms;
     frame.pixel_tolerance = effective.asa_enabled ? info.build.pixel_tolerance : 0;
     frame.budget_limited = info.build.budget_limited;
-    // Runs with ASA hand the renderer what the camera sees (--no-asa and
-    // --view-independent draw the whole mesh, as before).
+    // Runs with ASA and a renderer hand it what the camera sees (--no-asa
+    // and --view-independent draw the whole mesh, as before).
     cull_for_renderer(frame, effective.asa_enabled ? asa_input : frame.decoded,
-                      settings.view.dependent && (settings.asa_enabled || settings.asa_guided),
+                      settings.view.cull_for_renderer && settings.view.dependent &&
+                          (settings.asa_enabled || settings.asa_guided),
                       topology);
     info.elapsed_ms = elapsed();
     publish(frame, info);
