@@ -265,13 +265,26 @@ class ViewerLoop {
     uploaded_ = mesh;
     uploaded_cull_ = cull;
     panel_.distance_ready = false;
-    if (distances_.has_reference()) distances_.request(mesh, ++distance_tag_);
+    ++distance_tag_;  // the distances of what was on the GPU no longer fit
+    request_distances_if_shown();
+  }
+
+  // Distances to the final mesh are worth their O(V log F) only while the
+  // distance colouring shows them: a re-cull each frame of an orbit would
+  // otherwise keep the worker busy for nothing.
+  void request_distances_if_shown() {
+    if (!uploaded_ || !distances_.has_reference() || panel_.coloring != ColorMode::kDistance ||
+        requested_tag_ == distance_tag_)
+      return;
+    distances_.request(uploaded_, distance_tag_);
+    requested_tag_ = distance_tag_;
   }
 
   // 3. Before drawing: a culled mesh lacks faces this camera might see once
   // it has left the cull's region (the pipeline culled for the camera ASA
   // last ran with): cull the frame's whole display again for this one.
   void recull_if_needed(const FrameGeometry& g) {
+    request_distances_if_shown();  // the colouring may have just changed
     if (!has_shown_ || !shown_.topology || !shown_.display || g.fb_w <= 0 || g.fb_h <= 0) return;
     const AsaCamera camera = camera_.asa_camera(g.fb_w, g.fb_h);
     const float near_plane = camera_.near_plane();
@@ -295,7 +308,8 @@ class ViewerLoop {
       if (latest_.final && latest_.decoded && !distances_.has_reference()) {
         distances_.set_reference(latest_.decoded);
         if (has_shown_) {
-          distances_.request(uploaded_, ++distance_tag_);
+          ++distance_tag_;
+          request_distances_if_shown();
         }
       }
       if (panel_.history_index < 0) show(latest_);
@@ -574,7 +588,8 @@ class ViewerLoop {
   std::shared_ptr<const Mesh> uploaded_;  // the mesh on the GPU: shown_'s drawn or its re-cull
   CullRegion uploaded_cull_;
   bool has_shown_ = false, framed_once_ = false, want_frame_ = false;
-  uint64_t distance_tag_ = 0;  // identifies `shown_` for the distance worker
+  uint64_t distance_tag_ = 0;   // identifies `shown_` for the distance worker
+  uint64_t requested_tag_ = 0;  // the tag last asked of the worker
   int screenshot_counter_ = 0;
   RgbaImage last_model_image_;
   double last_x_ = 0, last_y_ = 0;
