@@ -204,6 +204,7 @@ class StreamingRun {
     settings.view.height = o.height;
     settings.view.pixel_tolerance = o.pixel_tolerance;
     settings.view.max_display_faces = o.max_display_faces;
+    settings.view.cull_for_renderer = o.view || !o.snapshot_png.empty();
     // Records that must each be shown (barriers, check_header) keep every
     // run of ASA; otherwise the final frame need not wait for a stale one.
     settings.drop_stale_asa_at_end = o.out_at.empty() && !o.snapshot_at && o.out_every == 0;
@@ -244,6 +245,13 @@ class StreamingRun {
     if (!file_error_) file_error_ = s.error();
   }
 
+  Status snapshot(const DisplayFrame& frame) const {
+    const Mesh& drawn = frame.drawn ? *frame.drawn : *frame.display;
+    const auto* kinds = frame.drawn ? frame.drawn_face_kind.get() : frame.face_kind.get();
+    return hooks_.snapshot(drawn, kinds, *frame.display, frame.camera ? &*frame.camera : nullptr,
+                           o_, o_.snapshot_png);
+  }
+
   // Pipeline thread, after each published frame: events and files.
   void on_frame(const DisplayFrame& frame, const FrameInfo& info) {
     if (!info.guidance_warning.empty()) log_.note("warning: " + info.guidance_warning);
@@ -257,8 +265,7 @@ class StreamingRun {
       if (!o_.out_dir.empty() && o_.saves_record(record))
         keep_error(write_mesh(*frame.display, record_file(o_, record)));
       if (o_.snapshot_at && !snapshot_done_ && record == *o_.snapshot_at && hooks_.snapshot) {
-        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),
-                                   frame.camera ? &*frame.camera : nullptr, o_, o_.snapshot_png));
+        keep_error(snapshot(frame));
         snapshot_done_ = true;
       }
     }
@@ -272,8 +279,7 @@ class StreamingRun {
           log_.note("warning: " + o_.out_file("final") + ": not stored: " + lost);
       }
       if (!o_.snapshot_png.empty() && !o_.snapshot_at && hooks_.snapshot) {
-        keep_error(hooks_.snapshot(*frame.display, frame.face_kind.get(),
-                                   frame.camera ? &*frame.camera : nullptr, o_, o_.snapshot_png));
+        keep_error(snapshot(frame));
         snapshot_done_ = true;
       }
     }
@@ -319,8 +325,11 @@ class StreamingRun {
       s.bytes = shown->bytes_received;
       s.vertices = shown->decoded->vertex_count();
       s.faces = shown->decoded->face_count();
-      s.display_vertices = shown->display->vertex_count();
-      s.display_faces = shown->display->face_count();
+      const Mesh& drawn = shown->drawn ? *shown->drawn : *shown->display;
+      s.display_vertices = drawn.vertex_count();
+      s.display_faces = drawn.face_count();
+      s.whole_display_vertices = shown->display->vertex_count();
+      s.whole_display_faces = shown->display->face_count();
     }
     return s;
   }

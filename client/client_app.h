@@ -17,10 +17,12 @@ namespace meshstream::client {
 struct ViewerHooks {
   // Runs the window on the calling (main) thread until it closes.
   std::function<Status(const ClientOptions&, LatestFrameMailbox&, StreamControls&)> run_view;
-  // Renders a display mesh to a PNG with the camera its display was made
-  // for (null: framed on the mesh itself).
-  std::function<Status(const Mesh&, const std::vector<FaceKind>*, const AsaCamera*,
-                       const ClientOptions&, const std::string& png)>
+  // Renders a display mesh (what the renderer is handed: the culled one in
+  // view-dependent mode) to a PNG with the camera its display was made for
+  // (null: framed on `whole`, the display mesh before the cull, which also
+  // sets the near and far planes).
+  std::function<Status(const Mesh& drawn, const std::vector<FaceKind>*, const Mesh& whole,
+                       const AsaCamera*, const ClientOptions&, const std::string& png)>
       snapshot;
 };
 

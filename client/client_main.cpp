@@ -25,13 +25,14 @@ int main(int argc, char** argv) {
     return run_viewer(v, frames, controls);
   };
   hooks.snapshot = [](const meshstream::Mesh& mesh, const std::vector<meshstream::FaceKind>* kinds,
-                      const meshstream::AsaCamera* camera, const ClientOptions& o,
-                      const std::string& png) {
+                      const meshstream::Mesh& whole, const meshstream::AsaCamera* camera,
+                      const ClientOptions& o, const std::string& png) {
     SnapshotOptions s;
     if (camera) s.camera = *camera;
     s.width = o.width;
     s.height = o.height;
     s.crease_degrees = o.asa.crease_degrees;
+    s.frame_on = &whole;
     return render_snapshot(mesh, kinds, s, png);
   };
   return run_client(options, hooks);

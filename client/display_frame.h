@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/asa/display_cull.h"
 #include "common/asa/subdivide.h"
 #include "common/mesh/mesh.h"
 
@@ -25,6 +26,15 @@ struct DisplayFrame {
   std::shared_ptr<const Mesh> decoded;                     // the decoder's mesh at this record
   std::shared_ptr<const Mesh> display;                     // after ASA (== decoded when ASA is off)
   std::shared_ptr<const std::vector<FaceKind>> face_kind;  // per display face; may be null
+  // What the renderer draws (view-dependent mode, display_cull.h): the
+  // display's faces the camera (within the cull's margins) can see, with
+  // a skirt; the display itself otherwise. --out files keep `display`.
+  std::shared_ptr<const Mesh> drawn;
+  std::shared_ptr<const std::vector<FaceKind>> drawn_face_kind;  // per drawn face; may be null
+  CullRegion cull;  // the cameras `drawn` is complete for
+  // Of `display`, for the viewer to cull again when its camera leaves
+  // `cull` (null: no culling, `drawn` is `display`).
+  std::shared_ptr<const DisplayTopology> topology;
   double decode_ms = 0;
   double asa_ms = 0;
   uint32_t coalesced_updates = 0;  // decoder updates merged into this frame

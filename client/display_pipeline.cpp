@@ -58,6 +58,44 @@ AsaOptions options_with_view(const PipelineSettings& settings,
   return options;
 }
 
+// The topologies of the newest ASA input and display mesh (held, so a
+// pool cannot reuse them while they are cached): camera moves on an
+// unchanged decoded mesh analyse it once, and a re-run that shows the same
+// display (the complete mesh without ASA) reuses all of it.
+struct TopologyCache {
+  std::shared_ptr<const Mesh> source_mesh, display_mesh;
+  std::shared_ptr<const SourceTopology> source;
+  std::shared_ptr<const DisplayTopology> display;
+};
+
+// View-dependent mode: the renderer gets the faces the frame's camera can
+// see (display_cull.h); else the display mesh itself. `source`: the mesh
+// ASA refined (its vertices are the display's first ones). O(V + F) of the
+// display mesh, plus O(V + F) of the source when it changed.
+void cull_for_renderer(DisplayFrame& frame, const std::shared_ptr<const Mesh>& source, bool cull,
+                       TopologyCache& cache) {
+  frame.drawn = frame.display;
+  frame.drawn_face_kind = frame.face_kind;
+  frame.cull = {};
+  frame.topology.reset();
+  if (!cull || !frame.camera || !frame.display || !source) return;
+  if (cache.source_mesh != source) {
+    cache.source_mesh = source;
+    cache.source = analyze_source_topology(*source);
+    cache.display_mesh.reset();
+  }
+  if (cache.display_mesh != frame.display) {
+    cache.display_mesh = frame.display;
+    cache.display = analyze_display_topology(*frame.display, *cache.source);
+  }
+  CulledDisplay culled =
+      cull_display(frame.display, frame.face_kind, *cache.display, *frame.camera);
+  frame.drawn = std::move(culled.mesh);
+  frame.drawn_face_kind = std::move(culled.face_kind);
+  frame.cull = culled.region;
+  frame.topology = cache.display;
+}
+
 // The options differ in more than the camera and tolerance.
 bool asa_settings_changed(const PipelineSettings& a, const PipelineSettings& b) {
   const AsaOptions &x = a.asa, &y = b.asa;
@@ -172,6 +210,7 @@ void DisplayPipeline::loop() {
   std::optional<PipelineSettings> used;  // the settings of the last build
   bool fresh_builder = false;            // the builder was replaced: its first build is a full one
   MeshViewFacts view_facts;              // of the newest decoded mesh (it holds it, as `last` does)
+  TopologyCache topology;                // of the newest display mesh
   while (decoded_.wait(seen_pokes, outcome_seen, std::chrono::milliseconds(200))) {
     const uint64_t pokes = decoded_.pokes();
     const bool rerun = pokes != seen_pokes;
@@ -334,6 +373,12 @@ void DisplayPipeline::loop() {
     frame.asa_ms = info.build.asa_ms;
     frame.pixel_tolerance = effective.asa_enabled ? info.build.pixel_tolerance : 0;
     frame.budget_limited = info.build.budget_limited;
+    // Runs with ASA and a renderer hand it what the camera sees (--no-asa
+    // and --view-independent draw the whole mesh, as before).
+    cull_for_renderer(frame, effective.asa_enabled ? asa_input : frame.decoded,
+                      settings.view.cull_for_renderer && settings.view.dependent &&
+                          (settings.asa_enabled || settings.asa_guided),
+                      topology);
     info.elapsed_ms = elapsed();
     publish(frame, info);
     last = frame;

@@ -79,6 +79,11 @@ void EventLog::record(const AppliedRecord& r, double elapsed_ms) {
   line(j.dump());
 }
 
+namespace {
+// What the renderer is handed (the culled display in view-dependent mode).
+const Mesh& drawn_of(const DisplayFrame& fr) { return fr.drawn ? *fr.drawn : *fr.display; }
+}  // namespace
+
 void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double elapsed_ms,
                           double rate) {
   std::lock_guard lock(mutex_);
@@ -88,8 +93,10 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
                      {"bytes", fr.bytes_received},
                      {"vertices", fr.decoded->vertex_count()},
                      {"faces", fr.decoded->face_count()},
-                     {"display_vertices", fr.display->vertex_count()},
-                     {"display_faces", fr.display->face_count()},
+                     {"display_vertices", drawn_of(fr).vertex_count()},
+                     {"display_faces", drawn_of(fr).face_count()},
+                     {"whole_display_vertices", fr.display->vertex_count()},
+                     {"whole_display_faces", fr.display->face_count()},
                      {"decode_ms", round3(fr.decode_ms)},
                      {"asa_ms", round3(fr.asa_ms)},
                      {"elapsed_ms", round3(elapsed_ms)},
@@ -117,8 +124,10 @@ void EventLog::view_update(const DisplayFrame& fr, const FrameInfo& info, double
   std::lock_guard lock(mutex_);
   if (!json_) return;
   nlohmann::json j{{"event", "view"},
-                   {"display_vertices", fr.display->vertex_count()},
-                   {"display_faces", fr.display->face_count()},
+                   {"display_vertices", drawn_of(fr).vertex_count()},
+                   {"display_faces", drawn_of(fr).face_count()},
+                   {"whole_display_vertices", fr.display->vertex_count()},
+                   {"whole_display_faces", fr.display->face_count()},
                    {"asa_ms", round3(fr.asa_ms)},
                    {"region_faces", info.build.region_faces},
                    {"asa_path", info.build.incremental ? "incremental" : "full"},
@@ -173,6 +182,8 @@ void EventLog::done(const DoneSummary& s) {
                      {"faces", s.faces},
                      {"display_vertices", s.display_vertices},
                      {"display_faces", s.display_faces},
+                     {"whole_display_vertices", s.whole_display_vertices},
+                     {"whole_display_faces", s.whole_display_faces},
                      {"elapsed_ms", round3(s.elapsed_ms)},
                      {"reconnects", s.reconnects},
                      {"display_updates", s.display_updates},

@@ -22,6 +22,7 @@ struct DoneSummary {
   uint32_t records = 0, records_total = 0;
   uint64_t bytes = 0, bytes_total = 0;
   uint32_t vertices = 0, faces = 0, display_vertices = 0, display_faces = 0;
+  uint32_t whole_display_vertices = 0, whole_display_faces = 0;  // display_* before the cull
   double elapsed_ms = 0;
   int reconnects = 0;
   uint32_t display_updates = 0;

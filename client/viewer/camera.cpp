@@ -66,9 +66,12 @@ Mat4 OrbitCamera::view() const { return mat4_look_at(eye(), target, Vec3f{0, 1, 
 Mat4 OrbitCamera::projection(float aspect) const {
   // Near and far planes hug the scene so depth precision stays useful at any
   // model scale.
-  float z_near = std::max(distance - 2 * scene_radius, distance * 0.01f);
   float z_far = distance + 2 * scene_radius;
-  return mat4_perspective(fovy, aspect, z_near, z_far);
+  return mat4_perspective(fovy, aspect, near_plane(), z_far);
+}
+
+float OrbitCamera::near_plane() const {
+  return std::max(distance - 2 * scene_radius, distance * 0.01f);
 }
 
 void OrbitCamera::look_from(const AsaCamera& c, const Mesh& mesh) {

@@ -40,6 +40,7 @@ class OrbitCamera {
   Vec3f eye() const;
   Mat4 view() const;
   Mat4 projection(float aspect) const;
+  float near_plane() const;  // the projection's near distance
 
   Vec3f target{0, 0, 0};
   float distance = 3;

@@ -73,7 +73,7 @@ Result<RgbaImage> render_offscreen(const Mesh& mesh, const OffscreenRequest& req
     camera.pitch = request.pitch;
     float aspect = static_cast<float>(request.width) / static_cast<float>(request.height);
     if (request.camera)
-      camera.look_from(*request.camera, mesh);
+      camera.look_from(*request.camera, request.frame_on ? *request.frame_on : mesh);
     else
       camera.frame(request.frame_on ? *request.frame_on : mesh, aspect, request.fill);
 

@@ -26,7 +26,9 @@ struct OffscreenRequest {
   int samples = 4;     // multisampling
   float fill = 0.85f;  // share of the smaller image side the model spans
   // When set, the camera frames this mesh instead of the one drawn, so that
-  // several meshes (a prefix, its ASA, the full model) share one camera.
+  // several meshes (a prefix, its ASA, the full model) share one camera; with
+  // `camera`, it sets the near and far planes (a culled mesh is drawn with
+  // the planes of the whole one, so its depths are the same).
   const Mesh* frame_on = nullptr;
   // Viewing direction (radians); the distance and target frame the model.
   float yaw = 0.6f;

@@ -16,6 +16,7 @@ Status render_snapshot(const Mesh& mesh, const std::vector<FaceKind>* face_kind,
   request.face_kind = face_kind;
   request.crease_degrees = options.crease_degrees;
   request.camera = options.camera;
+  request.frame_on = options.frame_on;
   auto image = render_offscreen(mesh, request);
   if (!image) return tl::unexpected(std::move(image.error()).with_context(png_path));
   return write_png(png_path, *image);

@@ -59,6 +59,9 @@ struct SnapshotOptions {
   // The camera to render with (the one the display was refined for); unset:
   // the whole model framed.
   std::optional<AsaCamera> camera;
+  // When set, the framing (without a camera) and the near and far planes
+  // come from this mesh (the whole display when `mesh` is its cull).
+  const Mesh* frame_on = nullptr;
 };
 
 // Renders `mesh` off-screen (OSMesa) with the viewer's renderer, framing the

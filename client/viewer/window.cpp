@@ -239,23 +239,60 @@ class ViewerLoop {
       ++report_.rejected_meshes;
       return;
     }
-    auto start = Clock::now();
-    // Shading follows the panel's crease angle (the ASA control), so the
-    // edges ASA keeps sharp are also drawn sharp.
-    renderer_.upload(*mesh, frame.face_kind.get(), panel_.asa.crease_degrees);
-    double ms = ms_since(start);
-    panel_.upload_ms = ms;
-    report_.max_upload_ms = std::max(report_.max_upload_ms, ms);
-    ++report_.meshes_uploaded;
+    // What the pipeline culled for its camera (view-dependent mode), else
+    // the display mesh.
+    upload(frame.drawn ? frame.drawn : mesh,
+           frame.drawn ? frame.drawn_face_kind.get() : frame.face_kind.get(), frame.cull);
     report_.last_sequence_shown = frame.sequence;
     shown_ = frame;
     has_shown_ = true;
-    panel_.distance_ready = false;
-    if (distances_.has_reference()) distances_.request(mesh, ++distance_tag_);
     if (!framed_once_) {
       want_frame_ = true;
       framed_once_ = true;
     }
+  }
+
+  void upload(const std::shared_ptr<const Mesh>& mesh, const std::vector<FaceKind>* kinds,
+              const CullRegion& cull) {
+    auto start = Clock::now();
+    // Shading follows the panel's crease angle (the ASA control), so the
+    // edges ASA keeps sharp are also drawn sharp.
+    renderer_.upload(*mesh, kinds, panel_.asa.crease_degrees);
+    double ms = ms_since(start);
+    panel_.upload_ms = ms;
+    report_.max_upload_ms = std::max(report_.max_upload_ms, ms);
+    ++report_.meshes_uploaded;
+    uploaded_ = mesh;
+    uploaded_cull_ = cull;
+    panel_.distance_ready = false;
+    ++distance_tag_;  // the distances of what was on the GPU no longer fit
+    request_distances_if_shown();
+  }
+
+  // Distances to the final mesh are worth their O(V log F) only while the
+  // distance colouring shows them: a re-cull each frame of an orbit would
+  // otherwise keep the worker busy for nothing.
+  void request_distances_if_shown() {
+    if (!uploaded_ || !distances_.has_reference() || panel_.coloring != ColorMode::kDistance ||
+        requested_tag_ == distance_tag_)
+      return;
+    distances_.request(uploaded_, distance_tag_);
+    requested_tag_ = distance_tag_;
+  }
+
+  // 3. Before drawing: a culled mesh lacks faces this camera might see once
+  // it has left the cull's region (the pipeline culled for the camera ASA
+  // last ran with): cull the frame's whole display again for this one.
+  void recull_if_needed(const FrameGeometry& g) {
+    request_distances_if_shown();  // the colouring may have just changed
+    if (!has_shown_ || !shown_.topology || !shown_.display || g.fb_w <= 0 || g.fb_h <= 0) return;
+    const AsaCamera camera = camera_.asa_camera(g.fb_w, g.fb_h);
+    const float near_plane = camera_.near_plane();
+    if (cull_valid_for(uploaded_cull_, camera, near_plane)) return;
+    const CulledDisplay culled =
+        cull_display(shown_.display, shown_.face_kind, *shown_.topology, camera, near_plane);
+    upload(culled.mesh, culled.face_kind.get(), culled.region);
+    ++report_.reculls;
   }
 
   // 1. New stream state: upload only when the sequence moved; distances to
@@ -271,7 +308,8 @@ class ViewerLoop {
       if (latest_.final && latest_.decoded && !distances_.has_reference()) {
         distances_.set_reference(latest_.decoded);
         if (has_shown_) {
-          distances_.request(shown_.display ? shown_.display : shown_.decoded, ++distance_tag_);
+          ++distance_tag_;
+          request_distances_if_shown();
         }
       }
       if (panel_.history_index < 0) show(latest_);
@@ -423,6 +461,7 @@ class ViewerLoop {
     style_.distance_max = panel_.distance_auto ? std::max(panel_.distance_p98, 1e-12f)
                                                : panel_.distance_max_percent / 100.0f *
                                                      std::max(panel_.reference_diagonal, 1e-12f);
+    recull_if_needed(g);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
     renderer_.draw(camera_, g.fb_w, g.fb_h, style_);
     const bool last_frame = (options_.exit_after_frames != 0 &&
@@ -544,10 +583,13 @@ class ViewerLoop {
   ViewerReport report_;
 
   uint64_t seen_ = 0;
-  DisplayFrame latest_;  // newest frame received (for the panel)
-  DisplayFrame shown_;   // frame whose mesh is on the GPU
+  DisplayFrame latest_;                   // newest frame received (for the panel)
+  DisplayFrame shown_;                    // frame whose mesh is on the GPU
+  std::shared_ptr<const Mesh> uploaded_;  // the mesh on the GPU: shown_'s drawn or its re-cull
+  CullRegion uploaded_cull_;
   bool has_shown_ = false, framed_once_ = false, want_frame_ = false;
-  uint64_t distance_tag_ = 0;  // identifies `shown_` for the distance worker
+  uint64_t distance_tag_ = 0;   // identifies `shown_` for the distance worker
+  uint64_t requested_tag_ = 0;  // the tag last asked of the worker
   int screenshot_counter_ = 0;
   RgbaImage last_model_image_;
   double last_x_ = 0, last_y_ = 0;
@@ -609,12 +651,13 @@ Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,
     std::fprintf(stderr,
                  "viewer: %llu frames (mean %.1f ms, longest %.1f ms of work), %llu without a "
                  "mesh once one was shown, %llu before the first; %llu cameras sent, %llu meshes "
-                 "uploaded (longest upload %.1f ms)\n",
+                 "uploaded (longest upload %.1f ms), %llu re-culls\n",
                  static_cast<unsigned long long>(report->frames_drawn), report->mean_frame_ms,
                  report->max_frame_ms, static_cast<unsigned long long>(report->frames_without_mesh),
                  static_cast<unsigned long long>(report->frames_before_first_mesh),
                  static_cast<unsigned long long>(report->cameras_sent),
-                 static_cast<unsigned long long>(report->meshes_uploaded), report->max_upload_ms);
+                 static_cast<unsigned long long>(report->meshes_uploaded), report->max_upload_ms,
+                 static_cast<unsigned long long>(report->reculls));
   }
   return {};
 }

@@ -165,7 +165,10 @@ TEST_F(ClientCliTest, CtrlCMidStreamEndsCleanlyWithDoneFinalPlyAndExit130) {
   ASSERT_TRUE(fs::exists(out / "o/final.ply"));
   const std::string expected = tool_decode(done["bytes"].get<uint64_t>(), "cancelled.ply");
   EXPECT_EQ(read_text(out / "o/final.decoded.ply"), read_text(expected));
-  EXPECT_EQ(load_ply(out / "o/final.ply").face_count(), done["display_faces"].get<uint32_t>());
+  // --out keeps the whole display; the renderer is handed what the camera sees.
+  EXPECT_EQ(load_ply(out / "o/final.ply").face_count(),
+            done["whole_display_faces"].get<uint32_t>());
+  EXPECT_LE(done["display_faces"].get<uint32_t>(), done["whole_display_faces"].get<uint32_t>());
 }
 
 // SIGTERM ends the same way (exit 143), and without --json the summary line
@@ -326,6 +329,8 @@ TEST_F(ClientCliTest, TheCompleteStreamIsShownAndSavedAsDecoded) {
   ASSERT_EQ(done["records"], done["records_total"]) << "the stream did not complete";
   const Mesh decoded = load_ply(out / "full/final.decoded.ply");
   EXPECT_TRUE(same_geometry(load_ply(out / "full/final.ply"), decoded));
+  EXPECT_EQ(done["whole_display_faces"].get<uint32_t>(), decoded.face_count());
+  // Nothing is drawn (no --view, no --snapshot): nothing is culled.
   EXPECT_EQ(done["display_faces"].get<uint32_t>(), decoded.face_count());
 
   // The default (--asa auto) follows the stream's guidance and names the
