@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/model_files.h"
 #include "bench/peers/draco_attribute_mesh.h"
 #include "common/codec/attribute_codec.h"
 #include "common/codec/container.h"
@@ -68,12 +69,8 @@ double median_ms(F&& f, int runs = 5) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The models folder: the argument, else ../models beside
-  // MESHSTREAM_TEST_MESHES (as the tests find them), else the shared one.
-  std::string dir = "/work/shared/models", out_path, report_dir;
-  if (const char* meshes = std::getenv("MESHSTREAM_TEST_MESHES"))
-    if (fs::exists(fs::path(meshes) / ".." / "models"))
-      dir = (fs::path(meshes) / ".." / "models").string();
+  // The models folder: the argument, else default_models_dir().
+  std::string dir = meshstream::bench::default_models_dir(), out_path, report_dir;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out" && i + 1 < argc)
@@ -84,13 +81,7 @@ int main(int argc, char** argv) {
       dir = a;
   }
   if (out_path.empty() && !report_dir.empty()) out_path = report_dir + "/attributes.md";
-  std::vector<fs::path> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    const std::string ext = e.path().extension().string();
-    if (ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".gltf")
-      files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = meshstream::bench::model_files(dir);
   std::string table =
       "| model | vertices | attributes | ours total | Draco total | ratio | ours geometry | Draco "
       "geometry | normals ours/Draco | uv ours/Draco | colors ours/Draco | seams | locked vertices "

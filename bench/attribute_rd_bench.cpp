@@ -53,6 +53,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/model_files.h"
 #include "bench/peers/draco_attribute_mesh.h"
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
@@ -276,12 +277,8 @@ std::string cells(const Point& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The models folder: the argument, else ../models beside
-  // MESHSTREAM_TEST_MESHES (as the tests find them), else the shared one.
-  std::string dir = "/work/shared/models", out_path, report_dir;
-  if (const char* meshes = std::getenv("MESHSTREAM_TEST_MESHES"))
-    if (fs::exists(fs::path(meshes) / ".." / "models"))
-      dir = (fs::path(meshes) / ".." / "models").string();
+  // The models folder: the argument, else default_models_dir().
+  std::string dir = meshstream::bench::default_models_dir(), out_path, report_dir;
   uint32_t samples = 20000;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -295,13 +292,7 @@ int main(int argc, char** argv) {
       dir = a;
   }
   if (out_path.empty() && !report_dir.empty()) out_path = report_dir + "/attributes_rd.md";
-  std::vector<fs::path> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    const std::string ext = e.path().extension().string();
-    if (ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".gltf")
-      files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<fs::path> files = meshstream::bench::model_files(dir);
   const std::vector<std::pair<std::string, double>> levels = {
       {"1/64", 1.0 / 64}, {"1/16", 1.0 / 16}, {"1/4", 1.0 / 4}, {"full", 1.0}};
   const std::string header =
