@@ -14,7 +14,10 @@
 //                 materials, a TANGENT extra attribute, one PNG texture);
 //   container3_v11_* the same cube at kEncoderVersion 11 (four values
 //                 records after geometry records): pinned so that a later
-//                 format keeps version-11 streams decoding.
+//                 format keeps version-11 streams decoding;
+//   container3_v12_* the same cube at kEncoderVersion 12 (normals leave the
+//                 values records for a normals record coded on the complete
+//                 mesh; UV predicted from the geometry).
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -140,7 +143,7 @@ uint64_t attribute_hash(const Mesh& m) {
 // and at once, to the mesh (attributes, materials and texture bytes
 // included) it decoded to when written.
 void expect_attributes_decode_as_when_written(const char* sample, uint64_t hash,
-                                              size_t values_records) {
+                                              size_t middle_records) {
   const std::vector<uint8_t> bytes = read_sample(sample);
   auto index = read_stream_index(bytes);
   ASSERT_TRUE(index) << index.error().message;
@@ -155,7 +158,7 @@ void expect_attributes_decode_as_when_written(const char* sample, uint64_t hash,
     attribute_records += !payload.empty() && payload[0] == kRecordAttributes;
   }
   ASSERT_TRUE(dec.finished());
-  EXPECT_EQ(attribute_records, values_records + 2) << "base, values records, final";
+  EXPECT_EQ(attribute_records, middle_records + 2) << "base, values (and normals) records, final";
   EXPECT_EQ(attribute_hash(dec.mesh()), hash)
       << "hash 0x" << std::hex << attribute_hash(dec.mesh());
   auto whole = decode_hcs(bytes);
@@ -176,6 +179,13 @@ TEST(LegacyStreams, VersionTenAttributesDecodeAsWhenWritten) {
 TEST(LegacyStreams, VersionElevenValuesRecordsDecodeAsWhenWritten) {
   expect_attributes_decode_as_when_written("container3_v11_faceted_cube_attributes.hcs",
                                            0x52ce8058599d568full, 4);
+}
+
+// Version 12: four values records without normals, then one normals record
+// coded on the complete mesh after the last geometry record.
+TEST(LegacyStreams, VersionTwelveNormalsRecordsDecodeAsWhenWritten) {
+  expect_attributes_decode_as_when_written("container3_v12_faceted_cube_attributes.hcs",
+                                           0x52ce8058599d568full, 5);
 }
 
 }  // namespace
