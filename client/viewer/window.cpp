@@ -239,10 +239,8 @@ class ViewerLoop {
       ++report_.rejected_meshes;
       return;
     }
-    // What the pipeline culled for its camera (view-dependent mode), else
-    // the display mesh.
-    upload(frame.drawn ? frame.drawn : mesh,
-           frame.drawn ? frame.drawn_face_kind.get() : frame.face_kind.get(), frame.cull);
+    // Uploaded before the next draw, culled or whole for that frame's camera
+    // (upload_for_camera).
     report_.last_sequence_shown = frame.sequence;
     shown_ = frame;
     has_shown_ = true;
@@ -252,8 +250,7 @@ class ViewerLoop {
     }
   }
 
-  void upload(const std::shared_ptr<const Mesh>& mesh, const std::vector<FaceKind>* kinds,
-              const CullRegion& cull) {
+  void upload(const std::shared_ptr<const Mesh>& mesh, const std::vector<FaceKind>* kinds) {
     auto start = Clock::now();
     // Shading follows the panel's crease angle (the ASA control), so the
     // edges ASA keeps sharp are also drawn sharp.
@@ -263,7 +260,6 @@ class ViewerLoop {
     report_.max_upload_ms = std::max(report_.max_upload_ms, ms);
     ++report_.meshes_uploaded;
     uploaded_ = mesh;
-    uploaded_cull_ = cull;
     panel_.distance_ready = false;
     ++distance_tag_;  // the distances of what was on the GPU no longer fit
     request_distances_if_shown();
@@ -280,19 +276,27 @@ class ViewerLoop {
     requested_tag_ = distance_tag_;
   }
 
-  // 3. Before drawing: a culled mesh lacks faces this camera might see once
-  // it has left the cull's region (the pipeline culled for the camera ASA
-  // last ran with): cull the frame's whole display again for this one.
-  void recull_if_needed(const FrameGeometry& g) {
+  // 3. Before drawing: what the pipeline culled for its camera (view-dependent
+  // mode) while this camera is within the cull's region, else the frame's
+  // whole display. A culled mesh lacks faces a camera outside that region
+  // might see; culling again here would cost O(V + F) on the render thread at
+  // every step of an orbit (hundreds of ms on a 3M-face display), so the
+  // window draws the whole display (the same picture) until the pipeline's
+  // next frame brings a cull for the camera it was sent.
+  void upload_for_camera(const FrameGeometry& g) {
     request_distances_if_shown();  // the colouring may have just changed
-    if (!has_shown_ || !shown_.topology || !shown_.display || g.fb_w <= 0 || g.fb_h <= 0) return;
-    const AsaCamera camera = camera_.asa_camera(g.fb_w, g.fb_h);
-    const float near_plane = camera_.near_plane();
-    if (cull_valid_for(uploaded_cull_, camera, near_plane)) return;
-    const CulledDisplay culled =
-        cull_display(shown_.display, shown_.face_kind, *shown_.topology, camera, near_plane);
-    upload(culled.mesh, culled.face_kind.get(), culled.region);
-    ++report_.reculls;
+    if (!has_shown_) return;
+    const std::shared_ptr<const Mesh>& whole = shown_.display ? shown_.display : shown_.decoded;
+    bool use_drawn = shown_.drawn != nullptr;
+    if (use_drawn && !shown_.cull.everything) {
+      use_drawn =
+          g.fb_w > 0 && g.fb_h > 0 &&
+          cull_valid_for(shown_.cull, camera_.asa_camera(g.fb_w, g.fb_h), camera_.near_plane());
+    }
+    const std::shared_ptr<const Mesh>& target = use_drawn ? shown_.drawn : whole;
+    if (!target || target == uploaded_) return;
+    if (!use_drawn && shown_.drawn && shown_.drawn != whole) ++report_.whole_display_uploads;
+    upload(target, use_drawn ? shown_.drawn_face_kind.get() : shown_.face_kind.get());
   }
 
   // 1. New stream state: upload only when the sequence moved; distances to
@@ -461,7 +465,7 @@ class ViewerLoop {
     style_.distance_max = panel_.distance_auto ? std::max(panel_.distance_p98, 1e-12f)
                                                : panel_.distance_max_percent / 100.0f *
                                                      std::max(panel_.reference_diagonal, 1e-12f);
-    recull_if_needed(g);
+    upload_for_camera(g);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
     renderer_.draw(camera_, g.fb_w, g.fb_h, style_);
     const bool last_frame = (options_.exit_after_frames != 0 &&
@@ -583,10 +587,10 @@ class ViewerLoop {
   ViewerReport report_;
 
   uint64_t seen_ = 0;
-  DisplayFrame latest_;                   // newest frame received (for the panel)
-  DisplayFrame shown_;                    // frame whose mesh is on the GPU
-  std::shared_ptr<const Mesh> uploaded_;  // the mesh on the GPU: shown_'s drawn or its re-cull
-  CullRegion uploaded_cull_;
+  DisplayFrame latest_;  // newest frame received (for the panel)
+  DisplayFrame shown_;   // frame whose mesh is on the GPU
+  std::shared_ptr<const Mesh>
+      uploaded_;  // the mesh on the GPU: shown_'s drawn or its whole display
   bool has_shown_ = false, framed_once_ = false, want_frame_ = false;
   uint64_t distance_tag_ = 0;   // identifies `shown_` for the distance worker
   uint64_t requested_tag_ = 0;  // the tag last asked of the worker
@@ -648,16 +652,17 @@ Status run_viewer(const ViewerOptions& given, LatestFrameMailbox& frames,
   if (options.orbit_degrees_per_frame != 0) {
     // The scripted orbit is a benchmark (bench/REPORT.md, view-dependent
     // ASA): say whether the window ever lacked a mesh and how long frames took.
-    std::fprintf(stderr,
-                 "viewer: %llu frames (mean %.1f ms, longest %.1f ms of work), %llu without a "
-                 "mesh once one was shown, %llu before the first; %llu cameras sent, %llu meshes "
-                 "uploaded (longest upload %.1f ms), %llu re-culls\n",
-                 static_cast<unsigned long long>(report->frames_drawn), report->mean_frame_ms,
-                 report->max_frame_ms, static_cast<unsigned long long>(report->frames_without_mesh),
-                 static_cast<unsigned long long>(report->frames_before_first_mesh),
-                 static_cast<unsigned long long>(report->cameras_sent),
-                 static_cast<unsigned long long>(report->meshes_uploaded), report->max_upload_ms,
-                 static_cast<unsigned long long>(report->reculls));
+    std::fprintf(
+        stderr,
+        "viewer: %llu frames (mean %.1f ms, longest %.1f ms of work), %llu without a "
+        "mesh once one was shown, %llu before the first; %llu cameras sent, %llu meshes "
+        "uploaded (longest upload %.1f ms), %llu whole displays for a camera outside the cull\n",
+        static_cast<unsigned long long>(report->frames_drawn), report->mean_frame_ms,
+        report->max_frame_ms, static_cast<unsigned long long>(report->frames_without_mesh),
+        static_cast<unsigned long long>(report->frames_before_first_mesh),
+        static_cast<unsigned long long>(report->cameras_sent),
+        static_cast<unsigned long long>(report->meshes_uploaded), report->max_upload_ms,
+        static_cast<unsigned long long>(report->whole_display_uploads));
   }
   return {};
 }

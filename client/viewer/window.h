@@ -40,7 +40,8 @@ struct ViewerReport {
   uint64_t distance_uploads = 0;     // per-vertex distances to the final mesh shown
   uint64_t rejected_meshes = 0;      // frames whose mesh failed validate_arrays
   uint64_t cameras_sent = 0;         // camera moves handed to view-dependent ASA
-  uint64_t reculls = 0;  // the camera left the shown cull's region: culled again before drawing
+  // The camera left the shown cull's region: the whole display was uploaded.
+  uint64_t whole_display_uploads = 0;
   // Frames drawn once a mesh had been shown but with none on the GPU (the
   // renderer keeps the last upload, so a re-run of ASA never blanks the
   // window), and frames drawn before the first mesh arrived.
