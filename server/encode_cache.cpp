@@ -92,8 +92,12 @@ EncodeOutcome encode_cached(const EncodeJob& job, const std::string& cache_dir,
 Result<bool> prepare_cache_folder(const std::string& dir, bool create_parents) {
   std::error_code ec;
   const fs::path path(dir);
-  if (fs::is_directory(path, ec)) return false;
-  if (fs::exists(path, ec)) {
+  // One look at the path: servers started together race to create the
+  // folder, and asking "a folder?" then "exists?" sees it appear between
+  // the two questions.
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::is_directory(status)) return false;
+  if (fs::exists(status)) {
     return make_error(ErrorCode::kInvalidArgument, dir + " exists and is not a folder");
   }
   // "x/" names the folder x: its parent is that of x.
