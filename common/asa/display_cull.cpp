@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "common/base/parallel_blocks.h"
+#include "common/mesh/union_find.h"
 
 namespace meshstream {
 namespace {
@@ -15,14 +16,6 @@ constexpr float kDegrees = static_cast<float>(std::numbers::pi) / 180.0f;
 // The widened cone stays a cone (a half-angle near 90 degrees would put
 // the apex at infinity).
 constexpr float kMaxHalfAngle = 85.0f * kDegrees;
-
-uint32_t find(std::vector<uint32_t>& parent, uint32_t v) {
-  while (parent[v] != v) {
-    parent[v] = parent[parent[v]];
-    v = parent[v];
-  }
-  return v;
-}
 
 double det(Vec3f a, Vec3f b, Vec3f c) {
   return double(a.x) * (double(b.y) * c.z - double(b.z) * c.y) +
@@ -57,20 +50,17 @@ std::shared_ptr<const SourceTopology> analyze_source_topology(const Mesh& mesh) 
   auto topo = std::make_shared<SourceTopology>();
   constexpr uint32_t kNone = SourceTopology::kNone;
   const uint32_t V = mesh.vertex_count(), F = mesh.face_count();
-  std::vector<uint32_t> parent(V);
-  for (uint32_t v = 0; v < V; ++v) parent[v] = v;
+  UnionFind sets(V);
   for (const Triangle& t : mesh.triangles) {
-    for (int k = 1; k < 3; ++k) {
-      const uint32_t a = find(parent, t[0]), b = find(parent, t[k]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+    sets.unite(t[0], t[1]);
+    sets.unite(t[0], t[2]);
   }
   // Components numbered by their smallest vertex.
   std::vector<uint32_t>& component = topo->vertex_component;
   component.assign(V, kNone);
   uint32_t count = 0;
   for (uint32_t v = 0; v < V; ++v) {
-    const uint32_t root = find(parent, v);
+    const uint32_t root = sets.find(v);
     if (component[root] == kNone) component[root] = count++;
     component[v] = component[root];
   }
