@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "common/base/parallel_blocks.h"
+#include "common/mesh/corner_data.h"
 #include "common/mesh/union_find.h"
 
 namespace meshstream {
@@ -454,34 +455,9 @@ CulledDisplay cull_display(const std::shared_ptr<const Mesh>& mesh_shared,
     const Triangle& t = mesh.triangles[f];
     m.triangles.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
   }
-  auto corners = [&](const auto& from, auto& to) {
-    if (from.empty()) return;
-    to.values = from.values;
-    to.corners.reserve(3 * kept.size());
-    for (uint32_t f : kept)
-      for (int k = 0; k < 3; ++k) to.corners.push_back(from.corners[3 * size_t(f) + k]);
-  };
-  corners(mesh.corner_normals, m.corner_normals);
-  corners(mesh.corner_colors, m.corner_colors);
-  corners(mesh.corner_texcoords, m.corner_texcoords);
   m.materials = mesh.materials;
   m.textures = mesh.textures;
-  if (mesh.face_materials.size() == F) {
-    m.face_materials.reserve(kept.size());
-    for (uint32_t f : kept) m.face_materials.push_back(mesh.face_materials[f]);
-  }
-  for (const ExtraAttribute& extra : mesh.extra_attributes) {
-    ExtraAttribute e = extra;
-    const size_t per_face = extra.bytes.size() / std::max<size_t>(F, 1);
-    e.bytes.clear();
-    if (per_face * F == extra.bytes.size()) {
-      e.bytes.reserve(per_face * kept.size());
-      for (uint32_t f : kept)
-        e.bytes.insert(e.bytes.end(), extra.bytes.begin() + per_face * f,
-                       extra.bytes.begin() + per_face * (f + 1));
-    }
-    m.extra_attributes.push_back(std::move(e));
-  }
+  copy_face_data(mesh, kept, m);
   if (face_kind && face_kind->size() == F) {
     auto kinds = std::make_shared<std::vector<FaceKind>>();
     kinds->reserve(kept.size());

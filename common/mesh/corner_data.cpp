@@ -36,6 +36,17 @@ void keep_extra(ExtraAttribute& extra, const std::vector<uint8_t>& keep) {
 }
 
 template <typename T>
+void copy_corners(const CornerAttribute<T>& from, const std::vector<uint32_t>& faces,
+                  CornerAttribute<T>& to) {
+  to = {};
+  if (from.empty()) return;
+  to.values = from.values;
+  to.corners.reserve(3 * faces.size());
+  for (uint32_t f : faces)
+    for (size_t k = 0; k < 3; ++k) to.corners.push_back(from.corners[3 * size_t(f) + k]);
+}
+
+template <typename T>
 void swap_corners(CornerAttribute<T>& attribute, uint32_t f) {
   if (!attribute.empty()) std::swap(attribute.corners[3 * f + 1], attribute.corners[3 * f + 2]);
 }
@@ -57,6 +68,30 @@ void keep_faces(Mesh& mesh, const std::vector<uint8_t>& keep) {
   }
   mesh.triangles.resize(out);
   if (materials) mesh.face_materials.resize(out);
+}
+
+void copy_face_data(const Mesh& from, const std::vector<uint32_t>& faces, Mesh& to) {
+  copy_corners(from.corner_normals, faces, to.corner_normals);
+  copy_corners(from.corner_colors, faces, to.corner_colors);
+  copy_corners(from.corner_texcoords, faces, to.corner_texcoords);
+  to.face_materials.clear();
+  if (from.face_materials.size() == from.triangles.size()) {
+    to.face_materials.reserve(faces.size());
+    for (uint32_t f : faces) to.face_materials.push_back(from.face_materials[f]);
+  }
+  to.extra_attributes.clear();
+  for (const ExtraAttribute& extra : from.extra_attributes) {
+    ExtraAttribute e = extra;
+    e.bytes.clear();
+    const size_t face_bytes = 3 * element_size(extra);
+    if (extra.bytes.size() == from.triangles.size() * face_bytes) {
+      e.bytes.reserve(faces.size() * face_bytes);
+      for (uint32_t f : faces)
+        e.bytes.insert(e.bytes.end(), extra.bytes.begin() + face_bytes * f,
+                       extra.bytes.begin() + face_bytes * (f + 1));
+    }
+    to.extra_attributes.push_back(std::move(e));
+  }
 }
 
 void reverse_face(Mesh& mesh, uint32_t f) {

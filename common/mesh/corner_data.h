@@ -19,6 +19,14 @@ namespace meshstream {
 // compact_corner_values). O(F).
 void keep_faces(Mesh& mesh, const std::vector<uint8_t>& keep);
 
+// Copies the per-corner and per-face data of `faces` of `from` (corner
+// attributes, extra attributes, face materials), in that order, into `to`,
+// replacing its own: `to` is a mesh made of those faces (its triangles are
+// the caller's, as their vertices may be renumbered). Values of corner
+// attributes are copied whole; an extra attribute of the wrong size comes
+// out empty. O(faces).
+void copy_face_data(const Mesh& from, const std::vector<uint32_t>& faces, Mesh& to);
+
 // Reverses face f's orientation by swapping its corners 1 and 2, with
 // everything stored per corner (so a flipped face keeps its seams). O(1).
 void reverse_face(Mesh& mesh, uint32_t f);

@@ -495,5 +495,49 @@ TEST(GltfExport, KhronosValidatorFindsNoErrors) {
     GTEST_SKIP() << "procedural meshes validated; test models not found (MESHSTREAM_TEST_MODELS)";
 }
 
+// copy_face_data: the corner, extra and material data of the chosen faces,
+// in their order, as keep_faces would keep them in place.
+TEST(CornerData, CopyFaceDataTakesTheChosenFacesDataInOrder) {
+  Mesh from = make_icosphere(1);
+  const uint32_t F = from.face_count();
+  from.corner_texcoords.values = {{0, 0}, {1, 0}, {0, 1}};
+  from.face_materials.resize(F);
+  ExtraAttribute extra;
+  extra.name = "_FACE";
+  extra.component_type = ExtraAttribute::ComponentType::kUint8;
+  ExtraAttribute wrong = extra;
+  wrong.name = "_SHORT";
+  wrong.bytes = {1, 2, 3};
+  for (uint32_t f = 0; f < F; ++f) {
+    for (uint32_t k = 0; k < 3; ++k) {
+      from.corner_texcoords.corners.push_back((f + k) % 3);
+      extra.bytes.push_back(uint8_t(3 * f + k));
+    }
+    from.face_materials[f] = f % 4;
+  }
+  from.materials.resize(4);
+  from.extra_attributes = {extra, wrong};
+  const std::vector<uint32_t> faces = {7, 2, 19};
+  Mesh to;
+  to.corner_normals.values = {{0, 0, 1}};  // replaced: `from` has none
+  to.corner_normals.corners = {0, 0, 0};
+  copy_face_data(from, faces, to);
+  EXPECT_TRUE(to.corner_normals.empty());
+  EXPECT_EQ(to.corner_texcoords.values.size(), 3u);
+  ASSERT_EQ(to.corner_texcoords.corners.size(), 9u);
+  ASSERT_EQ(to.face_materials.size(), 3u);
+  ASSERT_EQ(to.extra_attributes.size(), 2u);
+  ASSERT_EQ(to.extra_attributes[0].bytes.size(), 9u);
+  for (size_t i = 0; i < faces.size(); ++i) {
+    EXPECT_EQ(to.face_materials[i], faces[i] % 4);
+    for (uint32_t k = 0; k < 3; ++k) {
+      EXPECT_EQ(to.corner_texcoords.corners[3 * i + k], (faces[i] + k) % 3);
+      EXPECT_EQ(to.extra_attributes[0].bytes[3 * i + k], uint8_t(3 * faces[i] + k));
+    }
+  }
+  EXPECT_EQ(to.extra_attributes[1].name, "_SHORT");
+  EXPECT_TRUE(to.extra_attributes[1].bytes.empty()) << "an extra of the wrong size comes out empty";
+}
+
 }  // namespace
 }  // namespace meshstream
