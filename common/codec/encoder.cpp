@@ -410,7 +410,7 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   dopt.target_vertices = options.target_base_vertices;
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
-  dopt.locked = plan->locked;
+  if (!options.measure_unlocked_seams) dopt.locked = plan->locked;
   if (options.locality_cell_vertices > 0) {
     dopt.layer_locks = [levels = CellLevels(options.locality_cell_vertices,
                                             unlocked_for_share(static_cast<uint32_t>(q.size()),
@@ -454,7 +454,9 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
       measuring && options.threads != 1 && std::thread::hardware_concurrency() > 1;
   // The chosen geometry stream with the attribute and texture records added.
   auto finish = [&](EncodedStream& stream) -> Result<std::vector<uint8_t>> {
-    auto out = with_attributes(*plan, mesh, q, stream, report);
+    auto out = options.measure_unlocked_seams
+                   ? Result<std::vector<uint8_t>>(std::move(stream.bytes))
+                   : with_attributes(*plan, mesh, q, stream, report);
     if (report) report->warnings = encode_warnings(mesh);
     if (!out) return out;
     // Textures go in after: the record order and sizes above are the geometry's.

@@ -110,6 +110,13 @@ struct EncodeOptions {
   // the vertices (0..1, else kInvalidArgument) lock nothing (CellLevels);
   // 0 = cells down to the coarsest level.
   double locality_unlocked_share = 0;
+  // Measurement only (issue 18, bench/REPORT.md "Seams: locking against an
+  // uncoded seam pattern"): true decimates as if there were no seams (seam
+  // vertices not locked) and writes the geometry records alone, without
+  // attribute records: this stream cannot carry the seams, it only bounds
+  // what coding a re-triangulated patch's seam pattern could save. false
+  // (the default) leaves the stream unchanged.
+  bool measure_unlocked_seams = false;
 };
 
 // The record orderings the automatic choice tries (EncodeOptions): each
