@@ -31,6 +31,10 @@ struct Box {
     }
   }
   void grow(const Box& b) {
+    // An empty box (an empty SAH bin) is inverted: growing by its corners
+    // would span everything, every split cost would be inf or NaN and the
+    // build would fall back to median splits without a word.
+    if (!b.valid()) return;
     grow(b.lo);
     grow(b.hi);
   }

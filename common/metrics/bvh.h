@@ -69,6 +69,9 @@ class TriangleBvh {
     uint32_t first = 0;  // leaf: first slot in triangles_; inner: right child
     uint32_t count = 0;  // leaf: number of triangles; inner: 0
   };
+  // The nodes in depth-first order (the root first, a node's left child
+  // next): for inspecting the tree's shape.
+  const std::vector<Node>& nodes() const { return nodes_; }
 
  private:
   // The corners as the mesh holds them (floats, which doubles represent

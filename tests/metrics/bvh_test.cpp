@@ -116,6 +116,33 @@ TEST(TriangleBvh, DepthStaysBoundedWhenEveryCentroidCoincides) {
   expect_matches_brute_force(m, queries);
 }
 
+// Two clusters far apart, 4 and 28 small triangles: the SAH cuts at the gap,
+// so the root's left child is one leaf holding exactly the small cluster.
+// (Empty bins in between once made every split cost inf or NaN, and the
+// build fell back to a median split that mixed the clusters.)
+TEST(TriangleBvh, SahSplitsAtTheGapBetweenClusters) {
+  Mesh m;
+  auto add_triangle = [&](Vec3f at) {
+    const uint32_t v = m.vertex_count();
+    m.positions.push_back(at);
+    m.positions.push_back(at + Vec3f{0.1f, 0, 0});
+    m.positions.push_back(at + Vec3f{0, 0.1f, 0});
+    m.triangles.push_back({v, v + 1, v + 2});
+  };
+  for (int i = 0; i < 4; ++i) add_triangle({0.2f * i, 0, 0});
+  for (int i = 0; i < 28; ++i) add_triangle({100 + 0.2f * (i % 7), 0.2f * (i / 7), 0});
+  const TriangleBvh bvh = TriangleBvh::build(m);
+  ASSERT_GE(bvh.node_count(), 3u);
+  const TriangleBvh::Node& left = bvh.nodes()[1];
+  EXPECT_EQ(left.count, 4u) << "the root's left child is not the small cluster's leaf";
+  EXPECT_LT(left.hi.x, 1.0f);
+
+  // The shape never changes a distance.
+  std::vector<Vec3d> queries;
+  for (int i = 0; i < 50; ++i) queries.push_back({-5 + 2.5 * i, 0.3 * (i % 5), 1.0 - 0.1 * i});
+  expect_matches_brute_force(bvh, m, queries);
+}
+
 TEST(TriangleBvh, EmptyMeshGivesEmptyHierarchy) { EXPECT_TRUE(TriangleBvh::build(Mesh{}).empty()); }
 
 TEST(TriangleBvh, BuildIsDeterministic) {
