@@ -356,6 +356,54 @@ TEST(AttributeCodec, MeshWithoutAttributesHasNoAttributeRecords) {
   for (const RecordEntry& r : index->records) EXPECT_NE((*stream)[r.offset], kRecordAttributes);
 }
 
+// EncodeOptions::measure_unlocked_seams (a measurement for bench/REPORT.md):
+// false is the default stream byte for byte, seam vertices locked into the
+// base; true decimates through the seams (a smaller base than the locked
+// vertices) and writes the geometry alone, which decodes to the same
+// positions and face count.
+TEST(AttributeCodec, MeasureUnlockedSeamsOffChangesNothingOnRemovesTheLocks) {
+  const Mesh cube = faceted_cube(8);
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  o.asa_guidance = false;
+  EncodeReport report;
+  auto by_default = encode_hcs(cube, o, &report);
+  ASSERT_TRUE(by_default) << by_default.error().message;
+  EncodeOptions off = o;
+  off.measure_unlocked_seams = false;
+  auto locked = encode_hcs(cube, off);
+  ASSERT_TRUE(locked) << locked.error().message;
+  EXPECT_TRUE(*locked == *by_default) << "false must leave the stream unchanged";
+  auto locked_index = read_stream_index(*locked);
+  ASSERT_TRUE(locked_index);
+  // Every vertex on the cube's edges is a seam vertex (normals, UV islands
+  // and materials change there), locked into the base.
+  const uint32_t locked_vertices = report.attribute_locked_vertices;
+  EXPECT_EQ(locked_vertices, 12u * 7 + 8);
+  EXPECT_GE(locked_index->header.base_vertex_count, locked_vertices);
+
+  EncodeOptions on = o;
+  on.measure_unlocked_seams = true;
+  auto unlocked = encode_hcs(cube, on);
+  ASSERT_TRUE(unlocked) << unlocked.error().message;
+  auto index = read_stream_index(*unlocked);
+  ASSERT_TRUE(index);
+  EXPECT_LT(index->header.base_vertex_count, locked_vertices) << "seam vertices were decimated";
+  for (const RecordEntry& r : index->records) EXPECT_NE((*unlocked)[r.offset], kRecordAttributes);
+  auto a = decode_hcs(*locked);
+  auto b = decode_hcs(*unlocked);
+  ASSERT_TRUE(a && b);
+  auto sorted = [](std::vector<Vec3f> p) {
+    std::sort(p.begin(), p.end(), [](const Vec3f& x, const Vec3f& y) {
+      return std::tie(x.x, x.y, x.z) < std::tie(y.x, y.y, y.z);
+    });
+    return p;
+  };
+  EXPECT_TRUE(sorted(a->positions) == sorted(b->positions));
+  EXPECT_EQ(a->triangles.size(), b->triangles.size());
+  EXPECT_TRUE(b->corner_normals.empty() && b->colors.empty());
+}
+
 TEST(AttributeCodec, BadQuantizationBitsAreRefused) {
   EncodeOptions o;
   o.quant_color = 1;
