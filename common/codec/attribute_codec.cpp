@@ -309,6 +309,12 @@ bool carried_in(uint8_t part, const AttributeChannel& c) {
   return true;
 }
 
+// Whether record 1 has a section for channel c (version 13's normals have
+// none: kBaseNormalsLate).
+bool in_base_record(const AttributeChannel& c) {
+  return !(c.kind == AttributeKind::kNormal && (c.flags & kBaseNormalsLate));
+}
+
 // ---- layout bytes ----
 
 void put_f64(std::vector<uint8_t>& out, double d) {
@@ -426,10 +432,10 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
     if (c.kind != AttributeKind::kMaterial &&
         (c.bits < kMinAttributeBits || c.bits > kMaxAttributeBits))
       return tl::unexpected(parse_error("quantization bits out of 2..16"));
-    const uint8_t allowed = c.kind == AttributeKind::kTexcoord
-                                ? kPredictBaseAlternative | kPredictLaterFromGeometry
-                            : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative
-                                                               : 0;
+    const uint8_t allowed =
+        c.kind == AttributeKind::kTexcoord ? kPredictBaseAlternative | kPredictLaterFromGeometry
+        : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative | kBaseNormalsLate
+                                           : 0;
     if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
@@ -855,8 +861,17 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   // positions miss their low bits, which spoils the geometry-based guesses
   // where the base is as fine as the mesh (every vertex locked: Draco's
   // textured sphere); on a coarse base of exact-enough positions they win.
+  //
+  // Normals stay out of record 1 (version 13, kBaseNormalsLate): the base's
+  // come in the normals records with the inserted vertices', predicted on
+  // the complete mesh, and the first display with colours or texture
+  // waits for none of them (CesiumMilkTruck: 3 034 of record 1's 8 457
+  // bytes were the base's normals, bench/REPORT.md).
+  for (AttributeChannel& c : layout.channels)
+    if (c.kind == AttributeKind::kNormal) c.flags |= kBaseNormalsLate;
   ValueCoder base_coder{layout, true};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    if (!in_base_record(layout.channels[ch])) continue;
     // The base's values predicted over the base mesh (the decoder's state
     // after record 0); the wedge tables of base vertices are the same.
     AttributeValues base_truth;
@@ -909,14 +924,21 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   auto deferred = [&](size_t ch) {
     return late_normals && layout.channels[ch].kind == AttributeKind::kNormal;
   };
-  uint64_t all_inserted_bytes = 0, values_inserted_bytes = 0, normal_inserted_bytes = 0;
+  // The normals records start at vertex 0: the base's normals too.
+  const uint32_t normals_from = 0;
+  uint64_t all_inserted_bytes = 0, values_inserted_bytes = 0, normal_bytes = 0;
   {
     ValueCoder estimate{layout};
     for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+      if (deferred(ch)) {
+        normal_bytes += estimate.encode(*full, truth, ch, normals_from, n).size();
+        continue;
+      }
       const uint64_t b = estimate.encode(*full, truth, ch, base_n, n).size();
       all_inserted_bytes += b;
-      (deferred(ch) ? normal_inserted_bytes : values_inserted_bytes) += b;
+      values_inserted_bytes += b;
     }
+    all_inserted_bytes += normal_bytes;
   }
   uint64_t fixed_bytes = stream.size() + first.size();
   for (const ExtraAttribute& e : *plan.extras) fixed_bytes += e.bytes.size() / 4;  // a guess
@@ -961,13 +983,13 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   // Normals records: the normals the values records left out, on the
   // complete mesh, each about kValuesRecordShare of the stream.
   std::vector<std::vector<uint8_t>> normals_records;
-  if (late_normals && done > base_n) {
-    const double per_normal = double(normal_inserted_bytes) / inserted;
+  if (late_normals && done > normals_from) {
+    const double per_normal = double(normal_bytes) / (n - normals_from);
     const uint32_t chunk =
-        std::max<uint32_t>(1, per_normal > 0 ? uint32_t(target / per_normal) : done - base_n);
+        std::max<uint32_t>(1, per_normal > 0 ? uint32_t(target / per_normal) : done - normals_from);
     std::vector<ChannelModels> models(layout.channels.size());
     ValueCoder normals_coder{layout};
-    for (uint32_t from = base_n; from < done;) {
+    for (uint32_t from = normals_from; from < done;) {
       const uint32_t to = std::min(done, from + chunk);
       std::vector<uint8_t> payload{kRecordAttributes, kAttributePartNormals};
       put_varint(payload, to - from);
@@ -1055,7 +1077,7 @@ Result<AttributeParts> attribute_record_parts(
   parts["layout"] += layout_bytes.size();
   if (any_corner_channel(*layout)) parts["seams"] += r.section().size();
   for (const AttributeChannel& c : layout->channels)
-    parts[attribute_kind_name(c.kind)] += r.section().size();
+    if (in_base_record(c)) parts[attribute_kind_name(c.kind)] += r.section().size();
   if (!r.ok) return tl::unexpected(parse_error("base attribute record truncated"));
   for (std::span<const uint8_t> values : values_payloads) {
     if (values.size() < 2 || values[0] != kRecordAttributes || !is_values_part(values[1]))
@@ -1142,17 +1164,35 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
     }
   }
   ValueCoder coder{layout_, true};
+  bool normals_late = false;
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),
                             0);
+    if (!in_base_record(c)) {
+      // Version 13: the base's normals come later; each wedge shows its
+      // geometric normal on the base meanwhile.
+      normals_late = true;
+      int32_t pred[4];
+      for (uint32_t v = 0; v < n; ++v) {
+        const uint32_t w0 = c.per_corner ? values_.wedge_start[v] : v;
+        const uint32_t w1 = c.per_corner ? values_.wedge_start[v + 1] : v + 1;
+        for (uint32_t w = w0; w < w1; ++w) {
+          predict(base, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+          values_.data[ch][2 * size_t(w)] = pred[0];
+          values_.data[ch][2 * size_t(w) + 1] = pred[1];
+        }
+      }
+      continue;
+    }
     auto bytes = r.section();
     if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
     if (auto s = coder.decode(base, values_, ch, 0, n, bytes); !s) return s;
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the base part"));
   exact_vertices_ = n;
-  normals_exact_ = n;
+  normals_exact_ = normals_late ? 0 : n;
+  normals_refreshed_ = n;
   values_models_.assign(layout_.channels.size(), ChannelModels{});
   active_ = true;
   return {};
@@ -1270,11 +1310,15 @@ void AttributeDecoder::refresh_normal_previews(const EditableMesh& m) {
     const AttributeChannel& c = layout_.channels[ch];
     if (c.kind != AttributeKind::kNormal) continue;
     for (uint32_t v : stale) {
-      // Inserted vertices have one wedge.
-      const uint32_t w = c.per_corner ? values_.wedge_start[v] : v;
-      predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
-      values_.data[ch][2 * size_t(w)] = pred[0];
-      values_.data[ch][2 * size_t(w) + 1] = pred[1];
+      // Inserted vertices have one wedge, base vertices (version 13's
+      // normals wait for them too) one or more.
+      const uint32_t w0 = c.per_corner ? values_.wedge_start[v] : v;
+      const uint32_t w1 = c.per_corner ? values_.wedge_start[v + 1] : v + 1;
+      for (uint32_t w = w0; w < w1; ++w) {
+        predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+        values_.data[ch][2 * size_t(w)] = pred[0];
+        values_.data[ch][2 * size_t(w) + 1] = pred[1];
+      }
     }
   }
   normals_refreshed_ = now;

@@ -20,7 +20,9 @@
 // models that persist from one values record to the next; they are sized
 // like the geometry records (at most 1.5 % of the stream each). From
 // version 12 on they leave the normals out; normals records after the last
-// geometry record carry them, predicted on the complete mesh. The last
+// geometry record carry them, predicted on the complete mesh; from version
+// 13 on record 1 leaves the base's normals to those records too
+// (kBaseNormalsLate). The last
 // record carries the exact values of the vertices inserted after the last
 // values record (version 10: of every inserted vertex) and the extra
 // attributes (zstd). Until its values arrive the decoder shows each
@@ -79,6 +81,13 @@ const char* attribute_kind_name(AttributeKind kind);
 // records after it predict texture coordinates from the geometry.
 inline constexpr uint8_t kPredictBaseAlternative = 2;
 inline constexpr uint8_t kPredictLaterFromGeometry = 4;
+// A normal channel's flag (version 13 on): record 1 has no section for it;
+// the base vertices' normals come after every geometry record with the
+// inserted vertices', in the normals records (from vertex 0), predicted on
+// the complete mesh. Until then the decoder shows the geometric normal of
+// each wedge on the mesh it has. The first display with colours or
+// texture then waits for no normal (bench/REPORT.md, "first display").
+inline constexpr uint8_t kBaseNormalsLate = 8;
 
 struct AttributeChannel {
   AttributeKind kind = AttributeKind::kColor;

@@ -277,25 +277,32 @@ TEST(AttributeCodec, NormalsComeInNormalsRecordsAfterTheGeometry) {
   expect_valid_prefixes(*stream);
 }
 
-// Version 12: record 1 predicts the base's normals from the decoded
-// neighbours' normals where that codes smaller than the geometric normal of
-// the base's coarse positions (layout flag kPredictBaseAlternative). Draco's textured sphere, all
-// of whose vertices are seam vertices and stay in the base, takes it (its normals cost 2 730 bytes
-// with the geometric prediction, 1 501 with it, bench/REPORT.md); it comes back exactly either way.
-TEST(AttributeCodec, BaseNormalsFromNeighboursWhereTheyCodeSmaller) {
-  std::filesystem::path file;
-  if (!testing::test_mesh_dir().empty())
-    file = std::filesystem::path(testing::test_mesh_dir()) / ".." / "models" /
-           "SphereWithCircleTexture" / "sphere_with_circle_texture.gltf";
-  if (file.empty() || !std::filesystem::exists(file))
-    GTEST_SKIP() << "../shared/models/SphereWithCircleTexture not found (set "
-                    "MESHSTREAM_TEST_MESHES)";
-  auto imported = import_mesh(file.string());
-  ASSERT_TRUE(imported) << imported.error().message;
-  const Mesh& sphere = imported->mesh;
-  EncodeOptions o;
-  o.asa_guidance = false;
-  auto stream = encode_hcs(sphere, o);
+// The layout flags byte of channel `ch` in record 1's payload (the layout
+// section: varint length, channel count, then per channel kind, flags,
+// bits and for texture coordinates 16 bytes of grid).
+uint8_t layout_flags(std::span<const uint8_t> payload, AttributeKind kind) {
+  size_t pos = 2;
+  uint32_t length = 0;
+  if (!get_varint(payload, pos, length)) return 0xFF;
+  const size_t end = pos + length;
+  const uint32_t count = payload[pos++];
+  for (uint32_t i = 0; i < count && pos + 3 <= end; ++i) {
+    const uint8_t k = payload[pos], flags = payload[pos + 1];
+    if (k == uint8_t(kind)) return flags;
+    pos += 3 + (k == uint8_t(AttributeKind::kTexcoord) ? 16 : 0);
+  }
+  return 0xFF;
+}
+
+// Version 13: record 1 leaves the base's normals out (layout flag
+// kBaseNormalsLate, no section for them); the normals records, after every
+// geometry record, bring them from vertex 0, coded on the complete mesh.
+// Until then each wedge shows its geometric normal (every prefix valid; on
+// the cube's flat wedges the face's own normal), and the full-rate decode is
+// exact.
+void expect_base_normals_late(const Mesh& mesh, const EncodeOptions& o, bool flat_wedges) {
+  EncodeReport report;
+  auto stream = encode_hcs(mesh, o, &report);
   ASSERT_TRUE(stream) << stream.error().message;
   auto index = read_stream_index(*stream);
   ASSERT_TRUE(index);
@@ -305,21 +312,86 @@ TEST(AttributeCodec, BaseNormalsFromNeighboursWhereTheyCodeSmaller) {
   ASSERT_GE(payload.size(), 8u);
   EXPECT_EQ(payload[0], kRecordAttributes);
   EXPECT_EQ(payload[1], kAttributePartBase);
-  // The layout section: varint length, channel count, then per channel its
-  // kind and flags byte (normals first).
-  size_t pos = 2;
-  uint32_t length = 0;
-  ASSERT_TRUE(get_varint(payload, pos, length));
-  ASSERT_EQ(payload[pos + 1], uint8_t(AttributeKind::kNormal));
-  const uint8_t flags = payload[pos + 2];
-  EXPECT_TRUE(flags & 1) << "per corner";
-  EXPECT_TRUE(flags & kPredictBaseAlternative) << "record 1: the neighbours' normals";
+  const uint8_t flags = layout_flags(payload, AttributeKind::kNormal);
+  ASSERT_NE(flags, 0xFF) << "no normals in the layout";
+  EXPECT_TRUE(flags & kBaseNormalsLate);
+  EXPECT_FALSE(flags & kPredictBaseAlternative) << "record 1 codes no normals";
+  auto parts = attribute_record_parts(payload, {}, {});
+  ASSERT_TRUE(parts) << parts.error().message;
+  EXPECT_EQ(parts->count("normals") ? parts->at("normals") : 0, 0u);
+  EXPECT_GT(report.attribute_bytes["normals"], 0u) << "the normals travel later";
+  // The first normals record starts at vertex 0 and follows every geometry
+  // record.
+  size_t last_geometry = 0, first_normals = 0;
+  uint32_t first_count = 0;
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const RecordEntry& e = index->records[i];
+    const auto p = record_payload(e, {stream->data() + e.offset, e.size});
+    if (p.empty() || p[0] != kRecordAttributes) {
+      if (!p.empty() && p[0] != kRecordTexture) last_geometry = i;
+      continue;
+    }
+    if (p[1] == kAttributePartNormals && first_normals == 0) {
+      first_normals = i;
+      size_t pos = 2;
+      ASSERT_TRUE(get_varint(p, pos, first_count));
+    }
+  }
+  ASSERT_GT(first_normals, 0u) << "no normals record";
+  EXPECT_GT(first_normals, last_geometry);
+  EXPECT_GE(first_count, 1u);
   auto decoded = decode_hcs(*stream);
   ASSERT_TRUE(decoded) << decoded.error().message;
-  Mesh expected = expected_mesh(sphere, o);
-  expected.textures = sphere.textures;
+  Mesh expected = expected_mesh(mesh, o);
+  expected.textures = mesh.textures;
   EXPECT_TRUE(faces_of(*decoded) == faces_of(expected));
   expect_valid_prefixes(*stream);
+  if (!flat_wedges) return;
+  // Record 1's prefix: every corner's normal is its wedge's geometric
+  // normal on the base, which on flat wedges is the face's own.
+  IncrementalDecoder inc;
+  ASSERT_TRUE(inc.feed(std::span<const uint8_t>(*stream).subspan(0, r.offset + r.size)));
+  const Mesh& first = inc.mesh();
+  ASSERT_EQ(first.corner_normals.corners.size(), 3 * first.triangles.size());
+  for (size_t f = 0; f < first.triangles.size(); ++f) {
+    const Vec3f& a = first.positions[first.triangles[f][0]];
+    const Vec3f& b = first.positions[first.triangles[f][1]];
+    const Vec3f& c = first.positions[first.triangles[f][2]];
+    const Vec3f u{b.x - a.x, b.y - a.y, b.z - a.z}, v{c.x - a.x, c.y - a.y, c.z - a.z};
+    Vec3f g{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    const float l = std::sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+    ASSERT_GT(l, 0);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3f& n = first.corner_normals.values[first.corner_normals.corners[3 * f + k]];
+      EXPECT_GT((n.x * g.x + n.y * g.y + n.z * g.z) / l, 0.98f) << "face " << f << " corner " << k;
+    }
+  }
+}
+
+TEST(AttributeCodec, BaseNormalsLateOnTheFacetedCube) {
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  o.asa_guidance = false;
+  expect_base_normals_late(faceted_cube(8), o, true);
+}
+
+// Draco's textured sphere: every vertex is a seam vertex and stays in the
+// base (no geometry records with vertices), so its normals all travel in
+// the normals records (version 12 coded them in record 1, from the
+// neighbours' normals: 1 479 bytes; now 503 on the exact positions).
+TEST(AttributeCodec, BaseNormalsLateOnDracosSphere) {
+  std::filesystem::path file;
+  if (!testing::test_mesh_dir().empty())
+    file = std::filesystem::path(testing::test_mesh_dir()) / ".." / "models" /
+           "SphereWithCircleTexture" / "sphere_with_circle_texture.gltf";
+  if (file.empty() || !std::filesystem::exists(file))
+    GTEST_SKIP() << "../shared/models/SphereWithCircleTexture not found (set "
+                    "MESHSTREAM_TEST_MESHES)";
+  auto imported = import_mesh(file.string());
+  ASSERT_TRUE(imported) << imported.error().message;
+  EncodeOptions o;
+  o.asa_guidance = false;
+  expect_base_normals_late(imported->mesh, o, false);
 }
 
 TEST(AttributeCodec, EightBitColoursComeBackExactly) {
@@ -437,11 +509,13 @@ TEST(AttributeCodec, DamagedAttributeRecordsAreRefused) {
   ASSERT_TRUE(get_varint(*stream, pos, layout_length));
   const uint64_t layout_at = pos;
   const Damage damages[] = {
-      {first.offset + 1, 1, "before the mesh is complete"},     // base part claims to be the final
-      {first.offset + 3, 0xFF, "attribute record"},             // layout length past the record
-      {layout_at + 1, 9, "unknown attribute kind"},             // first channel's kind
-      {layout_at + 3, 40, "quantization bits"},                 // first channel's bits
-      {last.offset + 1, 0, "after a geometry record"},          // final part claims to be the base
+      {first.offset + 1, 1, "before the mesh is complete"},  // base part claims to be the final
+      {first.offset + 3, 0xFF, "attribute record"},          // layout length past the record
+      {layout_at + 1, 9, "unknown attribute kind"},          // first channel's kind
+      {layout_at + 3, 40, "quantization bits"},              // first channel's bits
+      {layout_at + 2, 0x11, "unknown prediction flags"},     // normals: bit 4
+      {layout_at + 2, 1, "attribute record"},           // normals without bit 3: a section missing
+      {last.offset + 1, 0, "after a geometry record"},  // final part claims to be the base
       {last.offset + last.size - 6, 0xFF, "attribute record"},  // the zstd frame's end
   };
   for (const Damage& d : damages) {
