@@ -394,6 +394,74 @@ TEST(AttributeCodec, BaseNormalsLateOnDracosSphere) {
   expect_base_normals_late(imported->mesh, o, false);
 }
 
+// Version 14: record 1 carries the base's 12-bit texture coordinates on an
+// 8-bit grid (layout flag kBaseCoarse, shift 4), shown at the middle of the
+// missing bits' range; the low-bits record brings the rest before the
+// first values record, after which the base's values are exact.
+TEST(AttributeCodec, CoarseBaseTexcoordsThenTheirLowBits) {
+  const Mesh cube = faceted_cube(8);
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  o.asa_guidance = false;
+  auto stream = encode_hcs(cube, o);
+  ASSERT_TRUE(stream) << stream.error().message;
+  auto index = read_stream_index(*stream);
+  ASSERT_TRUE(index);
+  const RecordEntry& r1 = index->records[1];
+  const auto payload = record_payload(r1, {stream->data() + r1.offset, r1.size});
+  const uint8_t flags = layout_flags(payload, AttributeKind::kTexcoord);
+  ASSERT_NE(flags, 0xFF);
+  EXPECT_TRUE(flags & kBaseCoarse);
+  size_t low = 0, first_values = 0;
+  for (size_t i = 2; i < index->records.size(); ++i) {
+    const RecordEntry& e = index->records[i];
+    const auto p = record_payload(e, {stream->data() + e.offset, e.size});
+    if (p.size() < 2 || p[0] != kRecordAttributes) continue;
+    if (p[1] == kAttributePartLowBits) {
+      EXPECT_EQ(low, 0u) << "one low-bits record";
+      low = i;
+    }
+    if ((p[1] == kAttributePartValues || p[1] == kAttributePartValuesLateNormals) &&
+        first_values == 0)
+      first_values = i;
+  }
+  ASSERT_GT(low, 1u) << "no low-bits record";
+  ASSERT_GT(first_values, 0u);
+  EXPECT_LT(low, first_values) << "the values are predicted from the exact base";
+  auto prefix = [&](size_t last) {
+    IncrementalDecoder d;
+    const RecordEntry& e = index->records[last];
+    EXPECT_TRUE(d.feed(std::span<const uint8_t>(*stream).subspan(0, e.offset + e.size)));
+    return d.mesh().corner_texcoords.values;
+  };
+  const std::vector<Vec2f> coarse = prefix(1), refined = prefix(low);
+  auto whole = decode_hcs(*stream);
+  ASSERT_TRUE(whole) << whole.error().message;
+  ASSERT_FALSE(coarse.empty());
+  ASSERT_GE(refined.size(), coarse.size());
+  ASSERT_GE(whole->corner_texcoords.values.size(), coarse.size());
+  // Half the coarse step: 2^3 steps of the 12-bit grid over the UV box.
+  float lo = 1e9f, hi = -1e9f;
+  for (const Vec2f& t : cube.corner_texcoords.values) {
+    lo = std::min({lo, t.x, t.y});
+    hi = std::max({hi, t.x, t.y});
+  }
+  const float half = 8 * (hi - lo) / 4095 * 1.01f;
+  size_t differ = 0;
+  for (size_t w = 0; w < coarse.size(); ++w) {
+    EXPECT_LE(std::abs(coarse[w].x - refined[w].x), half) << w;
+    EXPECT_LE(std::abs(coarse[w].y - refined[w].y), half) << w;
+    differ += coarse[w].x != refined[w].x || coarse[w].y != refined[w].y;
+    EXPECT_EQ(refined[w].x, whole->corner_texcoords.values[w].x) << "base wedge " << w;
+    EXPECT_EQ(refined[w].y, whole->corner_texcoords.values[w].y) << "base wedge " << w;
+  }
+  EXPECT_GT(differ, 0u) << "record 1 carried them exactly";
+  Mesh expected = expected_mesh(cube, o);
+  expected.textures = cube.textures;
+  EXPECT_TRUE(faces_of(*whole) == faces_of(expected));
+  expect_valid_prefixes(*stream);
+}
+
 TEST(AttributeCodec, EightBitColoursComeBackExactly) {
   std::filesystem::path file;
   if (!testing::test_mesh_dir().empty())
@@ -518,7 +586,16 @@ TEST(AttributeCodec, DamagedAttributeRecordsAreRefused) {
       {last.offset + 1, 0, "after a geometry record"},  // final part claims to be the base
       {last.offset + last.size - 6, 0xFF, "attribute record"},  // the zstd frame's end
   };
-  for (const Damage& d : damages) {
+  // The low-bits record (version 14) claiming to be a values record.
+  std::vector<Damage> all(std::begin(damages), std::end(damages));
+  for (const RecordEntry& e : index->records)
+    if ((*stream)[e.offset] == kRecordAttributes &&
+        (*stream)[e.offset + 1] == kAttributePartLowBits) {
+      all.push_back({e.offset + 1, kAttributePartValuesLateNormals, "before the base's low bits"});
+      all.push_back({e.offset + 2, 7, "low-bits record for 7 vertices"});
+    }
+  EXPECT_EQ(all.size(), std::size(damages) + 2) << "one low-bits record";
+  for (const Damage& d : all) {
     std::vector<uint8_t> bad = *stream;
     bad[d.at] = d.value;
     reseal_checksums(bad);
