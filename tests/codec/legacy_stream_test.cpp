@@ -25,7 +25,10 @@
 //                 flag bit 1), which version 13 no longer writes;
 //   container3_v13_* the faceted cube at kEncoderVersion 13 (record 1
 //                 without the base's normals, which come in the normals
-//                 record from vertex 0).
+//                 record from vertex 0);
+//   container3_v14_* the faceted cube at kEncoderVersion 14 (record 1's
+//                 texture coordinates on an 8-bit grid, their low bits in
+//                 a low-bits record before the first values record).
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -196,6 +199,13 @@ TEST(LegacyStreams, VersionElevenValuesRecordsDecodeAsWhenWritten) {
 TEST(LegacyStreams, VersionTwelveNormalsRecordsDecodeAsWhenWritten) {
   expect_attributes_decode_as_when_written("container3_v12_faceted_cube_attributes.hcs",
                                            0x52ce8058599d568full, 5);
+}
+
+// Version 14: record 1 with coarse texture coordinates, a low-bits record
+// before the first of four values records, one normals record.
+TEST(LegacyStreams, VersionFourteenCoarseBaseDecodeAsWhenWritten) {
+  expect_attributes_decode_as_when_written("container3_v14_faceted_cube_attributes.hcs",
+                                           0x52ce8058599d568full, 6);
 }
 
 // Version 13: record 1 without normals (layout flag bit 3), four values
