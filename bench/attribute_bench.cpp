@@ -38,6 +38,7 @@
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
+#include "common/codec/quantize.h"
 #include "common/mesh/import.h"
 #include "tests/codec/attribute_test_util.h"
 
@@ -45,47 +46,67 @@ namespace {
 
 using namespace meshstream;
 
-// Seam vertices: a corner channel (normal, texture coordinate, colour, face
-// material) gives the vertex's corners more than one value. Edges touching
-// one: the upper bound on the seam-pattern bits a re-triangulated patch
-// would code (one bit per such edge, Draco's seam-bit bound).
-uint64_t edges_touching_seams(const Mesh& m) {
-  const size_t n = m.vertex_count();
-  std::vector<std::vector<uint64_t>> seen(n);
-  auto mark = [&](const std::vector<uint32_t>& corners, bool face) {
-    for (size_t c = 0; c < 3 * m.triangles.size(); ++c) {
-      const uint32_t v = m.triangles[c / 3][c % 3];
-      const uint64_t key = face ? m.face_materials[c / 3] : corners[c];
-      auto& s = seen[v];
-      if (std::find(s.begin(), s.end(), (face ? 1ull << 63 : 0) | key) == s.end())
-        s.push_back((face ? 1ull << 63 : 0) | key);
-    }
-  };
-  std::vector<uint8_t> seam(n, 0);
-  for (const auto* corners :
-       {&m.corner_normals.corners, &m.corner_texcoords.corners, &m.corner_colors.corners}) {
-    if (corners->empty()) continue;
-    for (auto& s : seen) s.clear();
-    mark(*corners, false);
-    for (size_t v = 0; v < n; ++v) seam[v] |= seen[v].size() > 1;
-  }
-  if (!m.face_materials.empty()) {
-    for (auto& s : seen) s.clear();
-    mark({}, true);
-    for (size_t v = 0; v < n; ++v) seam[v] |= seen[v].size() > 1;
-  }
+// Edges of the input mesh with an end at a vertex the encoder locks: the
+// upper bound on the seam-pattern bits a re-triangulated patch would code
+// (one bit per such edge, Draco's seam-bit bound). The locked set is the
+// encoder's own (plan_attributes: both ends of every edge across which a
+// per-corner channel's quantized values differ), on the positions
+// quantized as the encoder quantizes them.
+uint64_t edges_touching_seams(const Mesh& m, const EncodeOptions& options) {
+  auto grid = make_grid(m, options.quant_bits);
+  if (!grid) return 0;
+  const std::vector<Vec3i> q = quantize_positions(m, *grid);
+  auto plan = plan_attributes(m, q, {options.quant_normal, options.quant_uv, options.quant_color});
+  if (!plan || plan->locked.empty()) return 0;
+  const std::vector<uint8_t>& locked = plan->locked;
   std::vector<std::pair<uint32_t, uint32_t>> edges;
   for (const Triangle& t : m.triangles)
     for (int k = 0; k < 3; ++k) {
       const uint32_t a = t[k], b = t[(k + 1) % 3];
-      if (seam[a] || seam[b]) edges.emplace_back(std::min(a, b), std::max(a, b));
+      if (locked[a] || locked[b]) edges.emplace_back(std::min(a, b), std::max(a, b));
     }
   std::sort(edges.begin(), edges.end());
   return uint64_t(std::unique(edges.begin(), edges.end()) - edges.begin());
 }
 
+// Bytes of a stream's texture records (with their index entries' share:
+// the records' sizes), to leave out of the geometry.
+uint64_t texture_record_bytes(const std::vector<uint8_t>& stream, const StreamIndex& index) {
+  uint64_t bytes = 0;
+  for (size_t i = 1; i < index.records.size(); ++i)
+    if (stream[index.records[i].offset] == kRecordTexture) bytes += index.records[i].size;
+  return bytes;
+}
+
+// One row of the first-display table: the bytes up to the first display
+// with attributes (the base record and record 1, the header and index
+// before them not shown) and record 1's payload by part.
+std::string first_display_row(const std::string& name, const std::vector<uint8_t>& stream,
+                              const StreamIndex& index, uint64_t plain_first) {
+  if (index.records.size() < 2 || stream[index.records[1].offset] != kRecordAttributes)
+    return "| " + name + " | no attribute record 1 |\n";
+  const RecordEntry& r = index.records[1];
+  auto parts = attribute_record_parts(
+      record_payload(r, std::span<const uint8_t>(stream).subspan(r.offset, r.size)), {}, {});
+  if (!parts) return "| " + name + " | record 1: " + parts.error().message + " |\n";
+  auto part = [&](const char* k) -> unsigned long long {
+    return parts->count(k) ? parts->at(k) : 0;
+  };
+  const uint64_t first = r.offset + r.size;
+  char row[512];
+  std::snprintf(row, sizeof row,
+                "| %s | %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu | %llu / %llu (%.2f) "
+                "|\n",
+                name.c_str(), (unsigned long long)index.records[0].size, (unsigned long long)r.size,
+                part("layout"), part("seams"), part("normals"), part("texcoords"), part("colors"),
+                part("materials"), (unsigned long long)first, (unsigned long long)plain_first,
+                plain_first ? double(first) / plain_first : 0.0);
+  return row;
+}
+
 // One row of the seam table: the default stream (seam vertices locked)
 // against EncodeOptions::measure_unlocked_seams (geometry records only).
+// Geometry: the stream without its attribute and texture records.
 std::string seam_row(const std::string& name, const Mesh& mesh, EncodeOptions options,
                      const StreamIndex& locked, uint64_t locked_geometry,
                      uint64_t attribute_records, uint64_t locked_first) {
@@ -95,8 +116,9 @@ std::string seam_row(const std::string& name, const Mesh& mesh, EncodeOptions op
     return "| " + name + " | unlocked encode failed: " + unlocked.error().message + " |\n";
   auto index = read_stream_index(*unlocked);
   if (!index) return "| " + name + " | unlocked index: " + index.error().message + " |\n";
+  const uint64_t unlocked_geometry = unlocked->size() - texture_record_bytes(*unlocked, *index);
   const uint64_t base = index->records[0].offset + index->records[0].size;
-  const uint64_t bits = edges_touching_seams(mesh);
+  const uint64_t bits = edges_touching_seams(mesh, options);
   // First display unlocked: its base plus record 1 of the locked stream
   // (an optimistic stand-in: record 1 grows with the base) plus the bits.
   const uint64_t record1 = locked.records.size() > 1
@@ -108,9 +130,9 @@ std::string seam_row(const std::string& name, const Mesh& mesh, EncodeOptions op
                 name.c_str(), locked.header.base_vertex_count, index->header.base_vertex_count,
                 (unsigned long long)locked_first,
                 (unsigned long long)(base + record1 + (bits + 7) / 8),
-                (unsigned long long)locked_geometry, (unsigned long long)unlocked->size(),
+                (unsigned long long)locked_geometry, (unsigned long long)unlocked_geometry,
                 (unsigned long long)(locked_geometry + attribute_records),
-                (unsigned long long)(unlocked->size() + attribute_records + (bits + 7) / 8),
+                (unsigned long long)(unlocked_geometry + attribute_records + (bits + 7) / 8),
                 (unsigned long long)bits, (unsigned long long)((bits + 7) / 8));
   return row;
 }
@@ -158,6 +180,10 @@ int main(int argc, char** argv) {
   }
   if (out_path.empty() && !report_dir.empty()) out_path = report_dir + "/attributes.md";
   const std::vector<fs::path> files = meshstream::bench::model_files(dir);
+  std::string first_table =
+      "| model | base record | record 1 | layout | seams | normals | texcoords | colors | "
+      "materials | first display / without attributes "
+      "|\n|---|---|---|---|---|---|---|---|---|---|\n";
   std::string seam_table =
       "| model | base vertices locked / unlocked | first display | geometry | total | seam-pattern "
       "bits |\n|---|---|---|---|---|---|\n";
@@ -216,7 +242,9 @@ int main(int argc, char** argv) {
       if ((*stream)[index->records[i].offset] == kRecordAttributes)
         attribute_records += index->records[i].size;
     const uint64_t ours_total = stream->size();
-    const uint64_t ours_geometry = ours_total - attribute_records;
+    // Textures excluded (Draco's geometry has none either).
+    const uint64_t ours_geometry =
+        ours_total - attribute_records - texture_record_bytes(*stream, *index);
     // The first display with attributes: through record 1 (record 0 when
     // the stream has none); without: the plain stream's base.
     const size_t shown =
@@ -285,10 +313,12 @@ int main(int argc, char** argv) {
     std::printf("  base vertices with attributes %u, without %u\n", index->header.base_vertex_count,
                 plain_index ? plain_index->header.base_vertex_count : 0);
     table += row;
+    first_table += first_display_row(name, *stream, *index, plain_first);
     seam_table +=
         seam_row(name, mesh, options, *index, ours_geometry, attribute_records, first_display);
   }
   std::printf("\n%s", table.c_str());
+  std::printf("\n%s", first_table.c_str());
   std::printf("\n%s", seam_table.c_str());
   if (!out_path.empty())
     std::ofstream(out_path) << (report_dir.empty()

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <unordered_map>
+#include <utility>
 
 #include "common/codec/byte_io.h"
 #include "common/codec/container.h"
@@ -305,8 +306,24 @@ bool any_corner_channel(const AttributeLayout& l) {
 bool carried_in(uint8_t part, const AttributeChannel& c) {
   const bool normal = c.kind == AttributeKind::kNormal;
   if (part == kAttributePartNormals) return normal;
+  if (part == kAttributePartLowBits) return (c.flags & kBaseCoarse) != 0;
   if (part == kAttributePartValuesLateNormals) return !normal;
   return true;
+}
+
+// Whether record 1 has a section for channel c (version 13's normals have
+// none: kBaseNormalsLate).
+bool in_base_record(const AttributeChannel& c) {
+  return !(c.kind == AttributeKind::kNormal && (c.flags & kBaseNormalsLate));
+}
+
+// The layout record 1's values are coded with: coarse channels
+// (kBaseCoarse) on their grid of bits - base_shift.
+AttributeLayout coarse_layout(const AttributeLayout& l) {
+  AttributeLayout out = l;
+  for (AttributeChannel& c : out.channels)
+    if (c.flags & kBaseCoarse) c.bits = uint8_t(c.bits - c.base_shift);
+  return out;
 }
 
 // ---- layout bytes ----
@@ -330,6 +347,7 @@ std::vector<uint8_t> write_layout(const AttributeLayout& l) {
     out.push_back(uint8_t(c.kind));
     out.push_back(uint8_t((c.per_corner ? 1 : 0) | c.flags));
     out.push_back(c.bits);
+    if (c.flags & kBaseCoarse) out.push_back(c.base_shift);
     if (c.kind == AttributeKind::kTexcoord) {
       put_f32(out, c.uv.min.x);
       put_f32(out, c.uv.min.y);
@@ -426,10 +444,16 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
     if (c.kind != AttributeKind::kMaterial &&
         (c.bits < kMinAttributeBits || c.bits > kMaxAttributeBits))
       return tl::unexpected(parse_error("quantization bits out of 2..16"));
+    if (c.flags & kBaseCoarse) {
+      c.base_shift = r.u8();
+      if (c.base_shift < 1 || c.base_shift + kMinAttributeBits > c.bits)
+        return tl::unexpected(parse_error("coarse base shift out of range"));
+    }
     const uint8_t allowed = c.kind == AttributeKind::kTexcoord
-                                ? kPredictBaseAlternative | kPredictLaterFromGeometry
-                            : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative
-                                                               : 0;
+                                ? kPredictBaseAlternative | kPredictLaterFromGeometry | kBaseCoarse
+                            : c.kind == AttributeKind::kNormal
+                                ? kPredictBaseAlternative | kBaseNormalsLate
+                                : 0;
     if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
@@ -531,6 +555,98 @@ struct ValueCoder {
       if (dec.exhausted_badly())
         return tl::unexpected(
             parse_error(std::string(attribute_kind_name(c.kind)) + " data runs out"));
+    }
+    return {};
+  }
+};
+
+// The low bits of a coarse channel's base values (low-bits record, version
+// 14), vertex by vertex, wedges and components in order, on record 1's mesh.
+// Each value's high bits are known (record 1); its record-1 prediction, now
+// at full precision from the exact values before it, says where in the
+// range [lo, lo + 2^shift) it should be: below the range (context 0: code
+// value - lo), above it (context 1: hi - value) or inside (context 2:
+// value - prediction mod 2^shift). Each context's symbol goes through a
+// binary tree of adaptive bits per component: about `shift` bits where the
+// prediction says nothing, fewer where it is good.
+struct LowBitCoder {
+  const AttributeLayout& layout;
+  size_t ch;
+  int shift;
+  std::vector<BitModel> tree;
+  std::vector<uint32_t> ring, corners;
+  LowBitCoder(const AttributeLayout& l, size_t channel)
+      : layout(l),
+        ch(channel),
+        shift(l.channels[channel].base_shift),
+        tree((size_t(4) * 3) << shift) {}
+  BitModel* models(uint32_t component, int context) {
+    return &tree[(size_t(component) * 3 + context) << shift];
+  }
+  // Context and symbol of `value` in [lo, lo + 2^shift) against `pred`.
+  std::pair<int, int32_t> symbol(int32_t pred, int32_t lo, int32_t value) const {
+    const int32_t hi = lo + (int32_t(1) << shift) - 1;
+    if (pred < lo) return {0, value - lo};
+    if (pred > hi) return {1, hi - value};
+    return {2, (value - pred) & ((int32_t(1) << shift) - 1)};
+  }
+  int32_t value_of(int context, int32_t pred, int32_t lo, int32_t sym) const {
+    const int32_t mask = (int32_t(1) << shift) - 1;
+    if (context == 0) return lo + sym;
+    if (context == 1) return lo + mask - sym;
+    return lo + ((pred - lo + sym) & mask);
+  }
+
+  std::vector<uint8_t> encode(const EditableMesh& base, const AttributeValues& truth,
+                              uint32_t base_n) {
+    const AttributeChannel& c = layout.channels[ch];
+    const uint32_t n = c.components();
+    RangeEncoder enc;
+    int32_t pred[4];
+    for (uint32_t v = 0; v < base_n; ++v) {
+      const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
+      const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
+      for (uint32_t w = w0; w < w1; ++w) {
+        predict(base, truth, layout, ch, v, w, prediction_of(c, true), pred, ring, corners);
+        for (uint32_t i = 0; i < n; ++i) {
+          const int32_t value = truth.data[ch][w * n + i];
+          const auto [context, sym] = symbol(pred[i], (value >> shift) << shift, value);
+          BitModel* m = models(i, context);
+          uint32_t node = 1;
+          for (int b = shift - 1; b >= 0; --b) {
+            const int bit = (sym >> b) & 1;
+            enc.encode_bit(m[node], bit);
+            node = 2 * node + uint32_t(bit);
+          }
+        }
+      }
+    }
+    return enc.finish();
+  }
+
+  Status decode(const EditableMesh& base, AttributeValues& a, uint32_t base_n,
+                std::span<const uint8_t> bytes) {
+    const AttributeChannel& c = layout.channels[ch];
+    const uint32_t n = c.components();
+    RangeDecoder dec(bytes);
+    int32_t pred[4];
+    for (uint32_t v = 0; v < base_n; ++v) {
+      const uint32_t w0 = c.per_corner ? a.wedge_start[v] : v;
+      const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
+      for (uint32_t w = w0; w < w1; ++w) {
+        predict(base, a, layout, ch, v, w, prediction_of(c, true), pred, ring, corners);
+        for (uint32_t i = 0; i < n; ++i) {
+          int32_t& value = a.data[ch][w * n + i];
+          const int32_t lo = (value >> shift) << shift;
+          // The symbol's context comes from the prediction alone.
+          const int context = pred[i] < lo ? 0 : pred[i] > lo + (int32_t(1) << shift) - 1 ? 1 : 2;
+          BitModel* m = models(i, context);
+          uint32_t node = 1;
+          for (int b = shift - 1; b >= 0; --b) node = 2 * node + uint32_t(dec.decode_bit(m[node]));
+          value = value_of(context, pred[i], lo, int32_t(node - (uint32_t(1) << shift)));
+        }
+      }
+      if (dec.exhausted_badly()) return tl::unexpected(parse_error("low-bits data runs out"));
     }
     return {};
   }
@@ -855,8 +971,29 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   // positions miss their low bits, which spoils the geometry-based guesses
   // where the base is as fine as the mesh (every vertex locked: Draco's
   // textured sphere); on a coarse base of exact-enough positions they win.
-  ValueCoder base_coder{layout, true};
+  //
+  // Normals stay out of record 1 (version 13, kBaseNormalsLate): the base's
+  // come in the normals records with the inserted vertices', predicted on
+  // the complete mesh, and the first display with colours or texture
+  // waits for none of them (CesiumMilkTruck: 3 034 of record 1's 8 457
+  // bytes were the base's normals, bench/REPORT.md).
+  for (AttributeChannel& c : layout.channels)
+    if (c.kind == AttributeKind::kNormal) c.flags |= kBaseNormalsLate;
+  // Texture coordinates of more than kBaseCoarseBits bits go coarse into
+  // record 1 (version 14, kBaseCoarse): their low bits follow in a low-bits
+  // record before the first values record (truck: record 1's UV 4 515 ->
+  // about 2 400 bytes; the first display shows the small texture level).
+  for (AttributeChannel& c : layout.channels)
+    if (c.kind == AttributeKind::kTexcoord && c.bits > kBaseCoarseBits) {
+      c.flags |= kBaseCoarse;
+      c.base_shift = uint8_t(c.bits - kBaseCoarseBits);
+    }
+  // Record 1 codes on the coarse grids (the flags it sets below are the
+  // layout's too).
+  AttributeLayout record1_layout = coarse_layout(layout);
+  ValueCoder base_coder{record1_layout, true};
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    if (!in_base_record(layout.channels[ch])) continue;
     // The base's values predicted over the base mesh (the decoder's state
     // after record 0); the wedge tables of base vertices are the same.
     AttributeValues base_truth;
@@ -869,14 +1006,18 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     const size_t count =
         size_t(c.per_corner ? base_truth.wedge_start.back() : base_n) * c.components();
     base_truth.data[ch].assign(truth.data[ch].begin(), truth.data[ch].begin() + count);
+    if (c.flags & kBaseCoarse)
+      for (int32_t& x : base_truth.data[ch]) x >>= c.base_shift;
     std::vector<uint8_t> bytes = base_coder.encode(*base, base_truth, ch, 0, base_n);
     if (c.kind == AttributeKind::kNormal || c.kind == AttributeKind::kTexcoord) {
-      layout.channels[ch].flags |= kPredictBaseAlternative;
+      record1_layout.channels[ch].flags |= kPredictBaseAlternative;
       std::vector<uint8_t> other = base_coder.encode(*base, base_truth, ch, 0, base_n);
-      if (other.size() < bytes.size())
+      if (other.size() < bytes.size()) {
         bytes = std::move(other);
-      else
-        layout.channels[ch].flags &= uint8_t(~kPredictBaseAlternative);
+        layout.channels[ch].flags |= kPredictBaseAlternative;
+      } else {
+        record1_layout.channels[ch].flags &= uint8_t(~kPredictBaseAlternative);
+      }
     }
     put_section(after_layout, bytes);
     local_parts[attribute_kind_name(c.kind)] += bytes.size();
@@ -885,6 +1026,25 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   put_section(first, layout_bytes);
   first.insert(first.end(), after_layout.begin(), after_layout.end());
   local_parts["layout"] += layout_bytes.size();
+
+  // The low-bits record (version 14): per coarse channel the base's exact
+  // values, in record 1's order and with its predictions on its mesh, now
+  // at full precision from the exact values before them, each prediction
+  // clamped into the range its coarse value leaves (so a residual costs at
+  // most about the missing bits, and less where the prediction is good).
+  std::vector<uint8_t> low_bits;
+  if (std::any_of(layout.channels.begin(), layout.channels.end(),
+                  [](const AttributeChannel& c) { return (c.flags & kBaseCoarse) != 0; })) {
+    low_bits = {kRecordAttributes, kAttributePartLowBits};
+    put_varint(low_bits, base_n);
+    for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+      if (!(layout.channels[ch].flags & kBaseCoarse)) continue;
+      LowBitCoder low_coder(layout, ch);
+      const std::vector<uint8_t> bytes = low_coder.encode(*base, truth, base_n);
+      put_section(low_bits, bytes);
+      local_parts[attribute_kind_name(layout.channels[ch].kind)] += bytes.size();
+    }
+  }
 
   // Values records: the geometry stream replayed as the decoder reads it,
   // and after a geometry record, once the vertices inserted since the last
@@ -909,14 +1069,21 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   auto deferred = [&](size_t ch) {
     return late_normals && layout.channels[ch].kind == AttributeKind::kNormal;
   };
-  uint64_t all_inserted_bytes = 0, values_inserted_bytes = 0, normal_inserted_bytes = 0;
+  // The normals records start at vertex 0: the base's normals too.
+  const uint32_t normals_from = 0;
+  uint64_t all_inserted_bytes = 0, values_inserted_bytes = 0, normal_bytes = 0;
   {
     ValueCoder estimate{layout};
     for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+      if (deferred(ch)) {
+        normal_bytes += estimate.encode(*full, truth, ch, normals_from, n).size();
+        continue;
+      }
       const uint64_t b = estimate.encode(*full, truth, ch, base_n, n).size();
       all_inserted_bytes += b;
-      (deferred(ch) ? normal_inserted_bytes : values_inserted_bytes) += b;
+      values_inserted_bytes += b;
     }
+    all_inserted_bytes += normal_bytes;
   }
   uint64_t fixed_bytes = stream.size() + first.size();
   for (const ExtraAttribute& e : *plan.extras) fixed_bytes += e.bytes.size() / 4;  // a guess
@@ -961,13 +1128,13 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   // Normals records: the normals the values records left out, on the
   // complete mesh, each about kValuesRecordShare of the stream.
   std::vector<std::vector<uint8_t>> normals_records;
-  if (late_normals && done > base_n) {
-    const double per_normal = double(normal_inserted_bytes) / inserted;
+  if (late_normals && done > normals_from) {
+    const double per_normal = double(normal_bytes) / (n - normals_from);
     const uint32_t chunk =
-        std::max<uint32_t>(1, per_normal > 0 ? uint32_t(target / per_normal) : done - base_n);
+        std::max<uint32_t>(1, per_normal > 0 ? uint32_t(target / per_normal) : done - normals_from);
     std::vector<ChannelModels> models(layout.channels.size());
     ValueCoder normals_coder{layout};
-    for (uint32_t from = base_n; from < done;) {
+    for (uint32_t from = normals_from; from < done;) {
       const uint32_t to = std::min(done, from + chunk);
       std::vector<uint8_t> payload{kRecordAttributes, kAttributePartNormals};
       put_varint(payload, to - from);
@@ -1022,14 +1189,21 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
     counts.push_back(counts.back());
     payloads.push_back(std::move(payload));
   };
+  // The low-bits record goes just before the first values record (the
+  // values are predicted from the base's exact values), else after the
+  // last geometry record.
   for (size_t i = 0; i < idx.records.size(); ++i) {
     const RecordEntry& r = idx.records[i];
     const auto bytes = record_payload(r, stream.subspan(r.offset, r.size));
     payloads.emplace_back(bytes.begin(), bytes.end());
     counts.push_back({r.vertices, r.faces});
     if (i == 0) add_attributes(std::move(first));
-    if (!values_after[i].empty()) add_attributes(std::move(values_after[i]));
+    if (!values_after[i].empty()) {
+      if (!low_bits.empty()) add_attributes(std::exchange(low_bits, {}));
+      add_attributes(std::move(values_after[i]));
+    }
   }
+  if (!low_bits.empty()) add_attributes(std::exchange(low_bits, {}));
   for (std::vector<uint8_t>& r : normals_records) add_attributes(std::move(r));
   add_attributes(std::move(last));
   auto written = write_container(idx.header, payloads, counts);
@@ -1055,7 +1229,7 @@ Result<AttributeParts> attribute_record_parts(
   parts["layout"] += layout_bytes.size();
   if (any_corner_channel(*layout)) parts["seams"] += r.section().size();
   for (const AttributeChannel& c : layout->channels)
-    parts[attribute_kind_name(c.kind)] += r.section().size();
+    if (in_base_record(c)) parts[attribute_kind_name(c.kind)] += r.section().size();
   if (!r.ok) return tl::unexpected(parse_error("base attribute record truncated"));
   for (std::span<const uint8_t> values : values_payloads) {
     if (values.size() < 2 || values[0] != kRecordAttributes || !is_values_part(values[1]))
@@ -1141,18 +1315,44 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
       values_.wedge_start.push_back(v + 1);
     }
   }
-  ValueCoder coder{layout_, true};
+  // Coarse channels (version 14) decode on their coarse grids.
+  const AttributeLayout record1_layout = coarse_layout(layout_);
+  ValueCoder coder{record1_layout, true};
+  bool normals_late = false;
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
     const AttributeChannel& c = layout_.channels[ch];
     values_.data[ch].assign(size_t(c.per_corner ? values_.wedge_key.size() : n) * c.components(),
                             0);
+    if (!in_base_record(c)) {
+      // Version 13: the base's normals come later; each wedge shows its
+      // geometric normal on the base meanwhile.
+      normals_late = true;
+      int32_t pred[4];
+      for (uint32_t v = 0; v < n; ++v) {
+        const uint32_t w0 = c.per_corner ? values_.wedge_start[v] : v;
+        const uint32_t w1 = c.per_corner ? values_.wedge_start[v + 1] : v + 1;
+        for (uint32_t w = w0; w < w1; ++w) {
+          predict(base, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+          values_.data[ch][2 * size_t(w)] = pred[0];
+          values_.data[ch][2 * size_t(w) + 1] = pred[1];
+        }
+      }
+      continue;
+    }
     auto bytes = r.section();
     if (!r.ok) return tl::unexpected(parse_error("value section truncated"));
     if (auto s = coder.decode(base, values_, ch, 0, n, bytes); !s) return s;
+    if (c.flags & kBaseCoarse) {
+      // Shown at the middle of the low bits' range until they come.
+      for (int32_t& x : values_.data[ch]) x = (x << c.base_shift) | (1 << (c.base_shift - 1));
+      low_bits_pending_ = true;
+      base_mesh_ = base;
+    }
   }
   if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after the base part"));
   exact_vertices_ = n;
-  normals_exact_ = n;
+  normals_exact_ = normals_late ? 0 : n;
+  normals_refreshed_ = n;
   values_models_.assign(layout_.channels.size(), ChannelModels{});
   active_ = true;
   return {};
@@ -1167,6 +1367,8 @@ Status AttributeDecoder::read_values(std::span<const uint8_t> payload, const Edi
     return tl::unexpected(parse_error("not a values record"));
   if (part == kAttributePartValues && normals_exact_ != exact_vertices_)
     return tl::unexpected(parse_error("values record with normals after one without"));
+  if (low_bits_pending_)
+    return tl::unexpected(parse_error("values record before the base's low bits"));
   Reader r{payload, 2};
   const uint32_t count = r.varint();
   if (!r.ok) return tl::unexpected(parse_error("values record truncated"));
@@ -1201,6 +1403,8 @@ Status AttributeDecoder::read_normals(std::span<const uint8_t> payload, const Ed
   if (!active_)
     return tl::unexpected(parse_error("normals record before the base attribute record"));
   if (complete_) return tl::unexpected(parse_error("normals record after the final one"));
+  if (low_bits_pending_)
+    return tl::unexpected(parse_error("normals record before the base's low bits"));
   Reader r{payload, 2};
   const uint32_t count = r.varint();
   if (!r.ok) return tl::unexpected(parse_error("normals record truncated"));
@@ -1270,14 +1474,43 @@ void AttributeDecoder::refresh_normal_previews(const EditableMesh& m) {
     const AttributeChannel& c = layout_.channels[ch];
     if (c.kind != AttributeKind::kNormal) continue;
     for (uint32_t v : stale) {
-      // Inserted vertices have one wedge.
-      const uint32_t w = c.per_corner ? values_.wedge_start[v] : v;
-      predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
-      values_.data[ch][2 * size_t(w)] = pred[0];
-      values_.data[ch][2 * size_t(w) + 1] = pred[1];
+      // Inserted vertices have one wedge, base vertices (version 13's
+      // normals wait for them too) one or more.
+      const uint32_t w0 = c.per_corner ? values_.wedge_start[v] : v;
+      const uint32_t w1 = c.per_corner ? values_.wedge_start[v + 1] : v + 1;
+      for (uint32_t w = w0; w < w1; ++w) {
+        predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+        values_.data[ch][2 * size_t(w)] = pred[0];
+        values_.data[ch][2 * size_t(w) + 1] = pred[1];
+      }
     }
   }
   normals_refreshed_ = now;
+}
+
+Status AttributeDecoder::read_low_bits(std::span<const uint8_t> payload) {
+  if (!active_)
+    return tl::unexpected(parse_error("low-bits record before the base attribute record"));
+  if (!low_bits_pending_)
+    return tl::unexpected(parse_error("low-bits record without coarse base values to refine"));
+  Reader r{payload, 2};
+  const uint32_t count = r.varint();
+  if (!r.ok || count != base_vertices_)
+    return tl::unexpected(parse_error("low-bits record for " + std::to_string(count) +
+                                      " vertices where the base has " +
+                                      std::to_string(base_vertices_)));
+  for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
+    const AttributeChannel& c = layout_.channels[ch];
+    if (!(c.flags & kBaseCoarse)) continue;
+    auto bytes = r.section();
+    if (!r.ok) return tl::unexpected(parse_error("low-bits section truncated"));
+    LowBitCoder coder(layout_, ch);
+    if (auto s = coder.decode(base_mesh_, values_, base_vertices_, bytes); !s) return s;
+  }
+  if (r.pos != payload.size()) return tl::unexpected(parse_error("bytes after a low-bits record"));
+  low_bits_pending_ = false;
+  base_mesh_ = EditableMesh{};
+  return {};
 }
 
 Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const EditableMesh& full) {
@@ -1285,6 +1518,8 @@ Status AttributeDecoder::read_final(std::span<const uint8_t> payload, const Edit
   if (complete_) return tl::unexpected(parse_error("a second final attribute record"));
   if (payload.size() < 2 || payload[1] != kAttributePartFinal)
     return tl::unexpected(parse_error("unknown attribute record part"));
+  if (low_bits_pending_)
+    return tl::unexpected(parse_error("final attribute record before the base's low bits"));
   Reader r{payload, 2};
   const uint32_t n = full.vertex_count();
   // Back to the exact values (the base's and the values records'); every

@@ -20,7 +20,11 @@
 // models that persist from one values record to the next; they are sized
 // like the geometry records (at most 1.5 % of the stream each). From
 // version 12 on they leave the normals out; normals records after the last
-// geometry record carry them, predicted on the complete mesh. The last
+// geometry record carry them, predicted on the complete mesh; from version
+// 13 on record 1 leaves the base's normals to those records too
+// (kBaseNormalsLate); from version 14 on it carries the base's texture
+// coordinates coarse (kBaseCoarse), and a low-bits record before the first
+// values record makes them exact. The last
 // record carries the exact values of the vertices inserted after the last
 // values record (version 10: of every inserted vertex) and the extra
 // attributes (zstd). Until its values arrive the decoder shows each
@@ -59,9 +63,12 @@ inline constexpr uint8_t kAttributePartValues = 2;  // after geometry records (v
 // of those values records, predicted on the complete mesh.
 inline constexpr uint8_t kAttributePartValuesLateNormals = 3;
 inline constexpr uint8_t kAttributePartNormals = 4;
+// Version 14 on: the low bits of the base's values of the channels record 1
+// carries coarse (kBaseCoarse), before any values, normals or final record.
+inline constexpr uint8_t kAttributePartLowBits = 5;
 inline bool is_values_part(uint8_t part) {
   return part == kAttributePartValues || part == kAttributePartValuesLateNormals ||
-         part == kAttributePartNormals;
+         part == kAttributePartNormals || part == kAttributePartLowBits;
 }
 // A values record is closed at about this share of the expected stream
 // (the record-size rule: no record beyond the base above 2 % of it).
@@ -79,13 +86,30 @@ const char* attribute_kind_name(AttributeKind kind);
 // records after it predict texture coordinates from the geometry.
 inline constexpr uint8_t kPredictBaseAlternative = 2;
 inline constexpr uint8_t kPredictLaterFromGeometry = 4;
+// A normal channel's flag (version 13 on): record 1 has no section for it;
+// the base vertices' normals come after every geometry record with the
+// inserted vertices', in the normals records (from vertex 0), predicted on
+// the complete mesh. Until then the decoder shows the geometric normal of
+// each wedge on the mesh it has. The first display with colours or
+// texture then waits for no normal (bench/REPORT.md, "first display").
+inline constexpr uint8_t kBaseNormalsLate = 8;
+// A texture coordinate channel's flag (version 14 on): record 1 carries the
+// base's values without their low `base_shift` bits (a u8 after the bits in
+// the layout), coded on the coarser grid; a low-bits record
+// (kAttributePartLowBits) brings them before the first values record. The
+// first display shows the coarse value at the middle of its range.
+inline constexpr uint8_t kBaseCoarse = 16;
+// The coarse grid record 1 uses for texture coordinates of more bits (the
+// first display shows the small texture level: 1/256 of the UV box).
+inline constexpr int kBaseCoarseBits = 8;
 
 struct AttributeChannel {
   AttributeKind kind = AttributeKind::kColor;
   bool per_corner = false;
   uint8_t bits = 8;  // quantization bits (normals: per octahedral coordinate); unused for materials
   TexcoordGrid uv;   // texture coordinates only
-  uint8_t flags = 0;  // kPredict* bits (last: the aggregate initializers above it)
+  uint8_t flags = 0;       // kPredict* bits (last: the aggregate initializers above it)
+  uint8_t base_shift = 0;  // kBaseCoarse: the low bits record 1 leaves out
   uint32_t components() const {
     return kind == AttributeKind::kColor ? 4 : kind == AttributeKind::kMaterial ? 1 : 2;
   }
@@ -198,6 +222,8 @@ class AttributeDecoder {
   // records'; their normals may still be to come: normals_exact_vertices).
   uint32_t exact_vertices() const { return exact_vertices_; }
   uint32_t normals_exact_vertices() const { return normals_exact_; }
+  // A low-bits record (kAttributePartLowBits): the base's values exact.
+  Status read_low_bits(std::span<const uint8_t> payload);
   // The last record, on the complete mesh.
   Status read_final(std::span<const uint8_t> payload, const EditableMesh& full);
   // Writes every attribute array of `out` for `m` (whose vertices all have
@@ -224,6 +250,8 @@ class AttributeDecoder {
   uint32_t exact_vertices_ = 0;
   uint32_t normals_exact_ = 0;      // vertices whose normals are exact (<= exact_vertices_)
   uint32_t normals_refreshed_ = 0;  // refresh_normal_previews saw the vertices below
+  bool low_bits_pending_ = false;   // record 1 had coarse channels, their low bits not come
+  EditableMesh base_mesh_;          // record 1's mesh, kept while low_bits_pending_
   std::vector<AttributeChannelModels> values_models_;  // the values records', persistent
   std::vector<ExtraAttribute> extras_;
 };

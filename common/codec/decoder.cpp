@@ -141,6 +141,10 @@ struct IncrementalDecoder::State {
       if (attributes_final)
         return make_error(ErrorCode::kParse, "attribute values record after the final one");
       if (auto s = attributes.read_values(payload, refine->mesh); !s) return s;
+    } else if (part == kAttributePartLowBits) {
+      if (attributes_final)
+        return make_error(ErrorCode::kParse, "attribute low-bits record after the final one");
+      if (auto s = attributes.read_low_bits(payload); !s) return s;
     } else if (part == kAttributePartNormals) {
       if (attributes_final)
         return make_error(ErrorCode::kParse, "attribute normals record after the final one");

@@ -277,25 +277,32 @@ TEST(AttributeCodec, NormalsComeInNormalsRecordsAfterTheGeometry) {
   expect_valid_prefixes(*stream);
 }
 
-// Version 12: record 1 predicts the base's normals from the decoded
-// neighbours' normals where that codes smaller than the geometric normal of
-// the base's coarse positions (layout flag kPredictBaseAlternative). Draco's textured sphere, all
-// of whose vertices are seam vertices and stay in the base, takes it (its normals cost 2 730 bytes
-// with the geometric prediction, 1 501 with it, bench/REPORT.md); it comes back exactly either way.
-TEST(AttributeCodec, BaseNormalsFromNeighboursWhereTheyCodeSmaller) {
-  std::filesystem::path file;
-  if (!testing::test_mesh_dir().empty())
-    file = std::filesystem::path(testing::test_mesh_dir()) / ".." / "models" /
-           "SphereWithCircleTexture" / "sphere_with_circle_texture.gltf";
-  if (file.empty() || !std::filesystem::exists(file))
-    GTEST_SKIP() << "../shared/models/SphereWithCircleTexture not found (set "
-                    "MESHSTREAM_TEST_MESHES)";
-  auto imported = import_mesh(file.string());
-  ASSERT_TRUE(imported) << imported.error().message;
-  const Mesh& sphere = imported->mesh;
-  EncodeOptions o;
-  o.asa_guidance = false;
-  auto stream = encode_hcs(sphere, o);
+// The layout flags byte of channel `ch` in record 1's payload (the layout
+// section: varint length, channel count, then per channel kind, flags,
+// bits and for texture coordinates 16 bytes of grid).
+uint8_t layout_flags(std::span<const uint8_t> payload, AttributeKind kind) {
+  size_t pos = 2;
+  uint32_t length = 0;
+  if (!get_varint(payload, pos, length)) return 0xFF;
+  const size_t end = pos + length;
+  const uint32_t count = payload[pos++];
+  for (uint32_t i = 0; i < count && pos + 3 <= end; ++i) {
+    const uint8_t k = payload[pos], flags = payload[pos + 1];
+    if (k == uint8_t(kind)) return flags;
+    pos += 3 + (k == uint8_t(AttributeKind::kTexcoord) ? 16 : 0);
+  }
+  return 0xFF;
+}
+
+// Version 13: record 1 leaves the base's normals out (layout flag
+// kBaseNormalsLate, no section for them); the normals records, after every
+// geometry record, bring them from vertex 0, coded on the complete mesh.
+// Until then each wedge shows its geometric normal (every prefix valid; on
+// the cube's flat wedges the face's own normal), and the full-rate decode is
+// exact.
+void expect_base_normals_late(const Mesh& mesh, const EncodeOptions& o, bool flat_wedges) {
+  EncodeReport report;
+  auto stream = encode_hcs(mesh, o, &report);
   ASSERT_TRUE(stream) << stream.error().message;
   auto index = read_stream_index(*stream);
   ASSERT_TRUE(index);
@@ -305,20 +312,153 @@ TEST(AttributeCodec, BaseNormalsFromNeighboursWhereTheyCodeSmaller) {
   ASSERT_GE(payload.size(), 8u);
   EXPECT_EQ(payload[0], kRecordAttributes);
   EXPECT_EQ(payload[1], kAttributePartBase);
-  // The layout section: varint length, channel count, then per channel its
-  // kind and flags byte (normals first).
-  size_t pos = 2;
-  uint32_t length = 0;
-  ASSERT_TRUE(get_varint(payload, pos, length));
-  ASSERT_EQ(payload[pos + 1], uint8_t(AttributeKind::kNormal));
-  const uint8_t flags = payload[pos + 2];
-  EXPECT_TRUE(flags & 1) << "per corner";
-  EXPECT_TRUE(flags & kPredictBaseAlternative) << "record 1: the neighbours' normals";
+  const uint8_t flags = layout_flags(payload, AttributeKind::kNormal);
+  ASSERT_NE(flags, 0xFF) << "no normals in the layout";
+  EXPECT_TRUE(flags & kBaseNormalsLate);
+  EXPECT_FALSE(flags & kPredictBaseAlternative) << "record 1 codes no normals";
+  auto parts = attribute_record_parts(payload, {}, {});
+  ASSERT_TRUE(parts) << parts.error().message;
+  EXPECT_EQ(parts->count("normals") ? parts->at("normals") : 0, 0u);
+  EXPECT_GT(report.attribute_bytes["normals"], 0u) << "the normals travel later";
+  // The first normals record starts at vertex 0 and follows every geometry
+  // record.
+  size_t last_geometry = 0, first_normals = 0;
+  uint32_t first_count = 0;
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const RecordEntry& e = index->records[i];
+    const auto p = record_payload(e, {stream->data() + e.offset, e.size});
+    if (p.empty() || p[0] != kRecordAttributes) {
+      if (!p.empty() && p[0] != kRecordTexture) last_geometry = i;
+      continue;
+    }
+    if (p[1] == kAttributePartNormals && first_normals == 0) {
+      first_normals = i;
+      size_t pos = 2;
+      ASSERT_TRUE(get_varint(p, pos, first_count));
+    }
+  }
+  ASSERT_GT(first_normals, 0u) << "no normals record";
+  EXPECT_GT(first_normals, last_geometry);
+  EXPECT_GE(first_count, 1u);
   auto decoded = decode_hcs(*stream);
   ASSERT_TRUE(decoded) << decoded.error().message;
-  Mesh expected = expected_mesh(sphere, o);
-  expected.textures = sphere.textures;
+  Mesh expected = expected_mesh(mesh, o);
+  expected.textures = mesh.textures;
   EXPECT_TRUE(faces_of(*decoded) == faces_of(expected));
+  expect_valid_prefixes(*stream);
+  if (!flat_wedges) return;
+  // Record 1's prefix: every corner's normal is its wedge's geometric
+  // normal on the base, which on flat wedges is the face's own.
+  IncrementalDecoder inc;
+  ASSERT_TRUE(inc.feed(std::span<const uint8_t>(*stream).subspan(0, r.offset + r.size)));
+  const Mesh& first = inc.mesh();
+  ASSERT_EQ(first.corner_normals.corners.size(), 3 * first.triangles.size());
+  for (size_t f = 0; f < first.triangles.size(); ++f) {
+    const Vec3f& a = first.positions[first.triangles[f][0]];
+    const Vec3f& b = first.positions[first.triangles[f][1]];
+    const Vec3f& c = first.positions[first.triangles[f][2]];
+    const Vec3f u{b.x - a.x, b.y - a.y, b.z - a.z}, v{c.x - a.x, c.y - a.y, c.z - a.z};
+    Vec3f g{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    const float l = std::sqrt(g.x * g.x + g.y * g.y + g.z * g.z);
+    ASSERT_GT(l, 0);
+    for (int k = 0; k < 3; ++k) {
+      const Vec3f& n = first.corner_normals.values[first.corner_normals.corners[3 * f + k]];
+      EXPECT_GT((n.x * g.x + n.y * g.y + n.z * g.z) / l, 0.98f) << "face " << f << " corner " << k;
+    }
+  }
+}
+
+TEST(AttributeCodec, BaseNormalsLateOnTheFacetedCube) {
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  o.asa_guidance = false;
+  expect_base_normals_late(faceted_cube(8), o, true);
+}
+
+// Draco's textured sphere: every vertex is a seam vertex and stays in the
+// base (no geometry records with vertices), so its normals all travel in
+// the normals records (version 12 coded them in record 1, from the
+// neighbours' normals: 1 479 bytes; now 503 on the exact positions).
+TEST(AttributeCodec, BaseNormalsLateOnDracosSphere) {
+  std::filesystem::path file;
+  if (!testing::test_mesh_dir().empty())
+    file = std::filesystem::path(testing::test_mesh_dir()) / ".." / "models" /
+           "SphereWithCircleTexture" / "sphere_with_circle_texture.gltf";
+  if (file.empty() || !std::filesystem::exists(file))
+    GTEST_SKIP() << "../shared/models/SphereWithCircleTexture not found (set "
+                    "MESHSTREAM_TEST_MESHES)";
+  auto imported = import_mesh(file.string());
+  ASSERT_TRUE(imported) << imported.error().message;
+  EncodeOptions o;
+  o.asa_guidance = false;
+  expect_base_normals_late(imported->mesh, o, false);
+}
+
+// Version 14: record 1 carries the base's 12-bit texture coordinates on an
+// 8-bit grid (layout flag kBaseCoarse, shift 4), shown at the middle of the
+// missing bits' range; the low-bits record brings the rest before the
+// first values record, after which the base's values are exact.
+TEST(AttributeCodec, CoarseBaseTexcoordsThenTheirLowBits) {
+  const Mesh cube = faceted_cube(8);
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  o.asa_guidance = false;
+  auto stream = encode_hcs(cube, o);
+  ASSERT_TRUE(stream) << stream.error().message;
+  auto index = read_stream_index(*stream);
+  ASSERT_TRUE(index);
+  const RecordEntry& r1 = index->records[1];
+  const auto payload = record_payload(r1, {stream->data() + r1.offset, r1.size});
+  const uint8_t flags = layout_flags(payload, AttributeKind::kTexcoord);
+  ASSERT_NE(flags, 0xFF);
+  EXPECT_TRUE(flags & kBaseCoarse);
+  size_t low = 0, first_values = 0;
+  for (size_t i = 2; i < index->records.size(); ++i) {
+    const RecordEntry& e = index->records[i];
+    const auto p = record_payload(e, {stream->data() + e.offset, e.size});
+    if (p.size() < 2 || p[0] != kRecordAttributes) continue;
+    if (p[1] == kAttributePartLowBits) {
+      EXPECT_EQ(low, 0u) << "one low-bits record";
+      low = i;
+    }
+    if ((p[1] == kAttributePartValues || p[1] == kAttributePartValuesLateNormals) &&
+        first_values == 0)
+      first_values = i;
+  }
+  ASSERT_GT(low, 1u) << "no low-bits record";
+  ASSERT_GT(first_values, 0u);
+  EXPECT_LT(low, first_values) << "the values are predicted from the exact base";
+  auto prefix = [&](size_t last) {
+    IncrementalDecoder d;
+    const RecordEntry& e = index->records[last];
+    EXPECT_TRUE(d.feed(std::span<const uint8_t>(*stream).subspan(0, e.offset + e.size)));
+    return d.mesh().corner_texcoords.values;
+  };
+  const std::vector<Vec2f> coarse = prefix(1), refined = prefix(low);
+  auto whole = decode_hcs(*stream);
+  ASSERT_TRUE(whole) << whole.error().message;
+  ASSERT_FALSE(coarse.empty());
+  ASSERT_GE(refined.size(), coarse.size());
+  ASSERT_GE(whole->corner_texcoords.values.size(), coarse.size());
+  // Half the coarse step: 2^3 steps of the 12-bit grid over the UV box.
+  float lo = 1e9f, hi = -1e9f;
+  for (const Vec2f& t : cube.corner_texcoords.values) {
+    lo = std::min({lo, t.x, t.y});
+    hi = std::max({hi, t.x, t.y});
+  }
+  const float half = 8 * (hi - lo) / 4095 * 1.01f;
+  size_t differ = 0;
+  for (size_t w = 0; w < coarse.size(); ++w) {
+    EXPECT_LE(std::abs(coarse[w].x - refined[w].x), half) << w;
+    EXPECT_LE(std::abs(coarse[w].y - refined[w].y), half) << w;
+    differ += coarse[w].x != refined[w].x || coarse[w].y != refined[w].y;
+    EXPECT_EQ(refined[w].x, whole->corner_texcoords.values[w].x) << "base wedge " << w;
+    EXPECT_EQ(refined[w].y, whole->corner_texcoords.values[w].y) << "base wedge " << w;
+  }
+  EXPECT_GT(differ, 0u) << "record 1 carried them exactly";
+  Mesh expected = expected_mesh(cube, o);
+  expected.textures = cube.textures;
+  EXPECT_TRUE(faces_of(*whole) == faces_of(expected));
   expect_valid_prefixes(*stream);
 }
 
@@ -356,6 +496,54 @@ TEST(AttributeCodec, MeshWithoutAttributesHasNoAttributeRecords) {
   for (const RecordEntry& r : index->records) EXPECT_NE((*stream)[r.offset], kRecordAttributes);
 }
 
+// EncodeOptions::measure_unlocked_seams (a measurement for bench/REPORT.md):
+// false is the default stream byte for byte, seam vertices locked into the
+// base; true decimates through the seams (a smaller base than the locked
+// vertices) and writes the geometry alone, which decodes to the same
+// positions and face count.
+TEST(AttributeCodec, MeasureUnlockedSeamsOffChangesNothingOnRemovesTheLocks) {
+  const Mesh cube = faceted_cube(8);
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  o.asa_guidance = false;
+  EncodeReport report;
+  auto by_default = encode_hcs(cube, o, &report);
+  ASSERT_TRUE(by_default) << by_default.error().message;
+  EncodeOptions off = o;
+  off.measure_unlocked_seams = false;
+  auto locked = encode_hcs(cube, off);
+  ASSERT_TRUE(locked) << locked.error().message;
+  EXPECT_TRUE(*locked == *by_default) << "false must leave the stream unchanged";
+  auto locked_index = read_stream_index(*locked);
+  ASSERT_TRUE(locked_index);
+  // Every vertex on the cube's edges is a seam vertex (normals, UV islands
+  // and materials change there), locked into the base.
+  const uint32_t locked_vertices = report.attribute_locked_vertices;
+  EXPECT_EQ(locked_vertices, 12u * 7 + 8);
+  EXPECT_GE(locked_index->header.base_vertex_count, locked_vertices);
+
+  EncodeOptions on = o;
+  on.measure_unlocked_seams = true;
+  auto unlocked = encode_hcs(cube, on);
+  ASSERT_TRUE(unlocked) << unlocked.error().message;
+  auto index = read_stream_index(*unlocked);
+  ASSERT_TRUE(index);
+  EXPECT_LT(index->header.base_vertex_count, locked_vertices) << "seam vertices were decimated";
+  for (const RecordEntry& r : index->records) EXPECT_NE((*unlocked)[r.offset], kRecordAttributes);
+  auto a = decode_hcs(*locked);
+  auto b = decode_hcs(*unlocked);
+  ASSERT_TRUE(a && b);
+  auto sorted = [](std::vector<Vec3f> p) {
+    std::sort(p.begin(), p.end(), [](const Vec3f& x, const Vec3f& y) {
+      return std::tie(x.x, x.y, x.z) < std::tie(y.x, y.y, y.z);
+    });
+    return p;
+  };
+  EXPECT_TRUE(sorted(a->positions) == sorted(b->positions));
+  EXPECT_EQ(a->triangles.size(), b->triangles.size());
+  EXPECT_TRUE(b->corner_normals.empty() && b->colors.empty());
+}
+
 TEST(AttributeCodec, BadQuantizationBitsAreRefused) {
   EncodeOptions o;
   o.quant_color = 1;
@@ -389,14 +577,25 @@ TEST(AttributeCodec, DamagedAttributeRecordsAreRefused) {
   ASSERT_TRUE(get_varint(*stream, pos, layout_length));
   const uint64_t layout_at = pos;
   const Damage damages[] = {
-      {first.offset + 1, 1, "before the mesh is complete"},     // base part claims to be the final
-      {first.offset + 3, 0xFF, "attribute record"},             // layout length past the record
-      {layout_at + 1, 9, "unknown attribute kind"},             // first channel's kind
-      {layout_at + 3, 40, "quantization bits"},                 // first channel's bits
-      {last.offset + 1, 0, "after a geometry record"},          // final part claims to be the base
+      {first.offset + 1, 1, "before the mesh is complete"},  // base part claims to be the final
+      {first.offset + 3, 0xFF, "attribute record"},          // layout length past the record
+      {layout_at + 1, 9, "unknown attribute kind"},          // first channel's kind
+      {layout_at + 3, 40, "quantization bits"},              // first channel's bits
+      {layout_at + 2, 0x11, "unknown prediction flags"},     // normals: bit 4
+      {layout_at + 2, 1, "attribute record"},           // normals without bit 3: a section missing
+      {last.offset + 1, 0, "after a geometry record"},  // final part claims to be the base
       {last.offset + last.size - 6, 0xFF, "attribute record"},  // the zstd frame's end
   };
-  for (const Damage& d : damages) {
+  // The low-bits record (version 14) claiming to be a values record.
+  std::vector<Damage> all(std::begin(damages), std::end(damages));
+  for (const RecordEntry& e : index->records)
+    if ((*stream)[e.offset] == kRecordAttributes &&
+        (*stream)[e.offset + 1] == kAttributePartLowBits) {
+      all.push_back({e.offset + 1, kAttributePartValuesLateNormals, "before the base's low bits"});
+      all.push_back({e.offset + 2, 7, "low-bits record for 7 vertices"});
+    }
+  EXPECT_EQ(all.size(), std::size(damages) + 2) << "one low-bits record";
+  for (const Damage& d : all) {
     std::vector<uint8_t> bad = *stream;
     bad[d.at] = d.value;
     reseal_checksums(bad);

@@ -17,7 +17,18 @@
 //                 format keeps version-11 streams decoding;
 //   container3_v12_* the same cube at kEncoderVersion 12 (normals leave the
 //                 values records for a normals record coded on the complete
-//                 mesh; UV predicted from the geometry).
+//                 mesh; UV predicted from the geometry);
+//   container3_v12_sphere_neighbour_normals.hcs Draco's textured sphere
+//                 (SphereWithCircleTexture, Apache-2.0) at kEncoderVersion
+//                 12, `meshstream encode --no-asa-guidance`: record 1 codes
+//                 the base's normals from the neighbours' normals (layout
+//                 flag bit 1), which version 13 no longer writes;
+//   container3_v13_* the faceted cube at kEncoderVersion 13 (record 1
+//                 without the base's normals, which come in the normals
+//                 record from vertex 0);
+//   container3_v14_* the faceted cube at kEncoderVersion 14 (record 1's
+//                 texture coordinates on an 8-bit grid, their low bits in
+//                 a low-bits record before the first values record).
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -27,6 +38,8 @@
 #include <iterator>
 #include <string>
 
+#include "common/codec/attribute_codec.h"
+#include "common/codec/byte_io.h"
 #include "common/codec/container.h"
 #include "common/codec/container_reseal.h"
 #include "common/codec/decoder.h"
@@ -186,6 +199,55 @@ TEST(LegacyStreams, VersionElevenValuesRecordsDecodeAsWhenWritten) {
 TEST(LegacyStreams, VersionTwelveNormalsRecordsDecodeAsWhenWritten) {
   expect_attributes_decode_as_when_written("container3_v12_faceted_cube_attributes.hcs",
                                            0x52ce8058599d568full, 5);
+}
+
+// Version 14: record 1 with coarse texture coordinates, a low-bits record
+// before the first of four values records, one normals record.
+TEST(LegacyStreams, VersionFourteenCoarseBaseDecodeAsWhenWritten) {
+  expect_attributes_decode_as_when_written("container3_v14_faceted_cube_attributes.hcs",
+                                           0x52ce8058599d568full, 6);
+}
+
+// Version 13: record 1 without normals (layout flag bit 3), four values
+// records without normals, one normals record from vertex 0.
+TEST(LegacyStreams, VersionThirteenBaseNormalsLateDecodeAsWhenWritten) {
+  expect_attributes_decode_as_when_written("container3_v13_faceted_cube_attributes.hcs",
+                                           0x52ce8058599d568full, 5);
+}
+
+// Version 12's record 1 with the base's normals predicted from the decoded
+// neighbours' normals (flag bit 1 on the normals): the decoder keeps that
+// prediction for such streams.
+TEST(LegacyStreams, VersionTwelveNeighbourNormalsDecodeAsWhenWritten) {
+  const std::vector<uint8_t> bytes = read_sample("container3_v12_sphere_neighbour_normals.hcs");
+  auto index = read_stream_index(bytes);
+  ASSERT_TRUE(index) << index.error().message;
+  ASSERT_GT(index->records.size(), 1u);
+  const RecordEntry& r1 = index->records[1];
+  const auto payload = record_payload(r1, {bytes.data() + r1.offset, r1.size});
+  // Layout: varint length, channel count, normals first: kind, flags.
+  ASSERT_GE(payload.size(), 6u);
+  ASSERT_EQ(payload[0], kRecordAttributes);
+  size_t pos = 2;
+  uint32_t length = 0;
+  ASSERT_TRUE(get_varint(payload, pos, length));
+  ASSERT_EQ(payload[pos + 1], uint8_t(AttributeKind::kNormal));
+  EXPECT_EQ(payload[pos + 2], 1 | kPredictBaseAlternative);
+  IncrementalDecoder dec;
+  for (const RecordEntry& r : index->records) {
+    const uint64_t from = r.offset == index->payload_offset ? 0 : r.offset;
+    auto fed = dec.feed(std::span<const uint8_t>(bytes).subspan(from, r.offset + r.size - from));
+    ASSERT_TRUE(fed) << fed.error().message;
+    ASSERT_TRUE(check_attribute_counts(dec.mesh()));
+  }
+  ASSERT_TRUE(dec.finished());
+  constexpr uint64_t kHash = 0x09209576d7d677d2ull;
+  EXPECT_EQ(attribute_hash(dec.mesh()), kHash)
+      << "hash 0x" << std::hex << attribute_hash(dec.mesh());
+  auto whole = decode_hcs(bytes);
+  ASSERT_TRUE(whole) << whole.error().message;
+  EXPECT_EQ(attribute_hash(*whole), kHash);
+  ASSERT_EQ(whole->textures.size(), 1u);
 }
 
 }  // namespace
