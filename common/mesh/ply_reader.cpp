@@ -520,9 +520,12 @@ class BodyParser {
     double count_value = 0;
     float unused = 0;
     if (!reader_.read(property.count_type, count_value, unused)) return body_error(at.str());
-    if (count_value < 0 || count_value > 1e6) {
+    // Written this way round so a NaN length (a float count type) is refused
+    // too; a fractional one would be truncated in silence.
+    if (!(count_value >= 0 && count_value <= 1e6) || count_value != std::floor(count_value)) {
       return make_error(ErrorCode::kParse, at.str() + ": list length " +
-                                               std::to_string(count_value) + " is out of range");
+                                               std::to_string(count_value) +
+                                               " is not a whole number from 0 to 1000000");
     }
     polygon_.clear();
     for (uint32_t i = 0; i < static_cast<uint32_t>(count_value); ++i) {

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "common/mesh/import.h"
 #include "common/mesh/mesh_readers.h"
@@ -200,6 +201,26 @@ TEST(PlyReader, MalformedFilesAreRefused) {
   auto imported = import_mesh(file.path());
   ASSERT_FALSE(imported);
   EXPECT_EQ(imported.error().code, ErrorCode::kTruncated) << imported.error().message;
+}
+
+// A list length of a float type that is NaN or not whole is refused by name
+// (the fuzzer found a NaN length converted to an integer).
+TEST(PlyReader, FloatListLengthMustBeAWholeNumber) {
+  for (float length : {std::numeric_limits<float>::quiet_NaN(), 3.5f, -1.0f}) {
+    std::string s =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 1\n"
+        "property list float int vertex_indices\nend_header\n";
+    const float coords[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    s.append(reinterpret_cast<const char*>(coords), sizeof coords);
+    s.append(reinterpret_cast<const char*>(&length), sizeof length);
+    for (int32_t i : {0, 1, 2}) s.append(reinterpret_cast<const char*>(&i), sizeof i);
+    TempFile file("float_length.ply", s);
+    auto imported = import_mesh(file.path());
+    ASSERT_FALSE(imported) << length;
+    EXPECT_EQ(imported.error().code, ErrorCode::kParse) << imported.error().message;
+    EXPECT_THAT(imported.error().message, HasSubstr("list length")) << length;
+  }
 }
 
 }  // namespace
