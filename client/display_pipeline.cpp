@@ -121,18 +121,21 @@ void draw_whole_display(DisplayFrame& frame) {
 // margin is 0.6 degrees) and then draws the whole display anyway, so a
 // cull per re-run would cost O(V + F) on this thread for nothing. The
 // camera rests when no new camera came for twice the time between the last
-// two (a slow renderer sends them seconds apart), at least kRestMin.
+// two camera re-runs (a slow renderer, llvmpipe under Xvfb, sends them
+// seconds apart: an orbit there must not count as resting at every frame),
+// at least kRestMin and at most kRestMax (a gap longer than that starts a
+// new move).
 struct OwedCull {
   static constexpr Clock::duration kRestMin = std::chrono::milliseconds(200);
   static constexpr Clock::duration kRestMax = std::chrono::seconds(10);
   bool owed = false;
   std::shared_ptr<const Mesh> source;  // the mesh ASA refined for the owed frame
-  Clock::time_point last_rerun{};
-  Clock::duration interval{};  // between the last two camera-only re-runs; 0: one so far
+  std::optional<Clock::time_point> last_rerun;
+  Clock::duration interval{};  // between the last two camera-only re-runs; 0: none
 
   void camera_rerun(const std::shared_ptr<const Mesh>& refined) {
     const auto now = Clock::now();
-    interval = owed ? now - last_rerun : Clock::duration{};
+    interval = last_rerun && now - *last_rerun <= kRestMax ? now - *last_rerun : Clock::duration{};
     last_rerun = now;
     source = refined;
     owed = true;
@@ -140,10 +143,9 @@ struct OwedCull {
   void paid() {
     owed = false;
     source.reset();
-    interval = {};
   }
   Clock::time_point rest_at() const {
-    return last_rerun + std::clamp(2 * interval, kRestMin, kRestMax);
+    return last_rerun.value_or(Clock::time_point{}) + std::clamp(2 * interval, kRestMin, kRestMax);
   }
   // How long the pipeline may wait for news before the cull falls due.
   std::chrono::milliseconds wait_for(std::chrono::milliseconds idle) const {
