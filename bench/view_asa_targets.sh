@@ -85,8 +85,12 @@ events = [json.loads(l) for l in open(base + ".json") if l.startswith("{")]
 # Re-runs for the camera once the whole stream is decoded (--asa-complete
 # keeps ASA on there): the target's "at 3.5M decoded triangles".
 last_record = max((i for i, e in enumerate(events) if e.get("event") == "refinement"), default=-1)
-views = [e for e in events[last_record + 1:] if e.get("event") == "view"]
-early = sum(1 for e in events[:last_record] if e.get("event") == "view")
+after = [e for e in events[last_record + 1:] if e.get("event") == "view"]
+# asa_path "none": the renderer's cull once the camera rested (no ASA ran).
+views = [e for e in after if e.get("asa_path") != "none"]
+rests = [e for e in after if e.get("asa_path") == "none"]
+early = sum(1 for e in events[:last_record] if e.get("event") == "view" and e.get("asa_path") != "none")
+culls = sorted(e.get("cull_ms", 0) for e in views + rests if e.get("cull_ms", 0) > 0)
 ms = sorted(e.get("asa_ms", 0) for e in views)
 region = [e.get("region_faces", 0) for e in views]
 paths = {}
@@ -97,7 +101,8 @@ print(f"{base.split('/')[-1]}: {early} camera re-runs while streaming; on the co
       f"{len(views)} re-runs, asa_ms median "
       f"{statistics.median(ms) if ms else 0:.1f}, p90 {ms[int(0.9 * (len(ms) - 1))] if ms else 0:.1f}, "
       f"max {ms[-1] if ms else 0:.1f}; region faces median {statistics.median(region) if region else 0:.0f}; "
-      f"paths {paths}; {viewer[-1] if viewer else 'no viewer line'}")
+      f"paths {paths}; {len(culls)} pipeline culls ({len(rests)} at rest), cull_ms median "
+      f"{statistics.median(culls) if culls else 0:.1f}; {viewer[-1] if viewer else 'no viewer line'}")
 EOF
 done
 echo "load after orbits: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -255,7 +255,8 @@ class StreamingRun {
   // Pipeline thread, after each published frame: events and files.
   void on_frame(const DisplayFrame& frame, const FrameInfo& info) {
     if (!info.guidance_warning.empty()) log_.note("warning: " + info.guidance_warning);
-    if (!info.new_records && info.rerun) log_.view_update(frame, info, elapsed());
+    if (!info.new_records && (info.rerun || info.rest_cull))
+      log_.view_update(frame, info, elapsed());
     if (info.new_records) {
       last_frame_ = frame;
       ++display_updates_;

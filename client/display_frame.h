@@ -37,6 +37,11 @@ struct DisplayFrame {
   std::shared_ptr<const DisplayTopology> topology;
   double decode_ms = 0;
   double asa_ms = 0;
+  // The renderer's cull for this frame (display_cull.h, with the topology
+  // passes it needed); 0 when none ran: no renderer, no view-dependent ASA,
+  // or a camera-only re-run, whose cull is left to the frame published
+  // once the camera rests (FrameInfo::rest_cull).
+  double cull_ms = 0;
   uint32_t coalesced_updates = 0;  // decoder updates merged into this frame
   bool final = false;              // the stream is complete (or its budget reached)
   // The camera the display was refined for (view-dependent ASA) and that

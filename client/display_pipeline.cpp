@@ -1,5 +1,6 @@
 #include "client/display_pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -95,6 +96,65 @@ void cull_for_renderer(DisplayFrame& frame, const std::shared_ptr<const Mesh>& s
   frame.cull = culled.region;
   frame.topology = cache.display;
 }
+
+// Times cull_for_renderer into frame.cull_ms (0 when it culled nothing).
+void timed_cull_for_renderer(DisplayFrame& frame, const std::shared_ptr<const Mesh>& source,
+                             bool cull, TopologyCache& cache) {
+  const auto start = Clock::now();
+  cull_for_renderer(frame, source, cull, cache);
+  frame.cull_ms =
+      frame.topology ? std::chrono::duration<double, std::milli>(Clock::now() - start).count() : 0;
+}
+
+// The whole display as what the renderer draws, for any camera (a
+// camera-only re-run: the cull is owed until the camera rests).
+void draw_whole_display(DisplayFrame& frame) {
+  frame.drawn = frame.display;
+  frame.drawn_face_kind = frame.face_kind;
+  frame.cull = {};
+  frame.topology.reset();
+  frame.cull_ms = 0;
+}
+
+// While the viewer's camera moves, each re-run's display is drawn whole:
+// the window leaves a cull's region within a frame of an orbit (its eye
+// margin is 0.6 degrees) and then draws the whole display anyway, so a
+// cull per re-run would cost O(V + F) on this thread for nothing. The
+// camera rests when no new camera came for twice the time between the last
+// two camera re-runs (a slow renderer, llvmpipe under Xvfb, sends them
+// seconds apart: an orbit there must not count as resting at every frame),
+// at least kRestMin and at most kRestMax (a gap longer than that starts a
+// new move).
+struct OwedCull {
+  static constexpr Clock::duration kRestMin = std::chrono::milliseconds(200);
+  static constexpr Clock::duration kRestMax = std::chrono::seconds(10);
+  bool owed = false;
+  std::shared_ptr<const Mesh> source;  // the mesh ASA refined for the owed frame
+  std::optional<Clock::time_point> last_rerun;
+  Clock::duration interval{};  // between the last two camera-only re-runs; 0: none
+
+  void camera_rerun(const std::shared_ptr<const Mesh>& refined) {
+    const auto now = Clock::now();
+    interval = last_rerun && now - *last_rerun <= kRestMax ? now - *last_rerun : Clock::duration{};
+    last_rerun = now;
+    source = refined;
+    owed = true;
+  }
+  void paid() {
+    owed = false;
+    source.reset();
+  }
+  Clock::time_point rest_at() const {
+    return last_rerun.value_or(Clock::time_point{}) + std::clamp(2 * interval, kRestMin, kRestMax);
+  }
+  // How long the pipeline may wait for news before the cull falls due.
+  std::chrono::milliseconds wait_for(std::chrono::milliseconds idle) const {
+    if (!owed) return idle;
+    const auto left =
+        std::chrono::ceil<std::chrono::milliseconds>(rest_at() - Clock::now()).count();
+    return std::chrono::milliseconds(std::clamp<long long>(left, 1, idle.count()));
+  }
+};
 
 // The options differ in more than the camera and tolerance.
 bool asa_settings_changed(const PipelineSettings& a, const PipelineSettings& b) {
@@ -211,7 +271,9 @@ void DisplayPipeline::loop() {
   bool fresh_builder = false;            // the builder was replaced: its first build is a full one
   MeshViewFacts view_facts;              // of the newest decoded mesh (it holds it, as `last` does)
   TopologyCache topology;                // of the newest display mesh
-  while (decoded_.wait(seen_pokes, outcome_seen, std::chrono::milliseconds(200))) {
+  OwedCull owed;                         // `last` was published uncull'd (camera-only re-run)
+  constexpr std::chrono::milliseconds kIdleWait(200);
+  while (decoded_.wait(seen_pokes, outcome_seen, owed.wait_for(kIdleWait))) {
     const uint64_t pokes = decoded_.pokes();
     const bool rerun = pokes != seen_pokes;
     seen_pokes = pokes;
@@ -226,6 +288,20 @@ void DisplayPipeline::loop() {
       end_record = end_record_;
     }
     const bool pending = decoded_.has_pending();
+    if (owed.owed && last && !pending && !rerun && Clock::now() >= owed.rest_at()) {
+      // The camera rests: the newest display again, culled for its camera.
+      DisplayFrame frame = *last;
+      frame.decode_ms = 0;
+      frame.asa_ms = 0;
+      frame.coalesced_updates = 0;
+      timed_cull_for_renderer(frame, owed.source, true, topology);
+      owed.paid();
+      FrameInfo info;
+      info.rest_cull = true;
+      info.elapsed_ms = elapsed();
+      publish(frame, info);
+      last = frame;
+    }
     if (!pending && !(rerun && last) && (outcome_seen || !decoded_.outcome())) continue;
 
     if (!pending && !(rerun && last)) {
@@ -374,11 +450,18 @@ void DisplayPipeline::loop() {
     frame.pixel_tolerance = effective.asa_enabled ? info.build.pixel_tolerance : 0;
     frame.budget_limited = info.build.budget_limited;
     // Runs with ASA and a renderer hand it what the camera sees (--no-asa
-    // and --view-independent draw the whole mesh, as before).
-    cull_for_renderer(frame, effective.asa_enabled ? asa_input : frame.decoded,
-                      settings.view.cull_for_renderer && settings.view.dependent &&
-                          (settings.asa_enabled || settings.asa_guided),
-                      topology);
+    // and --view-independent draw the whole mesh, as before); a camera-only
+    // re-run owes its cull until the camera rests (OwedCull).
+    const std::shared_ptr<const Mesh>& refined = effective.asa_enabled ? asa_input : frame.decoded;
+    const bool cull = settings.view.cull_for_renderer && settings.view.dependent &&
+                      (settings.asa_enabled || settings.asa_guided);
+    if (cull && !pending && !options_changed) {
+      draw_whole_display(frame);
+      owed.camera_rerun(refined);
+    } else {
+      timed_cull_for_renderer(frame, refined, cull, topology);
+      owed.paid();
+    }
     info.elapsed_ms = elapsed();
     publish(frame, info);
     last = frame;

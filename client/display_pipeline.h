@@ -25,6 +25,9 @@ namespace meshstream::client {
 struct FrameInfo {
   bool new_records = false;  // it shows records the previous frame did not
   bool rerun = false;        // ASA options changed
+  // The camera came to rest after camera-only re-runs (which draw the
+  // whole display): the same display again, now culled for the renderer.
+  bool rest_cull = false;
   BuildReport build;
   // --asa auto: the setting the stream's guidance chose for this frame
   // ("" when not guided), and once, why the guidance was refused.

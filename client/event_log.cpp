@@ -95,6 +95,7 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
                      {"faces", fr.decoded->face_count()},
                      {"display_vertices", drawn_of(fr).vertex_count()},
                      {"display_faces", drawn_of(fr).face_count()},
+                     {"cull_ms", round3(fr.cull_ms)},
                      {"whole_display_vertices", fr.display->vertex_count()},
                      {"whole_display_faces", fr.display->face_count()},
                      {"decode_ms", round3(fr.decode_ms)},
@@ -126,11 +127,14 @@ void EventLog::view_update(const DisplayFrame& fr, const FrameInfo& info, double
   nlohmann::json j{{"event", "view"},
                    {"display_vertices", drawn_of(fr).vertex_count()},
                    {"display_faces", drawn_of(fr).face_count()},
+                   {"cull_ms", round3(fr.cull_ms)},
                    {"whole_display_vertices", fr.display->vertex_count()},
                    {"whole_display_faces", fr.display->face_count()},
                    {"asa_ms", round3(fr.asa_ms)},
                    {"region_faces", info.build.region_faces},
-                   {"asa_path", info.build.incremental ? "incremental" : "full"},
+                   {"asa_path", info.rest_cull           ? "none"
+                                : info.build.incremental ? "incremental"
+                                                         : "full"},
                    {"elapsed_ms", round3(elapsed_ms)}};
   add_view_fields(j, fr);
   line(j.dump());

@@ -42,7 +42,8 @@ class EventLog {
   void header(const StreamFacts& facts, double elapsed_ms);
   void record(const AppliedRecord& record, double elapsed_ms);
   void refinement(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms, double rate);
-  // A re-run of ASA without new records (camera or options changed): a
+  // A re-run of ASA without new records (camera or options changed), or
+  // the cull owed since camera-only re-runs once the camera rests: a
   // "view" event with --json, nothing otherwise.
   void view_update(const DisplayFrame& frame, const FrameInfo& info, double elapsed_ms);
   void reconnecting(const Error& error, int attempt);

@@ -206,6 +206,68 @@ TEST_F(ClientControlsTest, ViewerCameraAndToleranceReRunForThatView) {
   EXPECT_EQ(s.pipeline->pixel_tolerance(), 12.0f);
 }
 
+// With a renderer (--view), an update with new records is culled for it at
+// once, a re-run for a moved camera alone is not (the window draws the whole
+// display while its camera moves), and once the camera rests the pipeline
+// publishes that same display again, culled for that camera exactly as
+// cull_display culls it.
+TEST_F(ClientControlsTest, ACameraReRunOwesTheRenderersCullUntilTheCameraRests) {
+  Server server;
+  ASSERT_TRUE(server.start({"--models", dir_ / "models", "--cache", dir_ / "cache"}, dir_.path()))
+      << server.log();
+  PipelineSettings settings;
+  settings.asa_on_complete = true;
+  settings.view.cull_for_renderer = true;
+  Session s(server, settings);
+  ASSERT_TRUE(s.pipeline->wait_finished());
+  auto done = s.mailbox.take_newer(0);
+  ASSERT_TRUE(done && done->final && done->camera && done->drawn);
+  auto direct_cull = [](const DisplayFrame& frame, const AsaCamera& camera) {
+    auto source = analyze_source_topology(*frame.decoded);
+    auto display = analyze_display_topology(*frame.display, *source);
+    return cull_display(frame.display, frame.face_kind, *display, camera);
+  };
+  // New records: culled as they come.
+  EXPECT_TRUE(done->topology);
+  EXPECT_GT(done->cull_ms, 0);
+  EXPECT_TRUE(same_faces(*done->drawn, *direct_cull(*done, *done->camera).mesh));
+
+  AsaCamera close = *done->camera;
+  close.eye =
+      close.target + Vec3f{close.eye.z - close.target.z, 0.2f * (close.eye.y - close.target.y),
+                           close.target.x - close.eye.x} *
+                         0.4f;
+  s.pipeline->set_view_camera(close);
+  auto moved = s.mailbox.wait_newer(done->sequence);
+  ASSERT_TRUE(moved && moved->camera && moved->display);
+  EXPECT_EQ(moved->camera->eye, close.eye);
+  EXPECT_NE(moved->display, done->display) << "the camera move re-ran ASA";
+  EXPECT_EQ(moved->drawn, moved->display) << "a camera-only re-run draws the whole display";
+  EXPECT_EQ(moved->drawn_face_kind, moved->face_kind);
+  EXPECT_TRUE(moved->cull.everything);
+  EXPECT_FALSE(moved->topology);
+  EXPECT_EQ(moved->cull_ms, 0);
+
+  // Nothing more comes: the camera rests, and the cull it owed arrives.
+  auto rested = s.mailbox.wait_newer(moved->sequence);
+  ASSERT_TRUE(rested && rested->camera && rested->drawn);
+  EXPECT_EQ(rested->camera->eye, close.eye);
+  EXPECT_EQ(rested->display, moved->display) << "the same display, only culled";
+  EXPECT_EQ(rested->decoded, moved->decoded);
+  EXPECT_EQ(rested->asa_ms, 0);
+  EXPECT_GT(rested->cull_ms, 0);
+  EXPECT_TRUE(rested->topology);
+  EXPECT_FALSE(rested->cull.everything);
+  const CulledDisplay direct = direct_cull(*rested, close);
+  EXPECT_LT(direct.mesh->face_count(), rested->display->face_count())
+      << "this close-up leaves nothing out: the test shows nothing";
+  EXPECT_EQ(rested->drawn->face_count(), direct.mesh->face_count());
+  EXPECT_TRUE(same_faces(*rested->drawn, *direct.mesh));
+  // Paid once: no further frame while nothing changes.
+  std::this_thread::sleep_for(600ms);
+  EXPECT_FALSE(s.mailbox.take_newer(rested->sequence));
+}
+
 // Network reads never wait for ASA: with ASA far slower than the stream,
 // the network side has every record long before the pipeline is done, and
 // the pipeline shows the newest mesh, merging the records in between.
