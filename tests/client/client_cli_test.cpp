@@ -335,8 +335,11 @@ TEST_F(ClientCliTest, TheCompleteStreamIsShownAndSavedAsDecoded) {
 
   // The default (--asa auto) follows the stream's guidance and names the
   // setting it used in every refinement event.
-  for (const auto& e : full.events)
-    if (e["event"] == "refinement") EXPECT_TRUE(e.contains("asa")) << e.dump();
+  for (const auto& e : full.events) {
+    if (e["event"] == "refinement") {
+      EXPECT_TRUE(e.contains("asa")) << e.dump();
+    }
+  }
   // Fixed ASA (--asa on) post-processes every prefix.
   const CliRun part = client(fast_->address(), {"demo", "--json", "--asa", "on", "--percent-bytes",
                                                 "30", "--out", out / "part"});
