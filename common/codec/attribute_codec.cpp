@@ -498,6 +498,29 @@ void put_section(std::vector<uint8_t>& out, const std::vector<uint8_t>& bytes) {
   out.insert(out.end(), bytes.begin(), bytes.end());
 }
 
+// The slots of vertex v's values in channel c: its wedges [begin, end) in
+// a per-corner channel, else v alone.
+struct WedgeRange {
+  uint32_t begin, end;
+};
+WedgeRange wedges_of(const AttributeChannel& c, const AttributeValues& a, uint32_t v) {
+  return c.per_corner ? WedgeRange{a.wedge_start[v], a.wedge_start[v + 1]} : WedgeRange{v, v + 1};
+}
+
+// Vertex v's normals (channel ch) shown as the geometric normal of each of
+// its wedges on `m`, until their exact values come.
+void show_geometric_normals(const EditableMesh& m, AttributeValues& a, const AttributeLayout& l,
+                            size_t ch, uint32_t v, std::vector<uint32_t>& ring,
+                            std::vector<uint32_t>& corners) {
+  int32_t pred[4];
+  const auto [w0, w1] = wedges_of(l.channels[ch], a, v);
+  for (uint32_t w = w0; w < w1; ++w) {
+    predict(m, a, l, ch, v, w, Prediction::kGeometric, pred, ring, corners);
+    a.data[ch][2 * size_t(w)] = pred[0];
+    a.data[ch][2 * size_t(w) + 1] = pred[1];
+  }
+}
+
 // Codes (or decodes) the values of vertices [first, last) of channel ch, in
 // id order, wedges in order. Encoder: `truth` holds them. `persistent`:
 // the models to continue (values records), else fresh ones.
@@ -516,8 +539,7 @@ struct ValueCoder {
     RangeEncoder enc;
     int32_t pred[4];
     for (uint32_t v = first; v < last; ++v) {
-      const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
-      const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
+      const auto [w0, w1] = wedges_of(c, truth, v);
       for (uint32_t w = w0; w < w1; ++w) {
         const int ctx =
             predict(m, truth, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
@@ -539,8 +561,7 @@ struct ValueCoder {
     RangeDecoder dec(bytes);
     int32_t pred[4];
     for (uint32_t v = first; v < last; ++v) {
-      const uint32_t w0 = c.per_corner ? a.wedge_start[v] : v;
-      const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
+      const auto [w0, w1] = wedges_of(c, a, v);
       for (uint32_t w = w0; w < w1; ++w) {
         const int ctx =
             predict(m, a, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
@@ -583,11 +604,17 @@ struct LowBitCoder {
   BitModel* models(uint32_t component, int context) {
     return &tree[(size_t(component) * 3 + context) << shift];
   }
+  // Where `pred` lies against the range [lo, lo + 2^shift): below (0),
+  // above (1) or inside (2). It depends on the prediction alone, so the
+  // decoder knows it before the symbol.
+  int context_of(int32_t pred, int32_t lo) const {
+    return pred < lo ? 0 : pred > lo + (int32_t(1) << shift) - 1 ? 1 : 2;
+  }
   // Context and symbol of `value` in [lo, lo + 2^shift) against `pred`.
   std::pair<int, int32_t> symbol(int32_t pred, int32_t lo, int32_t value) const {
-    const int32_t hi = lo + (int32_t(1) << shift) - 1;
-    if (pred < lo) return {0, value - lo};
-    if (pred > hi) return {1, hi - value};
+    const int context = context_of(pred, lo);
+    if (context == 0) return {0, value - lo};
+    if (context == 1) return {1, lo + (int32_t(1) << shift) - 1 - value};
     return {2, (value - pred) & ((int32_t(1) << shift) - 1)};
   }
   int32_t value_of(int context, int32_t pred, int32_t lo, int32_t sym) const {
@@ -604,8 +631,7 @@ struct LowBitCoder {
     RangeEncoder enc;
     int32_t pred[4];
     for (uint32_t v = 0; v < base_n; ++v) {
-      const uint32_t w0 = c.per_corner ? truth.wedge_start[v] : v;
-      const uint32_t w1 = c.per_corner ? truth.wedge_start[v + 1] : v + 1;
+      const auto [w0, w1] = wedges_of(c, truth, v);
       for (uint32_t w = w0; w < w1; ++w) {
         predict(base, truth, layout, ch, v, w, prediction_of(c, true), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
@@ -631,15 +657,13 @@ struct LowBitCoder {
     RangeDecoder dec(bytes);
     int32_t pred[4];
     for (uint32_t v = 0; v < base_n; ++v) {
-      const uint32_t w0 = c.per_corner ? a.wedge_start[v] : v;
-      const uint32_t w1 = c.per_corner ? a.wedge_start[v + 1] : v + 1;
+      const auto [w0, w1] = wedges_of(c, a, v);
       for (uint32_t w = w0; w < w1; ++w) {
         predict(base, a, layout, ch, v, w, prediction_of(c, true), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
           int32_t& value = a.data[ch][w * n + i];
           const int32_t lo = (value >> shift) << shift;
-          // The symbol's context comes from the prediction alone.
-          const int context = pred[i] < lo ? 0 : pred[i] > lo + (int32_t(1) << shift) - 1 ? 1 : 2;
+          const int context = context_of(pred[i], lo);
           BitModel* m = models(i, context);
           uint32_t node = 1;
           for (int b = shift - 1; b >= 0; --b) node = 2 * node + uint32_t(dec.decode_bit(m[node]));
@@ -1327,16 +1351,8 @@ Status AttributeDecoder::read_base(std::span<const uint8_t> payload, const Edita
       // Version 13: the base's normals come later; each wedge shows its
       // geometric normal on the base meanwhile.
       normals_late = true;
-      int32_t pred[4];
-      for (uint32_t v = 0; v < n; ++v) {
-        const uint32_t w0 = c.per_corner ? values_.wedge_start[v] : v;
-        const uint32_t w1 = c.per_corner ? values_.wedge_start[v + 1] : v + 1;
-        for (uint32_t w = w0; w < w1; ++w) {
-          predict(base, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
-          values_.data[ch][2 * size_t(w)] = pred[0];
-          values_.data[ch][2 * size_t(w) + 1] = pred[1];
-        }
-      }
+      for (uint32_t v = 0; v < n; ++v)
+        show_geometric_normals(base, values_, layout_, ch, v, ring, corners);
       continue;
     }
     auto bytes = r.section();
@@ -1469,21 +1485,11 @@ void AttributeDecoder::refresh_normal_previews(const EditableMesh& m) {
   }
   std::sort(stale.begin(), stale.end());
   stale.erase(std::unique(stale.begin(), stale.end()), stale.end());
-  int32_t pred[4];
   for (size_t ch = 0; ch < layout_.channels.size(); ++ch) {
-    const AttributeChannel& c = layout_.channels[ch];
-    if (c.kind != AttributeKind::kNormal) continue;
-    for (uint32_t v : stale) {
-      // Inserted vertices have one wedge, base vertices (version 13's
-      // normals wait for them too) one or more.
-      const uint32_t w0 = c.per_corner ? values_.wedge_start[v] : v;
-      const uint32_t w1 = c.per_corner ? values_.wedge_start[v + 1] : v + 1;
-      for (uint32_t w = w0; w < w1; ++w) {
-        predict(m, values_, layout_, ch, v, w, Prediction::kGeometric, pred, ring, corners);
-        values_.data[ch][2 * size_t(w)] = pred[0];
-        values_.data[ch][2 * size_t(w) + 1] = pred[1];
-      }
-    }
+    if (layout_.channels[ch].kind != AttributeKind::kNormal) continue;
+    // Inserted vertices have one wedge, base vertices (version 13's
+    // normals wait for them too) one or more.
+    for (uint32_t v : stale) show_geometric_normals(m, values_, layout_, ch, v, ring, corners);
   }
   normals_refreshed_ = now;
 }
