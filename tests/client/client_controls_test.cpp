@@ -51,6 +51,17 @@ struct Session {
   }
 };
 
+// The fitted camera moved to 0.4 of its distance and turned about a
+// quarter round the target: a view the fit did not refine for.
+AsaCamera close_up_and_turned(const AsaCamera& fitted) {
+  AsaCamera close = fitted;
+  close.eye =
+      close.target + Vec3f{close.eye.z - close.target.z, 0.2f * (close.eye.y - close.target.y),
+                           close.target.x - close.eye.x} *
+                         0.4f;
+  return close;
+}
+
 class ClientControlsTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -179,11 +190,7 @@ TEST_F(ClientControlsTest, ViewerCameraAndToleranceReRunForThatView) {
   EXPECT_TRUE(same_faces(*done->display, expected_for(*done->camera, 2)));
 
   // The window's camera, close up and turned: the display follows it.
-  AsaCamera close = *done->camera;
-  close.eye =
-      close.target + Vec3f{close.eye.z - close.target.z, 0.2f * (close.eye.y - close.target.y),
-                           close.target.x - close.eye.x} *
-                         0.4f;
+  const AsaCamera close = close_up_and_turned(*done->camera);
   s.pipeline->set_view_camera(close);
   auto moved = s.mailbox.wait_newer(done->sequence);
   ASSERT_TRUE(moved && moved->camera);
@@ -232,11 +239,7 @@ TEST_F(ClientControlsTest, ACameraReRunOwesTheRenderersCullUntilTheCameraRests) 
   EXPECT_GT(done->cull_ms, 0);
   EXPECT_TRUE(same_faces(*done->drawn, *direct_cull(*done, *done->camera).mesh));
 
-  AsaCamera close = *done->camera;
-  close.eye =
-      close.target + Vec3f{close.eye.z - close.target.z, 0.2f * (close.eye.y - close.target.y),
-                           close.target.x - close.eye.x} *
-                         0.4f;
+  const AsaCamera close = close_up_and_turned(*done->camera);
   s.pipeline->set_view_camera(close);
   auto moved = s.mailbox.wait_newer(done->sequence);
   ASSERT_TRUE(moved && moved->camera && moved->display);
