@@ -69,12 +69,12 @@ uint64_t edges_touching_seams(const Mesh& m, const EncodeOptions& options) {
   return uint64_t(std::unique(edges.begin(), edges.end()) - edges.begin());
 }
 
-// Bytes of a stream's texture records (with their index entries' share:
-// the records' sizes), to leave out of the geometry.
-uint64_t texture_record_bytes(const std::vector<uint8_t>& stream, const StreamIndex& index) {
+// Bytes of a stream's records of one type after the base (kRecordTexture,
+// kRecordAttributes: the records' sizes), to leave out of the geometry.
+uint64_t record_bytes(const std::vector<uint8_t>& stream, const StreamIndex& index, uint8_t type) {
   uint64_t bytes = 0;
   for (size_t i = 1; i < index.records.size(); ++i)
-    if (stream[index.records[i].offset] == kRecordTexture) bytes += index.records[i].size;
+    if (stream[index.records[i].offset] == type) bytes += index.records[i].size;
   return bytes;
 }
 
@@ -116,7 +116,8 @@ std::string seam_row(const std::string& name, const Mesh& mesh, EncodeOptions op
     return "| " + name + " | unlocked encode failed: " + unlocked.error().message + " |\n";
   auto index = read_stream_index(*unlocked);
   if (!index) return "| " + name + " | unlocked index: " + index.error().message + " |\n";
-  const uint64_t unlocked_geometry = unlocked->size() - texture_record_bytes(*unlocked, *index);
+  const uint64_t unlocked_geometry =
+      unlocked->size() - record_bytes(*unlocked, *index, kRecordTexture);
   const uint64_t base = index->records[0].offset + index->records[0].size;
   const uint64_t bits = edges_touching_seams(mesh, options);
   // First display unlocked: its base plus record 1 of the locked stream
@@ -237,14 +238,11 @@ int main(int argc, char** argv) {
     for (const auto& [k, n] : report.attribute_bytes) attribute_total += n;
     // Attribute records with their index entries and trailers: the stream
     // minus the records' payload sections counted above is ours geometry.
-    uint64_t attribute_records = 0;
-    for (size_t i = 1; i < index->records.size(); ++i)
-      if ((*stream)[index->records[i].offset] == kRecordAttributes)
-        attribute_records += index->records[i].size;
+    const uint64_t attribute_records = record_bytes(*stream, *index, kRecordAttributes);
     const uint64_t ours_total = stream->size();
     // Textures excluded (Draco's geometry has none either).
     const uint64_t ours_geometry =
-        ours_total - attribute_records - texture_record_bytes(*stream, *index);
+        ours_total - attribute_records - record_bytes(*stream, *index, kRecordTexture);
     // The first display with attributes: through record 1 (record 0 when
     // the stream has none); without: the plain stream's base.
     const size_t shown =
