@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <set>
+#include <string_view>
 
 #include "common/mesh/export.h"
 #include "common/mesh/import.h"
@@ -65,9 +66,9 @@ void expect_round_trip(const Mesh& mesh, const Format& format, const std::string
   as_is.weld = false;
   // PLY and OFF hold attributes per vertex: a seam (per-corner values) is
   // written as vertex copies, which welding joins again into the same mesh.
-  const bool seams_split =
-      format.extension != ".obj" && (!mesh.corner_normals.empty() ||
-                                     !mesh.corner_texcoords.empty() || !mesh.corner_colors.empty());
+  const bool seams_split = std::string_view(format.extension) != ".obj" &&
+                           (!mesh.corner_normals.empty() || !mesh.corner_texcoords.empty() ||
+                            !mesh.corner_colors.empty());
   if (seams_split) as_is.weld = true;
   auto back = import_mesh(path, as_is);
   std::filesystem::remove(path);
