@@ -274,8 +274,7 @@ void Session::handle_stream(const v1::StreamRequest& request) {
     send_not_servable(status);
     return;
   }
-  const Budget budget = request.has_budget() ? budget_from_wire(request.budget()) : Budget{};
-  auto plan = plan_stream(model->index, request.resume_offset(), budget);
+  auto plan = plan_request(model->index, request);
   if (!plan) {
     send_error(v1::Error::INVALID_REQUEST, plan.error().message, false);
     return;
@@ -407,6 +406,10 @@ std::vector<uint8_t> header_frame(const CatalogModel& model, const StreamPlan& p
   bounds->set_max_z(h.bounds.max.z);
   header->set_container_version(index.version);  // a catalog may hold older streams
   header->set_max_chunk_bytes(static_cast<uint32_t>(chunk_bytes));
+  if (plan.ranged()) {
+    header->set_ranged(true);
+    header->set_ranged_bytes(plan.ranged_bytes);
+  }
   fill_record_index(model, compact_index, *header->mutable_records());
   return proto::encode_frame(out);
 }
@@ -430,8 +433,7 @@ awaitable<void> Session::write_loop(std::shared_ptr<Session> self) {
 }
 
 bool Session::header_must_go_alone() const {
-  return !pending_header_.empty() &&
-         (!queue_.empty() || !stream_ || stream_->position >= stream_->plan.end);
+  return !pending_header_.empty() && (!queue_.empty() || !stream_ || stream_->all_sent());
 }
 
 awaitable<bool> Session::write_header_alone() {
@@ -472,15 +474,18 @@ awaitable<bool> Session::begin_stream(const StartStream& start) {
     if (!co_await write_end(v1::StreamEnd::CANCELLED)) co_return false;
   }
   const CatalogModel& model = *start.model;
+  std::vector<ByteSegment> segments = plan_segments(model.index, start.plan);
+  const uint64_t first_byte = segments.empty() ? start.plan.start : segments.front().start;
   stream_.emplace(ActiveStream{
       .model = start.model,
       .plan = start.plan,
+      .segments = std::move(segments),
       .chunk_bytes = start.chunk_bytes,
       .requested = start.requested,
       .bucket = TokenBucket(double(shared_.options->rate_bytes_per_s), double(start.chunk_bytes),
                             Clock::now()),
-      .position = start.plan.start,
-      .records_complete = records_complete_at(model.index, start.plan.start),
+      .position = first_byte,
+      .records_complete = records_sent_at(model.index, start.plan, 0, first_byte),
   });
   ++streams_;
   if (models_.find(model.name) == std::string::npos) {
@@ -494,8 +499,10 @@ awaitable<bool> Session::begin_stream(const StartStream& start) {
 
 awaitable<bool> Session::write_stream_step() {
   ActiveStream& s = *stream_;
-  if (s.position >= s.plan.end) {
-    co_return co_await write_end(s.plan.complete ? v1::StreamEnd::COMPLETE : v1::StreamEnd::BUDGET);
+  if (s.all_sent()) {
+    co_return co_await write_end(s.plan.ranged()   ? v1::StreamEnd::RECORDS_SENT
+                                 : s.plan.complete ? v1::StreamEnd::COMPLETE
+                                                   : v1::StreamEnd::BUDGET);
   }
   if (s.chunks_sent > 0) {
     // Bulk: new streams' first chunks go first (held up to the gate's
@@ -515,7 +522,8 @@ awaitable<bool> Session::write_stream_step() {
 awaitable<bool> Session::write_chunk(ActiveStream& s) {
   const size_t limit =
       std::min(s.chunk_bytes, kFirstChunkBytes << std::min<uint32_t>(s.chunks_sent, 20));
-  const ChunkCut cut = next_chunk(s.model->index, s.plan, s.position, limit);
+  const ChunkCut cut = next_chunk(s.model->index, s.segments[s.segment], s.position, limit);
+  const uint32_t records_complete = records_sent_at(s.model->index, s.plan, s.segment, cut.end);
   const size_t size = static_cast<size_t>(cut.end - s.position);
   // The stream header goes out with the first chunk and is paced with it,
   // so --rate behaves like a slow link (the header is most of what a
@@ -528,7 +536,7 @@ awaitable<bool> Session::write_chunk(ActiveStream& s) {
     if (closed_) co_return false;
   }
   const proto::ChunkFrameHead head =
-      proto::encode_chunk_frame_head(s.position, cut.records_complete, size);
+      proto::encode_chunk_frame_head(s.position, records_complete, size);
   const std::array<asio::const_buffer, 3> buffers{
       asio::buffer(pending_header_),  // empty except before the first chunk
       asio::buffer(head.bytes, head.size),
@@ -541,7 +549,11 @@ awaitable<bool> Session::write_chunk(ActiveStream& s) {
   // Only the writer replaces stream_, so `s` is the stream just written.
   s.position = cut.end;
   s.bytes_sent += size;
-  s.records_complete = cut.records_complete;
+  s.records_complete = records_complete;
+  if (s.position >= s.segments[s.segment].end && s.segment + 1 < s.segments.size()) {
+    ++s.segment;  // the next range starts where its first record is
+    s.position = s.segments[s.segment].start;
+  }
   ++s.chunks_sent;
   bytes_total_ += size;
   shared_.metrics->bytes_sent.fetch_add(size, std::memory_order_relaxed);

@@ -93,6 +93,8 @@ class Session : public std::enable_shared_from_this<Session> {
   struct ActiveStream {
     std::shared_ptr<const CatalogModel> model;
     StreamPlan plan;
+    std::vector<ByteSegment> segments;  // plan_segments(plan), sent in order
+    size_t segment = 0;                 // the one `position` is in
     size_t chunk_bytes = 0;
     Clock::time_point requested;
     TokenBucket bucket;
@@ -101,6 +103,11 @@ class Session : public std::enable_shared_from_this<Session> {
     uint64_t bytes_sent = 0;
     uint32_t chunks_sent = 0;
     bool yielded = false;  // this chunk already stepped back once for new streams
+
+    bool all_sent() const {
+      return segments.empty() ||
+             (segment + 1 == segments.size() && position >= segments.back().end);
+    }
   };
 
   net::asio::awaitable<void> read_loop(std::shared_ptr<Session> self);

@@ -40,6 +40,12 @@ const char* wire_name(Budget::Kind kind) {
   return "budget";
 }
 
+Error too_many_ranges(size_t count) {
+  return Error{ErrorCode::kInvalidArgument, "records: " + std::to_string(count) +
+                                                " ranges, at most " +
+                                                std::to_string(kMaxRecordRanges) + " a request"};
+}
+
 }  // namespace
 
 Budget budget_from_wire(const v1::Budget& wire) {
@@ -92,9 +98,108 @@ Result<StreamPlan> plan_stream(const StreamIndex& index, uint64_t resume_offset,
   return plan;
 }
 
+Result<StreamPlan> plan_records(const StreamIndex& index, std::span<const RecordSpan> ranges) {
+  const auto count = static_cast<uint32_t>(index.records.size());
+  auto refuse = [](std::string message) -> Result<StreamPlan> {
+    return tl::unexpected(Error{ErrorCode::kInvalidArgument, std::move(message)});
+  };
+  if (ranges.empty()) return refuse("records: the list of ranges is empty");
+  if (ranges.size() > kMaxRecordRanges) return tl::unexpected(too_many_ranges(ranges.size()));
+  auto describe = [&](size_t i) {
+    return "records.ranges[" + std::to_string(i) + "] [" + std::to_string(ranges[i].first) + ", " +
+           std::to_string(ranges[i].end) + ")";
+  };
+  StreamPlan plan;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    const RecordSpan& r = ranges[i];
+    if (r.end == r.first) return refuse(describe(i) + " is empty");
+    if (r.end < r.first) return refuse(describe(i) + " is reversed (end before first)");
+    if (r.end > count) {
+      return refuse(describe(i) + " is out of bounds: the stream has " + std::to_string(count) +
+                    " records, 0 to " + std::to_string(count - 1));
+    }
+    plan.ranged_bytes += record_end(index.records[r.end - 1]) - index.records[r.first].offset;
+  }
+  // Two ranges sharing a record: sort the positions by first, compare neighbours.
+  std::vector<uint32_t> order(ranges.size());
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return ranges[a].first < ranges[b].first; });
+  for (size_t k = 1; k < order.size(); ++k) {
+    const uint32_t before = order[k - 1];
+    const uint32_t after = order[k];
+    if (ranges[after].first < ranges[before].end) {
+      const uint32_t shared = ranges[after].first;
+      return refuse(describe(std::min(before, after)) + " and " +
+                    describe(std::max(before, after)) + " both ask for record " +
+                    std::to_string(shared));
+    }
+  }
+  plan.ranges.assign(ranges.begin(), ranges.end());
+  plan.records_before.reserve(ranges.size() + 1);
+  plan.records_before.push_back(0);
+  for (const RecordSpan& r : ranges) {
+    plan.records_before.push_back(plan.records_before.back() + (r.end - r.first));
+  }
+  plan.first_record = ranges.front().first;
+  plan.end_record = ranges.back().end;
+  plan.start = index.records[plan.first_record].offset;
+  plan.end = record_end(index.records[plan.end_record - 1]);
+  plan.complete = false;
+  return plan;
+}
+
+Result<StreamPlan> plan_request(const StreamIndex& index, const v1::StreamRequest& request) {
+  if (!request.has_records()) {
+    const Budget budget = request.has_budget() ? budget_from_wire(request.budget()) : Budget{};
+    return plan_stream(index, request.resume_offset(), budget);
+  }
+  if (request.resume_offset() != 0 || request.has_budget()) {
+    return tl::unexpected(
+        Error{ErrorCode::kInvalidArgument,
+              "records cannot be combined with resume_offset or budget: a ranged request "
+              "resumes by asking for the records still missing"});
+  }
+  const auto& wire = request.records().ranges();
+  if (static_cast<size_t>(wire.size()) > kMaxRecordRanges) {
+    return tl::unexpected(too_many_ranges(static_cast<size_t>(wire.size())));
+  }
+  std::vector<RecordSpan> ranges;
+  ranges.reserve(static_cast<size_t>(wire.size()));
+  for (const v1::RecordRange& r : wire) ranges.push_back({r.first(), r.end()});
+  return plan_records(index, ranges);
+}
+
+std::vector<ByteSegment> plan_segments(const StreamIndex& index, const StreamPlan& plan) {
+  std::vector<ByteSegment> segments;
+  if (!plan.ranged()) {
+    if (plan.start < plan.end) segments.push_back({plan.start, plan.end});
+    return segments;
+  }
+  segments.reserve(plan.ranges.size());
+  for (const RecordSpan& r : plan.ranges) {
+    segments.push_back({index.records[r.first].offset, record_end(index.records[r.end - 1])});
+  }
+  return segments;
+}
+
+uint32_t records_sent_at(const StreamIndex& index, const StreamPlan& plan, size_t segment,
+                         uint64_t position) {
+  if (!plan.ranged()) return records_complete_at(index, position);
+  if (segment >= plan.ranges.size()) return plan.records_before.back();
+  const RecordSpan& r = plan.ranges[segment];
+  const uint32_t whole = std::clamp(first_ending_after(index, position), r.first, r.end);
+  return plan.records_before[segment] + (whole - r.first);
+}
+
 ChunkCut next_chunk(const StreamIndex& index, const StreamPlan& plan, uint64_t position,
                     size_t max_chunk_bytes) {
-  const uint64_t limit = std::min<uint64_t>(plan.end, position + max_chunk_bytes);
+  return next_chunk(index, ByteSegment{plan.start, plan.end}, position, max_chunk_bytes);
+}
+
+ChunkCut next_chunk(const StreamIndex& index, const ByteSegment& segment, uint64_t position,
+                    size_t max_chunk_bytes) {
+  const uint64_t limit = std::min<uint64_t>(segment.end, position + max_chunk_bytes);
   // The unit `position` is in: the container prefix, or a record.
   uint32_t next = first_ending_after(index, position);  // record after the current unit
   uint64_t unit_start = 0;

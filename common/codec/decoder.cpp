@@ -445,6 +445,41 @@ bool IncrementalDecoder::error_is_recoverable() const {
   return state_->error && state_->error_recoverable;
 }
 
+Result<uint32_t> IncrementalDecoder::feed_record(uint32_t record, std::span<const uint8_t> bytes) {
+  State& s = *state_;
+  if (s.error && !s.error_recoverable) return tl::unexpected(*s.error);
+  if (!s.index) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "record " + std::to_string(record) + ": the stream's index has not arrived");
+  }
+  const auto count = static_cast<uint32_t>(s.index->records.size());
+  const std::string name = "record " + std::to_string(record) + " of " + std::to_string(count);
+  if (record >= count) return make_error(ErrorCode::kInvalidArgument, name + ": no such record");
+  if (record < s.records_done) {
+    return make_error(ErrorCode::kInvalidArgument, name + ": already applied");
+  }
+  if (record > s.records_done) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      name + ": needs record" + (record - s.records_done > 1 ? "s " : " ") +
+                          std::to_string(s.records_done) +
+                          (record - s.records_done > 1 ? " to " + std::to_string(record - 1) : "") +
+                          " first (a record needs every record before it)");
+  }
+  const RecordEntry& rec = s.index->records[record];
+  if (bytes.size() != rec.size) {
+    return make_error(ErrorCode::kInvalidArgument, name + ": is " + std::to_string(rec.size) +
+                                                       " bytes, given " +
+                                                       std::to_string(bytes.size()));
+  }
+  // Whatever partial bytes the buffer held are dropped: this record is whole.
+  s.error.reset();
+  s.error_recoverable = false;
+  s.buffer.clear();
+  s.buffer_start = rec.offset;
+  s.stream_pos = rec.offset;
+  return feed(bytes);
+}
+
 Status IncrementalDecoder::resume_at(uint64_t offset) {
   State& s = *state_;
   if (s.error && !s.error_recoverable) return tl::unexpected(*s.error);

@@ -100,6 +100,16 @@ class IncrementalDecoder {
   // from resume_offset() may succeed.
   bool error_is_recoverable() const;
 
+  // Applies one record given alone, as a ranged request delivers it
+  // (StreamRequest.records: the server sends what it is asked, in any
+  // order). Needs the index (the container prefix fed first). Refuses,
+  // without changing anything, a record already applied, one past the last,
+  // bytes that are not the record's size, and a record before its needs: a
+  // record of today's streams needs every record before it, so only record
+  // records_decoded() applies. Otherwise as feed() of exactly those bytes
+  // (a checksum failure is recoverable). Returns 1.
+  Result<uint32_t> feed_record(uint32_t record, std::span<const uint8_t> bytes);
+
   // Starts over from a resume offset: the caller feeds bytes starting at
   // `offset`, which must be a record boundary this decoder has reached.
   // Clears a recoverable error; any other error is returned again.

@@ -210,6 +210,24 @@ int main(int argc, char** argv) {
       r.set_max_chunk_bytes(kind == 0 ? 0 : 1024u << kind);
       streams.push_back(m);
     }
+    // Ranged requests (StreamRequest.records): a good one, last records
+    // first, and one whose ranges share a record.
+    const auto last = static_cast<uint32_t>(index->records.size());
+    for (int kind = 0; kind < 2; ++kind) {
+      v1::ClientMessage m;
+      v1::StreamRequest& r = *m.mutable_stream();
+      r.set_model("demo");
+      r.set_max_chunk_bytes(1024);
+      auto add = [&](uint32_t first, uint32_t end) {
+        v1::RecordRange* range = r.mutable_records()->add_ranges();
+        range->set_first(first);
+        range->set_end(end);
+      };
+      add(last / 2, last);
+      add(1, kind == 0 ? last / 2 : last / 2 + 1);
+      add(0, 1);
+      streams.push_back(m);
+    }
     for (size_t i = 0; i < streams.size(); ++i) {
       std::vector<uint8_t> t;
       append(t, hello);

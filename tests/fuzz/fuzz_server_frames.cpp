@@ -9,8 +9,11 @@
 //
 // Input layout: bytes from the FRONT are the byte stream, integers from the
 // BACK (FuzzedDataProvider) choose the frame limit and read sizes.
-// Checked invariants (a violation traps): chunks advance, stay inside the
-// plan, end on the plan's end, records_complete never decreases.
+// Ranged requests (StreamRequest.records) go through the same plan_request
+// as the session's and are cut segment by segment.
+// Checked invariants (a violation traps): chunks advance, stay inside their
+// segment, end on its end, records_complete never decreases, a ranged plan
+// sends exactly the bytes and records it announced.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
@@ -46,25 +49,40 @@ const StreamIndex& sample_index() {
 
 void handle_stream(const v1::StreamRequest& request) {
   const StreamIndex& index = sample_index();
-  const Budget budget =
-      request.has_budget() ? server::budget_from_wire(request.budget()) : Budget{};
-  auto plan = server::plan_stream(index, request.resume_offset(), budget);
+  auto plan = server::plan_request(index, request);
   if (!plan) return;
-  check(plan->start <= plan->end && plan->end <= index.total_bytes());
+  // A ranged plan's start and end are its first range's start and its last
+  // range's end, in either order.
+  check(plan->ranged() || plan->start <= plan->end);
+  check(plan->start <= index.total_bytes() && plan->end <= index.total_bytes());
+  check(plan->ranged() == request.has_records());
   size_t chunk = request.max_chunk_bytes() ? request.max_chunk_bytes() : 64 * 1024;
   chunk = std::clamp<size_t>(chunk, 1024, 1 << 20);
-  uint64_t position = plan->start;
-  uint32_t records = server::records_complete_at(index, position);
+  const std::vector<server::ByteSegment> segments = server::plan_segments(index, *plan);
+  uint32_t records = segments.empty()
+                         ? server::records_complete_at(index, plan->start)
+                         : server::records_sent_at(index, *plan, 0, segments.front().start);
+  uint64_t bytes = 0;
   int steps = 0;
-  while (position < plan->end) {
-    const server::ChunkCut cut = server::next_chunk(index, *plan, position, chunk);
-    check(cut.end > position && cut.end <= plan->end);
-    check(cut.end - position <= chunk || cut.end - position <= index.payload_offset);
-    check(cut.records_complete >= records && cut.records_complete <= index.records.size());
-    records = cut.records_complete;
-    position = cut.end;
-    check(++steps < 1000000);
+  for (size_t k = 0; k < segments.size(); ++k) {
+    const server::ByteSegment& segment = segments[k];
+    check(segment.start < segment.end && segment.end <= index.total_bytes());
+    for (uint64_t position = segment.start; position < segment.end;) {
+      const server::ChunkCut cut = server::next_chunk(index, segment, position, chunk);
+      check(cut.end > position && cut.end <= segment.end);
+      check(cut.end - position <= chunk || cut.end - position <= index.payload_offset);
+      const uint32_t sent = server::records_sent_at(index, *plan, k, cut.end);
+      check(sent >= records);
+      check(plan->ranged() ? sent <= plan->records_before.back() : sent == cut.records_complete);
+      check(sent <= index.records.size());
+      records = sent;
+      bytes += cut.end - position;
+      position = cut.end;
+      check(++steps < 1000000);
+    }
   }
+  // A ranged plan sends what it announced, every record of every range.
+  if (plan->ranged()) check(bytes == plan->ranged_bytes && records == plan->records_before.back());
 }
 }  // namespace
 

@@ -144,6 +144,72 @@ TEST(StreamPlan, TheChunkThatCompletesTheBaseEndsThere) {
   EXPECT_EQ(cut.end, end_of(index, 0));
 }
 
+// A ranged request (StreamRequest.records): every bad list is refused with
+// a message naming the range; a good one sends its ranges in the order
+// given, each range's chunks tiling exactly its records.
+TEST(StreamPlan, RangedRequestsRefuseBadRangesNamingThem) {
+  const StreamIndex index = make_index(50, 400000);
+  auto refused = [&](std::vector<RecordSpan> ranges) {
+    auto plan = plan_records(index, ranges);
+    EXPECT_FALSE(plan);
+    return plan ? std::string("accepted") : plan.error().message;
+  };
+  EXPECT_EQ(refused({}), "records: the list of ranges is empty");
+  EXPECT_EQ(refused({{0, 2}, {7, 7}}), "records.ranges[1] [7, 7) is empty");
+  EXPECT_EQ(refused({{9, 4}}), "records.ranges[0] [9, 4) is reversed (end before first)");
+  EXPECT_EQ(refused({{45, 51}}),
+            "records.ranges[0] [45, 51) is out of bounds: the stream has 50 records, 0 to 49");
+  EXPECT_EQ(refused({{50, 60}}),
+            "records.ranges[0] [50, 60) is out of bounds: the stream has 50 records, 0 to 49");
+  EXPECT_EQ(refused({{20, 30}, {1, 3}, {29, 31}}),
+            "records.ranges[0] [20, 30) and records.ranges[2] [29, 31) both ask for record 29");
+  EXPECT_EQ(refused({{5, 6}, {5, 6}}),
+            "records.ranges[0] [5, 6) and records.ranges[1] [5, 6) both ask for record 5");
+  EXPECT_EQ(refused(std::vector<RecordSpan>(kMaxRecordRanges + 1, {0, 1})),
+            "records: 4097 ranges, at most 4096 a request");
+  // At the limit, disjoint ranges are fine.
+  const StreamIndex many = make_index(5000, 400000, 500);
+  std::vector<RecordSpan> singles;
+  for (uint32_t r = 0; r < kMaxRecordRanges; ++r) singles.push_back({r, r + 1});
+  EXPECT_TRUE(plan_records(many, singles));
+}
+
+TEST(StreamPlan, RangedPlanSendsEachRangeWholeInTheOrderAsked) {
+  const StreamIndex index = make_index(50, 400000);
+  const std::vector<RecordSpan> ranges{{30, 33}, {2, 3}, {0, 1}, {40, 50}, {10, 20}};
+  auto plan = plan_records(index, ranges);
+  ASSERT_TRUE(plan) << plan.error().message;
+  EXPECT_TRUE(plan->ranged());
+  EXPECT_FALSE(plan->complete);
+  EXPECT_EQ(plan->first_record, 30u);
+  EXPECT_EQ(plan->end_record, 20u);
+  const std::vector<ByteSegment> segments = plan_segments(index, *plan);
+  ASSERT_EQ(segments.size(), ranges.size());
+  uint64_t bytes = 0;
+  uint32_t sent = 0;
+  for (size_t k = 0; k < ranges.size(); ++k) {
+    EXPECT_EQ(segments[k].start, index.records[ranges[k].first].offset);
+    EXPECT_EQ(segments[k].end, end_of(index, ranges[k].end - 1));
+    bytes += segments[k].end - segments[k].start;
+    EXPECT_EQ(records_sent_at(index, *plan, k, segments[k].start), sent);
+    // Chunks tile the segment; records_complete counts requested records.
+    for (uint64_t position = segments[k].start; position < segments[k].end;) {
+      const ChunkCut cut = next_chunk(index, segments[k], position, 3000);
+      EXPECT_GT(cut.end, position);
+      EXPECT_LE(cut.end, segments[k].end);
+      const uint32_t now_sent = records_sent_at(index, *plan, k, cut.end);
+      EXPECT_GE(now_sent, sent);
+      EXPECT_LE(now_sent, sent + (ranges[k].end - ranges[k].first));
+      sent = now_sent;
+      position = cut.end;
+    }
+    EXPECT_EQ(records_sent_at(index, *plan, k, segments[k].end), plan->records_before[k + 1]);
+  }
+  EXPECT_EQ(plan->ranged_bytes, bytes);
+  EXPECT_EQ(sent, 3u + 1 + 1 + 10 + 10);
+  EXPECT_EQ(records_sent_at(index, *plan, ranges.size(), 0), sent);
+}
+
 TEST(TokenBucket, PacesToTheRate) {
   using Clock = TokenBucket::Clock;
   auto now = Clock::now();
