@@ -18,6 +18,7 @@
 // both).
 //
 // Usage: attribute_bench [MODELS_DIR] [--out FILE.md] [--report-dir DIR]
+//                        [--base-color-bits B] (EncodeOptions::base_color_bits)
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/io/mesh_io.h>
@@ -170,9 +171,12 @@ double median_ms(F&& f, int runs = 5) {
 int main(int argc, char** argv) {
   // The models folder: the argument, else default_models_dir().
   std::string dir = meshstream::bench::default_models_dir(), out_path, report_dir;
+  int base_color_bits = EncodeOptions{}.base_color_bits;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
+    if (a == "--base-color-bits" && i + 1 < argc)
+      base_color_bits = std::atoi(argv[++i]);
+    else if (a == "--out" && i + 1 < argc)
       out_path = argv[++i];
     else if (a == "--report-dir" && i + 1 < argc)  // bench/run's convention
       report_dir = argv[++i];
@@ -215,6 +219,7 @@ int main(int argc, char** argv) {
       continue;
     }
     EncodeOptions options;
+    options.base_color_bits = base_color_bits;
     EncodeReport report;
     auto stream = encode_hcs(mesh, options, &report);
     if (!stream) {
@@ -310,6 +315,17 @@ int main(int argc, char** argv) {
     std::printf("%s", row);
     std::printf("  base vertices with attributes %u, without %u\n", index->header.base_vertex_count,
                 plain_index ? plain_index->header.base_vertex_count : 0);
+    // Where the base's coarse values become exact: the end of the low-bits
+    // record (record 1 when there is none).
+    uint64_t exact_base = first_display;
+    for (const RecordEntry& r : index->records) {
+      const auto p = record_payload(r, std::span<const uint8_t>(*stream).subspan(r.offset, r.size));
+      if (p.size() > 1 && p[0] == kRecordAttributes && p[1] == kAttributePartLowBits)
+        exact_base = r.offset + r.size;
+    }
+    std::printf("  base values exact at %llu bytes (first display %llu, stream %llu)\n",
+                (unsigned long long)exact_base, (unsigned long long)first_display,
+                (unsigned long long)ours_total);
     table += row;
     first_table += first_display_row(name, *stream, *index, plain_first);
     seam_table +=
