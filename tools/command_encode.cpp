@@ -106,9 +106,10 @@ void add_encode_command(CLI::App& app, int& exit_code) {
                   "colour quantization bits per channel (2..16; 8 keeps 8-bit colours exact)")
       ->check(CLI::Range(2, 16))
       ->capture_default_str();
-  cmd->add_option("--base-color-bits", args->base_color_bits,
-                  "record 1's grid for the base's colours (2..quant-color - 1 bits; their low bits "
-                  "follow in a record of their own); 0: exact in record 1")
+  cmd->add_option(
+         "--base-color-bits", args->base_color_bits,
+         "the base mesh's colours in the first attribute record on this many bits per channel "
+         "(2..quant-color - 1; their low bits follow in a record of their own); 0: exact")
       ->check(CLI::Range(0, 15))
       ->capture_default_str();
   cmd->add_option("--base-vertices", args->base_vertices,
