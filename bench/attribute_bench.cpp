@@ -18,11 +18,13 @@
 // both).
 //
 // Usage: attribute_bench [MODELS_DIR] [--out FILE.md] [--report-dir DIR]
+//                        [--base-color-bits B] (EncodeOptions::base_color_bits)
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
 #include <draco/io/mesh_io.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -67,6 +69,55 @@ uint64_t edges_touching_seams(const Mesh& m, const EncodeOptions& options) {
     }
   std::sort(edges.begin(), edges.end());
   return uint64_t(std::unique(edges.begin(), edges.end()) - edges.begin());
+}
+
+// The encoder's locked vertices by how many seam edges meet there (an edge
+// is a seam where a per-corner channel's quantized values differ across it
+// at either end): 1 (a seam ends), 2 (inside a seam path: the vertices a
+// collapse along the path could remove) and 3 or more (where seams meet).
+// For docs/seam-pattern-coding.md.
+std::array<uint32_t, 3> locked_by_seam_edges(const Mesh& m, const EncodeOptions& options) {
+  std::array<uint32_t, 3> out{};
+  auto grid = make_grid(m, options.quant_bits);
+  if (!grid) return out;
+  const std::vector<Vec3i> q = quantize_positions(m, *grid);
+  auto plan = plan_attributes(m, q, {options.quant_normal, options.quant_uv, options.quant_color});
+  if (!plan || plan->locked.empty()) return out;
+  // Per undirected edge, its corners (face, k) where the edge starts at k.
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<std::pair<uint32_t, int>>> edges;
+  for (uint32_t f = 0; f < m.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = m.triangles[f][k], b = m.triangles[f][(k + 1) % 3];
+      edges[{std::min(a, b), std::max(a, b)}].push_back({f, k});
+    }
+  auto same_at = [&](uint32_t c1, uint32_t c2) {
+    for (size_t ch = 0; ch < plan->layout.channels.size(); ++ch) {
+      const AttributeChannel& c = plan->layout.channels[ch];
+      if (!c.per_corner) continue;
+      const uint32_t n = c.components();
+      for (uint32_t i = 0; i < n; ++i)
+        if (plan->input_values[ch][size_t(c1) * n + i] !=
+            plan->input_values[ch][size_t(c2) * n + i])
+          return false;
+    }
+    return true;
+  };
+  std::vector<uint32_t> degree(m.vertex_count(), 0);
+  for (const auto& [e, sides] : edges) {
+    if (sides.size() != 2) continue;
+    const auto [f1, k1] = sides[0];
+    const auto [f2, k2] = sides[1];
+    // The corner at vertex e.first on each side, and at e.second.
+    auto corner_at = [&](uint32_t f, int k, uint32_t v) {
+      return m.triangles[f][k] == v ? 3 * f + k : 3 * f + (k + 1) % 3;
+    };
+    const bool seam = !same_at(corner_at(f1, k1, e.first), corner_at(f2, k2, e.first)) ||
+                      !same_at(corner_at(f1, k1, e.second), corner_at(f2, k2, e.second));
+    if (seam) ++degree[e.first], ++degree[e.second];
+  }
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (plan->locked[v] && degree[v] > 0) ++out[std::min<uint32_t>(degree[v], 3) - 1];
+  return out;
 }
 
 // Bytes of a stream's records of one type after the base (kRecordTexture,
@@ -170,9 +221,12 @@ double median_ms(F&& f, int runs = 5) {
 int main(int argc, char** argv) {
   // The models folder: the argument, else default_models_dir().
   std::string dir = meshstream::bench::default_models_dir(), out_path, report_dir;
+  int base_color_bits = EncodeOptions{}.base_color_bits;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
+    if (a == "--base-color-bits" && i + 1 < argc)
+      base_color_bits = std::atoi(argv[++i]);
+    else if (a == "--out" && i + 1 < argc)
       out_path = argv[++i];
     else if (a == "--report-dir" && i + 1 < argc)  // bench/run's convention
       report_dir = argv[++i];
@@ -215,6 +269,7 @@ int main(int argc, char** argv) {
       continue;
     }
     EncodeOptions options;
+    options.base_color_bits = base_color_bits;
     EncodeReport report;
     auto stream = encode_hcs(mesh, options, &report);
     if (!stream) {
@@ -310,6 +365,22 @@ int main(int argc, char** argv) {
     std::printf("%s", row);
     std::printf("  base vertices with attributes %u, without %u\n", index->header.base_vertex_count,
                 plain_index ? plain_index->header.base_vertex_count : 0);
+    if (!mesh.corner_normals.empty() || !mesh.corner_texcoords.empty()) {
+      const auto by = locked_by_seam_edges(mesh, options);
+      std::printf("  locked vertices by seam edges met: 1: %u, 2: %u, 3 or more: %u\n", by[0],
+                  by[1], by[2]);
+    }
+    // Where the base's coarse values become exact: the end of the low-bits
+    // record (record 1 when there is none).
+    uint64_t exact_base = first_display;
+    for (const RecordEntry& r : index->records) {
+      const auto p = record_payload(r, std::span<const uint8_t>(*stream).subspan(r.offset, r.size));
+      if (p.size() > 1 && p[0] == kRecordAttributes && p[1] == kAttributePartLowBits)
+        exact_base = r.offset + r.size;
+    }
+    std::printf("  base values exact at %llu bytes (first display %llu, stream %llu)\n",
+                (unsigned long long)exact_base, (unsigned long long)first_display,
+                (unsigned long long)ours_total);
     table += row;
     first_table += first_display_row(name, *stream, *index, plain_first);
     seam_table +=

@@ -38,7 +38,11 @@
 //     that alike, and the full-rate rows (both exactly the quantized input)
 //     show the measure's floor per model.
 //
+// The prefixes measured also include the first display (the end of record
+// 1) and the end of the low-bits record (the base's values exact).
+//
 // Usage: attribute_rd_bench [MODELS_DIR] [--out FILE.md] [--report-dir DIR] [--samples N]
+//                           [--base-color-bits B] [--only SUBSTRING]
 #include <draco/io/mesh_io.h>
 #include <draco/mesh/mesh_cleanup.h>
 #include <meshoptimizer.h>
@@ -55,6 +59,7 @@
 
 #include "bench/model_files.h"
 #include "bench/peers/draco_attribute_mesh.h"
+#include "common/codec/attribute_codec.h"
 #include "common/codec/container.h"
 #include "common/codec/decoder.h"
 #include "common/codec/encoder.h"
@@ -280,9 +285,15 @@ int main(int argc, char** argv) {
   // The models folder: the argument, else default_models_dir().
   std::string dir = meshstream::bench::default_models_dir(), out_path, report_dir;
   uint32_t samples = 20000;
+  int base_color_bits = EncodeOptions{}.base_color_bits;
+  std::string only;  // models whose path holds it; empty: all
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--out" && i + 1 < argc)
+    if (a == "--base-color-bits" && i + 1 < argc)
+      base_color_bits = std::atoi(argv[++i]);
+    else if (a == "--only" && i + 1 < argc)
+      only = argv[++i];
+    else if (a == "--out" && i + 1 < argc)
       out_path = argv[++i];
     else if (a == "--report-dir" && i + 1 < argc)  // bench/run's convention
       report_dir = argv[++i];
@@ -306,6 +317,7 @@ int main(int argc, char** argv) {
                                   "|---|---|---|---|---|---|---|\n";
   for (const fs::path& file : files) {
     const std::string name = fs::relative(file, dir).string();
+    if (!only.empty() && name.find(only) == std::string::npos) continue;
     auto read = draco::ReadMeshFromFile(file.string());
     if (!read.ok()) {
       std::printf("%s: Draco cannot read it: %s\n", name.c_str(), read.status().error_msg());
@@ -341,6 +353,7 @@ int main(int argc, char** argv) {
     }
     // Ours.
     EncodeOptions options;
+    options.base_color_bits = base_color_bits;
     auto stream = encode_hcs(mesh, options);
     if (!stream) {
       std::printf("%s: encode failed: %s\n", name.c_str(), stream.error().message.c_str());
@@ -359,6 +372,15 @@ int main(int argc, char** argv) {
     for (const Point& c : chain) {
       auto it = std::upper_bound(ends.begin(), ends.end(), c.bytes);
       prefixes.push_back(it == ends.begin() ? ends.front() : *(it - 1));
+    }
+    if (ends.size() > 1) prefixes.push_back(ends[1]);
+    for (const RecordEntry& r : index->records) {
+      const auto p = record_payload(r, std::span<const uint8_t>(*stream).subspan(r.offset, r.size));
+      if (p.size() > 1 && p[0] == kRecordAttributes && p[1] == kAttributePartLowBits) {
+        prefixes.push_back(r.offset + r.size);
+        std::printf("%s: low-bits record ends at %llu bytes\n", name.c_str(),
+                    (unsigned long long)(r.offset + r.size));
+      }
     }
     std::sort(prefixes.begin(), prefixes.end());
     prefixes.erase(std::unique(prefixes.begin(), prefixes.end()), prefixes.end());

@@ -30,6 +30,7 @@ struct EncodeArgs {
   int quant_normal = EncodeOptions{}.quant_normal;
   int quant_uv = EncodeOptions{}.quant_uv;
   int quant_color = EncodeOptions{}.quant_color;
+  int base_color_bits = EncodeOptions{}.base_color_bits;
   bool progress = false, no_progress = false;  // neither: a bar when stderr is a terminal
 };
 
@@ -58,6 +59,7 @@ int run_encode(const EncodeArgs& args) {
   options.quant_normal = args.quant_normal;
   options.quant_uv = args.quant_uv;
   options.quant_color = args.quant_color;
+  options.base_color_bits = args.base_color_bits;
   options.progress = [&bar](const EncodeProgress& p) { bar.update(p.stage, p.fraction); };
   auto bytes = encode_hcs(imported->mesh, options);
   bar.finish();
@@ -103,6 +105,12 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--quant-color", args->quant_color,
                   "colour quantization bits per channel (2..16; 8 keeps 8-bit colours exact)")
       ->check(CLI::Range(2, 16))
+      ->capture_default_str();
+  cmd->add_option(
+         "--base-color-bits", args->base_color_bits,
+         "the base mesh's colours in the first attribute record on this many bits per channel "
+         "(2..quant-color - 1; their low bits follow in a record of their own); 0: exact")
+      ->check(CLI::Range(0, 15))
       ->capture_default_str();
   cmd->add_option("--base-vertices", args->base_vertices,
                   "stop decimating at about this many vertices")

@@ -453,7 +453,8 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
                                 ? kPredictBaseAlternative | kPredictLaterFromGeometry | kBaseCoarse
                             : c.kind == AttributeKind::kNormal
                                 ? kPredictBaseAlternative | kBaseNormalsLate
-                                : 0;
+                            : c.kind == AttributeKind::kColor ? kBaseCoarse
+                                                              : 0;
     if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
@@ -705,9 +706,15 @@ Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>
     if (b < kMinAttributeBits || b > kMaxAttributeBits)
       return make_error(ErrorCode::kInvalidArgument,
                         "attribute quantization bits " + std::to_string(b) + " out of 2..16");
+  if (options.base_color_bits != 0 && (options.base_color_bits < kMinAttributeBits ||
+                                       options.base_color_bits >= options.color_bits))
+    return make_error(ErrorCode::kInvalidArgument,
+                      "base colour bits " + std::to_string(options.base_color_bits) +
+                          " out of 2.." + std::to_string(options.color_bits - 1) + " (0: exact)");
   if (auto s = check_attribute_counts(mesh); !s) return tl::unexpected(s.error());
   AttributePlan plan;
   plan.extras = &mesh.extra_attributes;
+  plan.base_color_bits = options.base_color_bits;
   const size_t corners = 3 * mesh.triangles.size();
   auto finite2 = [](Vec2f v) { return std::isfinite(v.x) && std::isfinite(v.y); };
   auto finite3 = [](Vec3f v) {
@@ -1012,6 +1019,14 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
       c.flags |= kBaseCoarse;
       c.base_shift = uint8_t(c.bits - kBaseCoarseBits);
     }
+  // Colours go coarse only when asked (version 15, base_color_bits):
+  // bench/REPORT.md measures what it costs and saves.
+  for (AttributeChannel& c : layout.channels)
+    if (c.kind == AttributeKind::kColor && plan.base_color_bits > 0 &&
+        c.bits > plan.base_color_bits) {
+      c.flags |= kBaseCoarse;
+      c.base_shift = uint8_t(c.bits - plan.base_color_bits);
+    }
   // Record 1 codes on the coarse grids (the flags it sets below are the
   // layout's too).
   AttributeLayout record1_layout = coarse_layout(layout);
@@ -1215,7 +1230,12 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   };
   // The low-bits record goes just before the first values record (the
   // values are predicted from the base's exact values), else after the
-  // last geometry record.
+  // last geometry record. Right after record 1 (measured for version 15,
+  // not kept) makes a base of every vertex exact sooner (Draco's textured
+  // sphere 4 887 -> 3 566 bytes) but delays every geometry record by its
+  // size, and there the coarse positions, not the 8-bit grid, are what the
+  // display misses (sphere UV RMS 19.2 against 1.2-14.9 x 1e-3 at equal
+  // bytes; bench/REPORT.md).
   for (size_t i = 0; i < idx.records.size(); ++i) {
     const RecordEntry& r = idx.records[i];
     const auto bytes = record_payload(r, stream.subspan(r.offset, r.size));

@@ -24,7 +24,8 @@
 // 13 on record 1 leaves the base's normals to those records too
 // (kBaseNormalsLate); from version 14 on it carries the base's texture
 // coordinates coarse (kBaseCoarse), and a low-bits record before the first
-// values record makes them exact. The last
+// values record makes them exact (version 15: colours coarse too, if
+// asked). The last
 // record carries the exact values of the vertices inserted after the last
 // values record (version 10: of every inserted vertex) and the extra
 // attributes (zstd). Until its values arrive the decoder shows each
@@ -93,11 +94,13 @@ inline constexpr uint8_t kPredictLaterFromGeometry = 4;
 // each wedge on the mesh it has. The first display with colours or
 // texture then waits for no normal (bench/REPORT.md, "first display").
 inline constexpr uint8_t kBaseNormalsLate = 8;
-// A texture coordinate channel's flag (version 14 on): record 1 carries the
-// base's values without their low `base_shift` bits (a u8 after the bits in
-// the layout), coded on the coarser grid; a low-bits record
-// (kAttributePartLowBits) brings them before the first values record. The
-// first display shows the coarse value at the middle of its range.
+// A texture coordinate channel's flag (version 14 on; a colour channel's
+// too from version 15, when the encoder is asked for it): record 1 carries
+// the base's values without their low `base_shift` bits (a u8 after the
+// bits in the layout), coded on the coarser grid; a low-bits record
+// (kAttributePartLowBits) brings them before the first values record (after
+// the last geometry record when there is none). The first display shows
+// the coarse value at the middle of its range.
 inline constexpr uint8_t kBaseCoarse = 16;
 // The coarse grid record 1 uses for texture coordinates of more bits (the
 // first display shows the small texture level: 1/256 of the UV box).
@@ -148,6 +151,11 @@ struct AttributeOptions {
   int normal_bits = 8;
   int texcoord_bits = 12;
   int color_bits = 8;
+  // Record 1's grid for colours (version 15, kBaseCoarse): 0 = colours
+  // exact in record 1; kMinAttributeBits .. color_bits - 1 = record 1 codes
+  // the base's colours on this many bits per channel and a low-bits record
+  // brings the rest; else kInvalidArgument.
+  int base_color_bits = 0;
 };
 
 // What the encoder takes from the input before decimation: the layout, the
@@ -159,6 +167,7 @@ struct AttributePlan {
   std::vector<uint8_t> locked;  // input vertex ids
   uint32_t locked_count = 0;
   const std::vector<ExtraAttribute>* extras = nullptr;
+  int base_color_bits = 0;  // AttributeOptions::base_color_bits
   bool empty() const { return layout.channels.empty() && (!extras || extras->empty()); }
 };
 

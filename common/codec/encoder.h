@@ -98,6 +98,12 @@ struct EncodeOptions {
   int quant_normal = 8;
   int quant_uv = 12;
   int quant_color = 8;
+  // Record 1's grid for the base's colours (version 15): 0 = exact in
+  // record 1 (the default); 2 .. quant_color - 1 bits per channel = coarse
+  // there, the low bits in a low-bits record after it (AttributeOptions::
+  // base_color_bits; bench/REPORT.md weighs the first display against the
+  // total). `meshstream encode --base-color-bits`.
+  int base_color_bits = 0;
   // The locality experiment (issue 17, docs/view-dependent-records.md):
   // 0 = off (the default; the stream is unchanged). Else each decimation
   // layer keeps the borders of a grid of cells of at least about this many

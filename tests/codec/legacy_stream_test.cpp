@@ -28,7 +28,16 @@
 //                 record from vertex 0);
 //   container3_v14_* the faceted cube at kEncoderVersion 14 (record 1's
 //                 texture coordinates on an 8-bit grid, their low bits in
-//                 a low-bits record before the first values record).
+//                 a low-bits record before the first values record);
+//   container3_v14_sphere_low_bits_last.hcs Draco's textured sphere at
+//                 kEncoderVersion 14, `meshstream encode --no-asa-guidance`:
+//                 every vertex in the base, no values record, so the
+//                 low-bits record follows the last geometry record;
+//   container3_v15_pos_color_coarse_base.hcs Draco's test_pos_color.ply
+//                 (Apache-2.0) at kEncoderVersion 15, `meshstream encode
+//                 --no-asa-guidance --base-color-bits 4`: record 1's colours
+//                 on a 4-bit grid (layout flag bit 4 on colours), which a
+//                 version-14 decoder refuses.
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -184,6 +193,28 @@ void expect_attributes_decode_as_when_written(const char* sample, uint64_t hash,
   EXPECT_EQ(whole->extra_attributes[0].name, "TANGENT");
 }
 
+// A stream decodes, record by record (attribute arrays sized at every
+// prefix) and at once, to the faces it decoded to when written.
+void expect_decodes_as_when_written(const std::vector<uint8_t>& bytes, uint64_t hash,
+                                    size_t textures) {
+  auto index = read_stream_index(bytes);
+  ASSERT_TRUE(index) << index.error().message;
+  IncrementalDecoder dec;
+  for (const RecordEntry& r : index->records) {
+    const uint64_t from = r.offset == index->payload_offset ? 0 : r.offset;
+    auto fed = dec.feed(std::span<const uint8_t>(bytes).subspan(from, r.offset + r.size - from));
+    ASSERT_TRUE(fed) << fed.error().message;
+    ASSERT_TRUE(check_attribute_counts(dec.mesh()));
+  }
+  ASSERT_TRUE(dec.finished());
+  EXPECT_EQ(attribute_hash(dec.mesh()), hash)
+      << "hash 0x" << std::hex << attribute_hash(dec.mesh());
+  auto whole = decode_hcs(bytes);
+  ASSERT_TRUE(whole) << whole.error().message;
+  EXPECT_EQ(attribute_hash(*whole), hash);
+  EXPECT_EQ(whole->textures.size(), textures);
+}
+
 TEST(LegacyStreams, VersionTenAttributesDecodeAsWhenWritten) {
   expect_attributes_decode_as_when_written("container3_v10_faceted_cube_attributes.hcs",
                                            0x52ce8058599d568full, 0);
@@ -233,21 +264,35 @@ TEST(LegacyStreams, VersionTwelveNeighbourNormalsDecodeAsWhenWritten) {
   ASSERT_TRUE(get_varint(payload, pos, length));
   ASSERT_EQ(payload[pos + 1], uint8_t(AttributeKind::kNormal));
   EXPECT_EQ(payload[pos + 2], 1 | kPredictBaseAlternative);
-  IncrementalDecoder dec;
-  for (const RecordEntry& r : index->records) {
-    const uint64_t from = r.offset == index->payload_offset ? 0 : r.offset;
-    auto fed = dec.feed(std::span<const uint8_t>(bytes).subspan(from, r.offset + r.size - from));
-    ASSERT_TRUE(fed) << fed.error().message;
-    ASSERT_TRUE(check_attribute_counts(dec.mesh()));
+  expect_decodes_as_when_written(bytes, 0x09209576d7d677d2ull, 1);
+}
+
+// Version 14, every vertex in the base: the low-bits record after the last
+// geometry record (the decoder keeps record 1's mesh for it).
+TEST(LegacyStreams, VersionFourteenLowBitsAfterTheGeometryDecodeAsWhenWritten) {
+  const std::vector<uint8_t> bytes = read_sample("container3_v14_sphere_low_bits_last.hcs");
+  auto index = read_stream_index(bytes);
+  ASSERT_TRUE(index) << index.error().message;
+  size_t low = 0, last_geometry = 0;
+  for (size_t i = 0; i < index->records.size(); ++i) {
+    const RecordEntry& r = index->records[i];
+    const auto payload = record_payload(r, {bytes.data() + r.offset, r.size});
+    if (payload.size() > 1 && payload[0] == kRecordAttributes &&
+        payload[1] == kAttributePartLowBits)
+      low = i;
+    else if (!payload.empty() && payload[0] != kRecordAttributes && payload[0] != kRecordTexture)
+      last_geometry = i;
   }
-  ASSERT_TRUE(dec.finished());
-  constexpr uint64_t kHash = 0x09209576d7d677d2ull;
-  EXPECT_EQ(attribute_hash(dec.mesh()), kHash)
-      << "hash 0x" << std::hex << attribute_hash(dec.mesh());
-  auto whole = decode_hcs(bytes);
-  ASSERT_TRUE(whole) << whole.error().message;
-  EXPECT_EQ(attribute_hash(*whole), kHash);
-  ASSERT_EQ(whole->textures.size(), 1u);
+  EXPECT_GT(low, last_geometry);
+  // The same faces as version 12's sphere above: both exact at full rate.
+  expect_decodes_as_when_written(bytes, 0x09209576d7d677d2ull, 1);
+}
+
+// Version 15: record 1's colours on a 4-bit grid, their low bits later
+// (the hash is also what the default stream of the same file decodes to).
+TEST(LegacyStreams, VersionFifteenCoarseColoursDecodeAsWhenWritten) {
+  expect_decodes_as_when_written(read_sample("container3_v15_pos_color_coarse_base.hcs"),
+                                 0x378a6e80e31dc375ull, 0);
 }
 
 }  // namespace
