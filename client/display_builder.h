@@ -2,8 +2,9 @@
 // (common/asa/subdivide.h) either on the whole mesh, or incrementally on
 // the region the update changed (common/asa/incremental.h), keeping
 // whichever path has been faster for updates of that size. Both paths give
-// the same triangles with the same positions (same face order); only the
-// numbering of the new vertices may differ.
+// the same triangles with the same positions; the incremental path's are in
+// another order and its mesh has unused vertex slots (IncrementalSubdivider::
+// result()): each update copies into the display only what it changed.
 #pragma once
 
 #include <cstdint>
