@@ -15,18 +15,7 @@
 namespace meshstream {
 namespace {
 
-// A decoder-like record: a vertex inserted inside face f (f rewritten, two
-// faces appended), lifted off the plane.
-void insert_vertex(Mesh& m, uint32_t f, float lift) {
-  const Triangle t = m.triangles[f];
-  const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
-  const Vec3f n = normalized(cross(b - a, c - a));
-  const uint32_t v = m.vertex_count();
-  m.positions.push_back((a + b + c) / 3.0f + n * (lift * length(b - a)));
-  m.triangles[f] = {t[0], t[1], v};
-  m.triangles.push_back({t[1], t[2], v});
-  m.triangles.push_back({t[2], t[0], v});
-}
+using asa_test::insert_vertex;
 
 struct Copy {
   Mesh mesh;

@@ -223,4 +223,19 @@ inline ::testing::AssertionResult conforming_incremental(const Mesh& input,
   return ::testing::AssertionSuccess();
 }
 
+// A decoder-like refinement: a new vertex inside face f, lifted off the
+// plane; f is replaced in place and two faces are appended.
+inline void insert_vertex(Mesh& m, uint32_t f, float lift) {
+  const Triangle t = m.triangles[f];
+  const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+  const Vec3f n = normalized(cross(b - a, c - a));
+  const float size = length(b - a);
+  const uint32_t v = m.vertex_count();
+  m.positions.push_back((a + b + c) / 3.0f + n * (lift * size));
+  if (!m.colors.empty()) m.colors.push_back({0.5f, 0.5f, 0.5f, 1});
+  m.triangles[f] = {t[0], t[1], v};
+  m.triangles.push_back({t[1], t[2], v});
+  m.triangles.push_back({t[2], t[0], v});
+}
+
 }  // namespace meshstream::asa_test
