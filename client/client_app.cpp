@@ -336,9 +336,9 @@ class StreamingRun {
       s.vertices = shown->decoded->vertex_count();
       s.faces = shown->decoded->face_count();
       const Mesh& drawn = shown->drawn ? *shown->drawn : *shown->display;
-      s.display_vertices = drawn.vertex_count();
+      s.display_vertices = drawn_vertices(*shown);
       s.display_faces = drawn.face_count();
-      s.whole_display_vertices = shown->display->vertex_count();
+      s.whole_display_vertices = whole_display_vertices(*shown);
       s.whole_display_faces = shown->display->face_count();
     }
     return s;

@@ -218,6 +218,7 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   report.asa_ms = ms_since(start);
   report.incremental = !stats.full;
   report.region_faces = stats.region_faces;
+  report.unused_vertices = s.incremental->unused_vertices();
   if (stats.full) {
     if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
   } else if (path_ == AsaPath::kAuto && s.full_ms_per_face > 0 && F > 0) {

@@ -27,8 +27,9 @@ struct BuildReport {
   // View-dependent ASA: the tolerance used (0 without a camera); raised
   // above the requested one when the display budget was reached.
   float pixel_tolerance = 0;
-  bool budget_limited = false;  // the budget cut this update (tolerance or levels)
-  int levels_used = 0;          // ASA levels the kept run allowed
+  bool budget_limited = false;   // the budget cut this update (tolerance or levels)
+  int levels_used = 0;           // ASA levels the kept run allowed
+  uint32_t unused_vertices = 0;  // display vertex slots no face uses (incremental path)
 };
 
 struct DisplayMesh {

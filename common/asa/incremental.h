@@ -19,6 +19,7 @@
 // it may hold unused vertex slots (see result()).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <span>
@@ -96,6 +97,12 @@ class IncrementalSubdivider {
   // (O(output), that update is a whole change).
   const AsaResult& result() const { return result_; }
   uint32_t input_slots() const { return input_slots_; }
+  // Output vertex slots no face uses: result().mesh.vertex_count() minus
+  // this is subdivide()'s vertex count. O(1).
+  uint32_t unused_vertices() const {
+    const uint32_t inputs = std::min(previous_.vertex_count(), input_slots_);
+    return input_slots_ - inputs + static_cast<uint32_t>(free_vertices_.size());
+  }
   // The result as subdivide() gives it: faces in input-face order (each
   // patch in its order), input vertices first, then the others as first
   // used. O(output); for tests and tools.

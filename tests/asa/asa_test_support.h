@@ -217,6 +217,9 @@ inline ::testing::AssertionResult conforming_incremental(const Mesh& input,
   if (!canonical_adj || adj->boundary_edge_count() != canonical_adj->boundary_edge_count())
     return ::testing::AssertionFailure() << "in place: boundary edges differ";
   const uint32_t unused = out.vertex_count() - canonical.mesh.vertex_count();
+  if (unused != inc.unused_vertices())
+    return ::testing::AssertionFailure()
+           << unused << " unused vertex slots, unused_vertices() says " << inc.unused_vertices();
   const uint32_t bound = (inc.input_slots() - input.vertex_count()) + 1024 + out.vertex_count() / 8;
   if (unused > bound)
     return ::testing::AssertionFailure() << unused << " unused vertex slots, bound " << bound;

@@ -240,6 +240,10 @@ TEST(DisplayBuilder, CameraMovesPatchFreeCopiesAndLeaveHeldDisplaysAlone) {
     ASSERT_TRUE(asa_test::face_set(*display->mesh, display->face_kind.get()) ==
                 asa_test::face_set(full->mesh, &full->face_kind))
         << "step " << step;
+    // The unused vertex slots it reports (events count the others) are
+    // those of the display: the rest are as many as a full run's.
+    EXPECT_EQ(display->mesh->vertex_count() - report.unused_vertices, full->mesh.vertex_count())
+        << "step " << step;
     for (const Held& h : held) {
       ASSERT_TRUE(h.display.mesh->triangles == h.triangles) << "a held display was written";
       ASSERT_TRUE(h.display.mesh->positions == h.positions) << "a held display was written";
