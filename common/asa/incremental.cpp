@@ -94,14 +94,15 @@ void IncrementalSubdivider::relayout(uint32_t slots) {
       if (new_id_[v] == kNone) new_id_[v] = count++;
       v = new_id_[v];
     }
-  auto remap = [&](auto& values, auto fill) {
-    if (values.empty()) return;
+  // (Positions always: an empty output still needs the input's slots.)
+  auto remap = [&](auto& values, auto fill, bool always = false) {
+    if (values.empty() && !always) return;
     std::remove_reference_t<decltype(values)> moved(count, fill);
     for (uint32_t v = 0; v < V; ++v)
       if (new_id_[v] != kNone) moved[new_id_[v]] = values[v];
     values.swap(moved);
   };
-  remap(out.positions, V > 0 ? out.positions[0] : Vec3f{});
+  remap(out.positions, V > 0 ? out.positions[0] : Vec3f{}, true);
   remap(out.colors, Vec4f{});
   remap(out.texcoords, Vec2f{});
   remap(out.normals, Vec3f{});
