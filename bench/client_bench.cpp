@@ -158,7 +158,7 @@ std::vector<ReplayRow> replay(const std::string& hcs, const AsaOptions& options)
     row.incremental_ms = Ms(std::chrono::steady_clock::now() - t0).count();
     row.incremental_was_full = incremental.last_update().full;
     row.display_faces = full.mesh.face_count();
-    row.equal = same_faces(full, incremental.result());
+    row.equal = same_faces(full, incremental.canonical());
     rows.push_back(row);
   }
   return rows;

@@ -7,6 +7,7 @@
 // Usage: view_asa_bench [--report-dir DIR] [--meshes a,b] [--big FILE[,FILE]]
 //                       [--streams DIR] [--no-big-pictures] [--updates-only]
 //                       [--pixel-tolerance PX] [--no-orbit] [--no-updates]
+//                       [--orbit-steps N] [--no-orbit-cull]
 // --big: large PLY files (read only), measured on the full mesh; an HCS of
 // the same stem in --streams DIR adds its early and middle prefixes.
 #include <algorithm>
@@ -61,8 +62,10 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-float g_tolerance = 2;  // --pixel-tolerance
-CullMargins g_margins;  // --cull-eye-share, --cull-angle
+float g_tolerance = 2;     // --pixel-tolerance
+int g_orbit_steps = 10;    // --orbit-steps
+bool g_orbit_cull = true;  // --no-orbit-cull: the orbit measures ASA only
+CullMargins g_margins;     // --cull-eye-share, --cull-angle
 
 AsaOptions view_options(const Mesh& mesh, const AsaCamera& camera) {
   AsaOptions o;  // the client's defaults: 1 level, t = 0.85, tolerance 2 px
@@ -299,7 +302,7 @@ OrbitStats orbit(const Mesh& mesh, int width, int height, int steps) {
     out.ms.push_back(ms_since(t0));
     out.cpu_ms.push_back(thread_cpu_ms() - c0);
     out.region_faces.push_back(report.region_faces);
-    if (!display) continue;
+    if (!display || !g_orbit_cull) continue;
     const auto t1 = Clock::now();
     const double c1 = thread_cpu_ms();
     // The source's topology is the pipeline's once per decoded mesh.
@@ -336,6 +339,8 @@ int main(int argc, char** argv) {
     if (a == "--cull-eye-share" && i + 1 < argc) g_margins.eye_share = std::stof(argv[++i]);
     if (a == "--cull-angle" && i + 1 < argc) g_margins.angle_degrees = std::stof(argv[++i]);
     if (a == "--no-updates") updates_wanted = false;
+    if (a == "--orbit-steps" && i + 1 < argc) g_orbit_steps = std::stoi(argv[++i]);
+    if (a == "--no-orbit-cull") g_orbit_cull = false;
   }
   std::vector<PictureRow> pictures, faces_rows;
   std::vector<std::pair<std::string, UpdateStats>> updates, big_updates;
@@ -384,7 +389,7 @@ int main(int argc, char** argv) {
                    median(stats.build_ms));
     }
     if (!orbit_wanted) continue;
-    orbits.emplace_back(name, orbit(imported->mesh, 1280, 720, 10));
+    orbits.emplace_back(name, orbit(imported->mesh, 1280, 720, g_orbit_steps));
     std::fprintf(stderr, "orbit %s: median %.1f ms (%.1f CPU), cull %.1f ms (%.1f CPU)\n",
                  name.c_str(), median(orbits.back().second.ms), median(orbits.back().second.cpu_ms),
                  median(orbits.back().second.cull_ms), median(orbits.back().second.cull_cpu_ms));

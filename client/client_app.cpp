@@ -20,6 +20,7 @@
 #include "client/stream_client.h"
 #include "client/stream_source.h"
 #include "common/mesh/export.h"
+#include "common/mesh/import.h"
 
 namespace meshstream::client {
 
@@ -245,6 +246,14 @@ class StreamingRun {
     if (!file_error_) file_error_ = s.error();
   }
 
+  // A display mesh to a file without the vertex slots no face uses (ASA's
+  // incremental path keeps some, IncrementalSubdivider::result()).
+  static Status write_display(const Mesh& display, const std::string& path) {
+    Mesh compact = display;  // (writing costs more than the copy)
+    drop_unreferenced(compact);
+    return write_mesh(compact, path);
+  }
+
   Status snapshot(const DisplayFrame& frame) const {
     const Mesh& drawn = frame.drawn ? *frame.drawn : *frame.display;
     const auto* kinds = frame.drawn ? frame.drawn_face_kind.get() : frame.face_kind.get();
@@ -264,7 +273,7 @@ class StreamingRun {
       log_.refinement(frame, info, elapsed(), client_->rate_bytes_per_s());
       const uint32_t record = frame.records_decoded - 1;
       if (!o_.out_dir.empty() && o_.saves_record(record))
-        keep_error(write_mesh(*frame.display, record_file(o_, record)));
+        keep_error(write_display(*frame.display, record_file(o_, record)));
       if (o_.snapshot_at && !snapshot_done_ && record == *o_.snapshot_at && hooks_.snapshot) {
         keep_error(snapshot(frame));
         snapshot_done_ = true;
@@ -274,7 +283,7 @@ class StreamingRun {
       final_frame_ = frame;
       if (!o_.out_dir.empty()) {
         const fs::path dir(o_.out_dir);
-        keep_error(write_mesh(*frame.display, (dir / o_.out_file("final")).string()));
+        keep_error(write_display(*frame.display, (dir / o_.out_file("final")).string()));
         keep_error(write_mesh(*frame.decoded, (dir / o_.out_file("final.decoded")).string()));
         for (const std::string& lost : export_losses(*frame.display, o_.out_file("final")))
           log_.note("warning: " + o_.out_file("final") + ": not stored: " + lost);
@@ -327,9 +336,9 @@ class StreamingRun {
       s.vertices = shown->decoded->vertex_count();
       s.faces = shown->decoded->face_count();
       const Mesh& drawn = shown->drawn ? *shown->drawn : *shown->display;
-      s.display_vertices = drawn.vertex_count();
+      s.display_vertices = drawn_vertices(*shown);
       s.display_faces = drawn.face_count();
-      s.whole_display_vertices = shown->display->vertex_count();
+      s.whole_display_vertices = whole_display_vertices(*shown);
       s.whole_display_faces = shown->display->face_count();
     }
     return s;

@@ -36,11 +36,15 @@ struct DisplayBuilder::State {
   double full_ms_per_face = 0;  // measured on the last full run
   std::vector<uint8_t> seen;    // scratch: changed faces counted once
   // The incremental path's display meshes: copies of its result, handed to
-  // frames. One no frame holds any more is copied into again, so the copy
-  // reuses its memory (a fresh 100 MB mesh costs more in page faults than
-  // in copying).
-  std::vector<std::shared_ptr<Mesh>> display_pool;
-  std::vector<std::shared_ptr<std::vector<FaceKind>>> kind_pool;
+  // frames. One no frame holds any more is brought up to date again: only
+  // what the updates since its version changed is copied
+  // (IncrementalSubdivider::copy_result_into), into the memory it had.
+  struct PooledDisplay {
+    std::shared_ptr<Mesh> mesh = std::make_shared<Mesh>();
+    std::shared_ptr<std::vector<FaceKind>> kinds = std::make_shared<std::vector<FaceKind>>();
+    uint64_t version = 0;  // of the incremental result it copies
+  };
+  std::vector<PooledDisplay> display_pool;
 };
 
 DisplayBuilder::DisplayBuilder() : state_(std::make_unique<State>()) {}
@@ -59,18 +63,23 @@ std::shared_ptr<const Mesh> with_surface(Mesh display, const Mesh& decoded) {
   return std::make_shared<const Mesh>(std::move(display));
 }
 
-// An entry of `pool` no one else holds (a new one when all are held; the
-// pool keeps at most three).
-template <class T>
-std::shared_ptr<T> free_entry(std::vector<std::shared_ptr<T>>& pool) {
+// The entry of `pool` no one else holds with the newest copy (the least to
+// bring up to date); a new one when all are held (the pool keeps at most
+// three).
+template <class Entry>
+Entry free_entry(std::vector<Entry>& pool) {
+  Entry* best = nullptr;
   for (auto& entry : pool) {
-    if (entry.use_count() != 1) continue;
+    if (entry.mesh.use_count() != 1 || entry.kinds.use_count() != 1) continue;
+    if (!best || entry.version > best->version) best = &entry;
+  }
+  if (best) {
     // The last holder's release (a frame on another thread) comes before
     // our writes (as in frame_mesh_pool.cpp).
     std::atomic_thread_fence(std::memory_order_acquire);
-    return entry;
+    return *best;
   }
-  auto entry = std::make_shared<T>();
+  Entry entry;
   if (pool.size() < 3) pool.push_back(entry);
   return entry;
 }
@@ -198,15 +207,18 @@ Result<DisplayMesh> DisplayBuilder::build(const std::shared_ptr<const Mesh>& dec
   const IncrementalStats& stats = s.incremental->last_update();
   const AsaResult& result = s.incremental->result();
   if (max_faces_ > 0 && result.mesh.face_count() > max_faces_) return budgeted_full_run();
-  std::shared_ptr<Mesh> display = free_entry(s.display_pool);
-  *display = result.mesh;  // into the memory it had: no page faults
+  State::PooledDisplay entry = free_entry(s.display_pool);
+  s.incremental->copy_result_into(*entry.mesh, *entry.kinds, entry.version);
+  for (auto& pooled : s.display_pool)
+    if (pooled.mesh == entry.mesh) pooled.version = entry.version;
+  std::shared_ptr<Mesh> display = std::move(entry.mesh);
   display->materials = mesh.materials;
   display->textures = mesh.textures;
-  std::shared_ptr<std::vector<FaceKind>> kinds = free_entry(s.kind_pool);
-  *kinds = result.face_kind;
+  std::shared_ptr<std::vector<FaceKind>> kinds = std::move(entry.kinds);
   report.asa_ms = ms_since(start);
   report.incremental = !stats.full;
   report.region_faces = stats.region_faces;
+  report.unused_vertices = s.incremental->unused_vertices();
   if (stats.full) {
     if (F > 0) s.full_ms_per_face = report.asa_ms / double(F);
   } else if (path_ == AsaPath::kAuto && s.full_ms_per_face > 0 && F > 0) {

@@ -2,8 +2,9 @@
 // (common/asa/subdivide.h) either on the whole mesh, or incrementally on
 // the region the update changed (common/asa/incremental.h), keeping
 // whichever path has been faster for updates of that size. Both paths give
-// the same triangles with the same positions (same face order); only the
-// numbering of the new vertices may differ.
+// the same triangles with the same positions; the incremental path's are in
+// another order and its mesh has unused vertex slots (IncrementalSubdivider::
+// result()): each update copies into the display only what it changed.
 #pragma once
 
 #include <cstdint>
@@ -26,8 +27,9 @@ struct BuildReport {
   // View-dependent ASA: the tolerance used (0 without a camera); raised
   // above the requested one when the display budget was reached.
   float pixel_tolerance = 0;
-  bool budget_limited = false;  // the budget cut this update (tolerance or levels)
-  int levels_used = 0;          // ASA levels the kept run allowed
+  bool budget_limited = false;   // the budget cut this update (tolerance or levels)
+  int levels_used = 0;           // ASA levels the kept run allowed
+  uint32_t unused_vertices = 0;  // display vertex slots no face uses (incremental path)
 };
 
 struct DisplayMesh {

@@ -26,6 +26,9 @@ struct DisplayFrame {
   std::shared_ptr<const Mesh> decoded;                     // the decoder's mesh at this record
   std::shared_ptr<const Mesh> display;                     // after ASA (== decoded when ASA is off)
   std::shared_ptr<const std::vector<FaceKind>> face_kind;  // per display face; may be null
+  // Vertex slots of `display` no face uses (ASA's incremental path keeps
+  // some, IncrementalSubdivider::result()); events count the others.
+  uint32_t display_unused_vertices = 0;
   // What the renderer draws (view-dependent mode, display_cull.h): the
   // display's faces the camera (within the cull's margins) can see, with
   // a skirt; the display itself otherwise. --out files keep `display`.
@@ -50,6 +53,14 @@ struct DisplayFrame {
   float pixel_tolerance = 0;    // the tolerance used; 0: view-independent or no ASA
   bool budget_limited = false;  // --max-display-faces cut this update
 };
+
+// The vertices faces use: of the whole display, and of what is drawn.
+inline uint32_t whole_display_vertices(const DisplayFrame& f) {
+  return f.display->vertex_count() - f.display_unused_vertices;
+}
+inline uint32_t drawn_vertices(const DisplayFrame& f) {
+  return f.drawn && f.drawn != f.display ? f.drawn->vertex_count() : whole_display_vertices(f);
+}
 
 // Latest-wins mailbox: the producer never waits for the consumer, and a
 // consumer that falls behind sees only the newest frame.

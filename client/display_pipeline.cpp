@@ -446,6 +446,7 @@ void DisplayPipeline::loop() {
     }
     frame.display = display->mesh;
     frame.face_kind = display->face_kind;
+    frame.display_unused_vertices = info.build.unused_vertices;
     frame.asa_ms = info.build.asa_ms;
     frame.pixel_tolerance = effective.asa_enabled ? info.build.pixel_tolerance : 0;
     frame.budget_limited = info.build.budget_limited;

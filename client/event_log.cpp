@@ -93,10 +93,10 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
                      {"bytes", fr.bytes_received},
                      {"vertices", fr.decoded->vertex_count()},
                      {"faces", fr.decoded->face_count()},
-                     {"display_vertices", drawn_of(fr).vertex_count()},
+                     {"display_vertices", drawn_vertices(fr)},
                      {"display_faces", drawn_of(fr).face_count()},
                      {"cull_ms", round3(fr.cull_ms)},
-                     {"whole_display_vertices", fr.display->vertex_count()},
+                     {"whole_display_vertices", whole_display_vertices(fr)},
                      {"whole_display_faces", fr.display->face_count()},
                      {"decode_ms", round3(fr.decode_ms)},
                      {"asa_ms", round3(fr.asa_ms)},
@@ -115,7 +115,7 @@ void EventLog::refinement(const DisplayFrame& fr, const FrameInfo& info, double 
   std::fprintf(stderr, "\r\033[K%s / %s (%.0f%%)  records %u/%u  vertices %u (display %u)  %s/s",
                human_bytes(double(fr.bytes_received)).c_str(),
                human_bytes(double(fr.bytes_total)).c_str(), pct, fr.records_decoded,
-               fr.records_total, fr.decoded->vertex_count(), fr.display->vertex_count(),
+               fr.records_total, fr.decoded->vertex_count(), whole_display_vertices(fr),
                human_bytes(rate).c_str());
   std::fflush(stderr);
   progress_shown_ = true;
@@ -125,10 +125,10 @@ void EventLog::view_update(const DisplayFrame& fr, const FrameInfo& info, double
   std::lock_guard lock(mutex_);
   if (!json_) return;
   nlohmann::json j{{"event", "view"},
-                   {"display_vertices", drawn_of(fr).vertex_count()},
+                   {"display_vertices", drawn_vertices(fr)},
                    {"display_faces", drawn_of(fr).face_count()},
                    {"cull_ms", round3(fr.cull_ms)},
-                   {"whole_display_vertices", fr.display->vertex_count()},
+                   {"whole_display_vertices", whole_display_vertices(fr)},
                    {"whole_display_faces", fr.display->face_count()},
                    {"asa_ms", round3(fr.asa_ms)},
                    {"region_faces", info.build.region_faces},

@@ -3,6 +3,7 @@
 #include "common/asa/incremental.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -46,8 +47,197 @@ void IncrementalSubdivider::remember(const Mesh& input) {
   previous_.colors.assign(input.colors.begin(), input.colors.end());
   previous_.texcoords.assign(input.texcoords.begin(), input.texcoords.end());
   previous_.normals.assign(input.normals.begin(), input.normals.end());
-  compute_patch_starts(result_.source_face, input.face_count(), patch_start_);
+  adopt_canonical(input.vertex_count(), input.face_count());
   has_previous_ = true;
+}
+
+// result_ as subdivide() made it (patches contiguous, in input-face order,
+// input vertices first) becomes the in-place layout: the patch lists, and
+// the vertices renumbered with headroom for the input's growth. O(output).
+void IncrementalSubdivider::adopt_canonical(uint32_t input_vertices, uint32_t input_faces) {
+  const uint32_t F = result_.mesh.face_count();
+  patch_first_.assign(input_faces, kNone);
+  patch_size_.assign(input_faces, 0);
+  patch_tail_.assign(input_faces, kNone);
+  next_in_patch_.assign(F, kNone);
+  for (uint32_t k = 0; k < F; ++k) {
+    const uint32_t f = result_.source_face[k];
+    if (patch_tail_[f] == kNone) {
+      patch_first_[f] = k;
+    } else {
+      next_in_patch_[patch_tail_[f]] = k;
+    }
+    patch_tail_[f] = k;
+    ++patch_size_[f];
+  }
+  input_slots_ = input_vertices;
+  relayout(input_vertices + headroom_for(input_vertices));
+}
+
+// Slots kept free after the input's vertices for those later records add.
+uint32_t IncrementalSubdivider::headroom_for(uint32_t input_vertices) const {
+  return input_vertices / 8 + 1024;
+}
+
+// Renumbers the output vertices: [0, input_slots_) keep theirs (the input
+// vertices' slots), [input_slots_, slots) become unused slots, and the
+// vertices the faces use beyond them follow in first use; the free list
+// empties. The faces keep their slots. O(output); a whole change.
+void IncrementalSubdivider::relayout(uint32_t slots) {
+  Mesh& out = result_.mesh;
+  const uint32_t V = out.vertex_count(), keep = std::min(input_slots_, V);
+  new_id_.assign(V, kNone);
+  for (uint32_t v = 0; v < keep; ++v) new_id_[v] = v;
+  uint32_t count = slots;
+  for (Triangle& t : out.triangles)
+    for (uint32_t& v : t) {
+      if (new_id_[v] == kNone) new_id_[v] = count++;
+      v = new_id_[v];
+    }
+  // (Positions always: an empty output still needs the input's slots.)
+  auto remap = [&](auto& values, auto fill, bool always = false) {
+    if (values.empty() && !always) return;
+    std::remove_reference_t<decltype(values)> moved(count, fill);
+    for (uint32_t v = 0; v < V; ++v)
+      if (new_id_[v] != kNone) moved[new_id_[v]] = values[v];
+    values.swap(moved);
+  };
+  remap(out.positions, V > 0 ? out.positions[0] : Vec3f{}, true);
+  remap(out.colors, Vec4f{});
+  remap(out.texcoords, Vec2f{});
+  remap(out.normals, Vec3f{});
+  vertex_refs_.assign(count, 0);
+  for (const Triangle& t : out.triangles)
+    for (uint32_t v : t) ++vertex_refs_[v];
+  free_vertices_.clear();
+  input_slots_ = slots;
+  if (!log_.empty()) current_change().whole = true;
+  stats_.rebuilt = true;
+}
+
+uint32_t IncrementalSubdivider::new_vertex_slot() {
+  if (!free_vertices_.empty()) {
+    const uint32_t v = free_vertices_.back();
+    free_vertices_.pop_back();
+    return v;
+  }
+  Mesh& out = result_.mesh;
+  const uint32_t v = out.vertex_count();
+  out.positions.emplace_back();
+  if (!out.colors.empty()) out.colors.emplace_back();
+  if (!out.texcoords.empty()) out.texcoords.emplace_back();
+  vertex_refs_.push_back(0);
+  return v;
+}
+
+void IncrementalSubdivider::release_vertex(uint32_t v) {
+  if (--vertex_refs_[v] == 0 && v >= input_slots_) free_vertices_.push_back(v);
+}
+
+// Output face `from` (the last) moves to the free slot `to`; its patch list
+// follows. O(patch).
+void IncrementalSubdivider::move_face(uint32_t from, uint32_t to) {
+  result_.mesh.triangles[to] = result_.mesh.triangles[from];
+  result_.face_kind[to] = result_.face_kind[from];
+  const uint32_t f = result_.source_face[to] = result_.source_face[from];
+  next_in_patch_[to] = next_in_patch_[from];
+  if (patch_first_[f] == from) {
+    patch_first_[f] = to;
+  } else {
+    uint32_t k = patch_first_[f];
+    while (next_in_patch_[k] != from) k = next_in_patch_[k];
+    next_in_patch_[k] = to;
+  }
+  current_change().faces.push_back(to);
+}
+
+void IncrementalSubdivider::open_change() {
+  static std::atomic<uint64_t> versions{0};
+  version_ = ++versions;
+  Change change;
+  if (log_.size() == kLoggedChanges) {
+    change = std::move(log_.front());  // (its memory)
+    log_.pop_front();
+  }
+  change.version = version_;
+  change.whole = false;
+  change.faces.clear();
+  change.vertices.clear();
+  log_.push_back(std::move(change));
+}
+
+bool IncrementalSubdivider::copy_result_into(Mesh& mesh, std::vector<FaceKind>& kinds,
+                                             uint64_t& version) const {
+  if (version == version_ && version != 0) return true;
+  size_t first = log_.size() + 1;  // the first change the copy lacks
+  for (size_t i = 0; i < log_.size(); ++i)
+    if (log_[i].version == version) first = i + 1;
+  bool whole = version == 0 || first > log_.size();
+  for (size_t i = first; !whole && i < log_.size(); ++i) whole = log_[i].whole;
+  version = version_;
+  const Mesh& r = result_.mesh;
+  if (whole) {
+    mesh = r;  // into the memory it had: no page faults
+    kinds = result_.face_kind;
+    return false;
+  }
+  // Every index whose value may differ from the copy's is listed in a
+  // change since (slots beyond an array's old end are written when they
+  // are taken): copying today's values at those indices suffices.
+  mesh.positions.resize(r.positions.size());
+  mesh.colors.resize(r.colors.size());
+  mesh.texcoords.resize(r.texcoords.size());
+  mesh.normals.resize(r.normals.size());
+  mesh.triangles.resize(r.triangles.size());
+  kinds.resize(result_.face_kind.size());
+  const uint32_t V = r.vertex_count(), F = r.face_count();
+  for (size_t i = first; i < log_.size(); ++i) {
+    for (uint32_t v : log_[i].vertices) {
+      if (v >= V) continue;
+      mesh.positions[v] = r.positions[v];
+      if (!r.colors.empty()) mesh.colors[v] = r.colors[v];
+      if (!r.texcoords.empty()) mesh.texcoords[v] = r.texcoords[v];
+    }
+    for (uint32_t f : log_[i].faces) {
+      if (f >= F) continue;
+      mesh.triangles[f] = r.triangles[f];
+      kinds[f] = result_.face_kind[f];
+    }
+  }
+  return true;
+}
+
+AsaResult IncrementalSubdivider::canonical() const {
+  AsaResult c;
+  const Mesh& out = result_.mesh;
+  const uint32_t Vn = std::min(previous_.vertex_count(), out.vertex_count());
+  std::vector<uint32_t> id(out.vertex_count(), kNone);
+  for (uint32_t v = 0; v < Vn; ++v) id[v] = v;
+  auto first = [&](const auto& values, auto& into) {
+    if (!values.empty()) into.assign(values.begin(), values.begin() + Vn);
+  };
+  first(out.positions, c.mesh.positions);
+  first(out.colors, c.mesh.colors);
+  first(out.texcoords, c.mesh.texcoords);
+  first(out.normals, c.mesh.normals);
+  for (uint32_t f = 0; f < patch_first_.size(); ++f)
+    for (uint32_t k = patch_first_[f]; k != kNone; k = next_in_patch_[k]) {
+      Triangle t = out.triangles[k];
+      for (uint32_t& v : t) {
+        if (id[v] == kNone) {
+          id[v] = c.mesh.vertex_count();
+          c.mesh.positions.push_back(out.positions[v]);
+          if (!out.colors.empty()) c.mesh.colors.push_back(out.colors[v]);
+          if (!out.texcoords.empty()) c.mesh.texcoords.push_back(out.texcoords[v]);
+          if (!out.normals.empty()) c.mesh.normals.push_back(out.normals[v]);
+        }
+        v = id[v];
+      }
+      c.mesh.triangles.push_back(t);
+      c.face_kind.push_back(result_.face_kind[k]);
+      c.source_face.push_back(f);
+    }
+  return c;
 }
 
 // The level-0 adjacency, face normals and (with a camera) feature flags of
@@ -226,9 +416,7 @@ bool IncrementalSubdivider::view_region_update(const Mesh& input) {
     if (!subdivide_into(region_, options_, workspace_, region_result_)) break;
     compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
     if (!seam_matches()) continue;
-    splice(input, input.vertex_count());
-    std::swap(result_, next_);
-    compute_patch_starts(result_.source_face, Fn, patch_start_);
+    splice(input);
     clear_vertex_marks();
     return true;
   }
@@ -251,6 +439,8 @@ Status IncrementalSubdivider::full_update(const Mesh& input, bool level0_current
   // test.cpp): keep it rather than rebuild the adjacency of the whole mesh.
   level0_valid_ = level0_valid_ && level0_current;
   clear_vertex_marks();
+  if (!log_.empty()) current_change().whole = true;
+  stats_.rebuilt = true;
   if (options_.view.enabled && !options_.uniform && options_.levels > 0) {
     stats_.full = false;
     if (view_region_update(input)) return {};
@@ -540,12 +730,12 @@ bool IncrementalSubdivider::seam_matches() {
   for (uint32_t g : seam_faces_) {
     if (is_dirty(g)) continue;
     const uint32_t lg = local_face_[g];
-    const uint32_t p0 = patch_start_[g], p1 = patch_start_[g + 1];
     const uint32_t r0 = region_patch_start_[lg], r1 = region_patch_start_[lg + 1];
-    if (p1 - p0 != r1 - r0) return false;
-    for (uint32_t k = 0; k < p1 - p0; ++k) {
+    if (patch_size_[g] != r1 - r0) return false;
+    uint32_t k = patch_first_[g];
+    for (uint32_t r = r0; r < r1; ++r, k = next_in_patch_[k]) {
       for (int i = 0; i < 3; ++i) {
-        const uint32_t pv = prev_out.triangles[p0 + k][i], rv = reg_out.triangles[r0 + k][i];
+        const uint32_t pv = prev_out.triangles[k][i], rv = reg_out.triangles[r][i];
         if (!same_bits(prev_out.positions[pv], reg_out.positions[rv]) ||
             (seam_map_[rv] != kNone && seam_map_[rv] != pv))
           return false;
@@ -556,71 +746,111 @@ bool IncrementalSubdivider::seam_matches() {
   return true;
 }
 
-// 6. Splice into next_: clean patches from the previous result, dirty ones
-// from the region; input vertices first, then others as first used.
-void IncrementalSubdivider::splice(const Mesh& input, uint32_t Vo) {
+// 6. Splice in place: the dirty faces' old patches free their output faces
+// and the vertices no other face uses; their new patches from the region
+// take the freed faces first, then new ones at the end; freed faces left
+// over are filled by the last faces. Kept vertices keep their slots, new
+// ones take free slots first. Every write is logged for copy_result_into.
+// O(region + patches moved).
+void IncrementalSubdivider::splice(const Mesh& input) {
   const uint32_t Fn = input.face_count();
-  const Mesh& prev_out = result_.mesh;
+  Mesh& out = result_.mesh;
   const Mesh& reg_out = region_result_.mesh;
-  new_id_prev_.assign(prev_out.vertex_count(), kNone);
-  for (uint32_t v = 0; v < Vo; ++v) new_id_prev_[v] = v;
+  Change& change = current_change();
+  const bool colors = !input.colors.empty(), texcoords = !input.texcoords.empty();
+  patch_first_.resize(Fn, kNone);
+  patch_size_.resize(Fn, 0);
+  free_faces_.clear();
+  for (uint32_t f : region_faces_) {
+    if (!is_dirty(f)) continue;
+    for (uint32_t k = patch_first_[f]; k != kNone; k = next_in_patch_[k]) {
+      free_faces_.push_back(k);
+      for (uint32_t v : out.triangles[k]) release_vertex(v);
+    }
+    patch_first_[f] = kNone;
+    patch_size_[f] = 0;
+  }
+  for (uint32_t v : changed_list_) {
+    out.positions[v] = input.positions[v];
+    if (colors) out.colors[v] = input.colors[v];
+    if (texcoords) out.texcoords[v] = input.texcoords[v];
+    change.vertices.push_back(v);
+  }
   new_id_region_.assign(reg_out.vertex_count(), kNone);
   for (uint32_t x = 0; x < region_.vertex_count(); ++x) new_id_region_[x] = global_vertex_[x];
-  Mesh& out = next_.mesh;
-  out.positions.assign(input.positions.begin(), input.positions.end());
-  out.colors.assign(input.colors.begin(), input.colors.end());
-  out.texcoords.assign(input.texcoords.begin(), input.texcoords.end());
-  out.triangles.clear();
-  next_.face_kind.clear();
-  next_.source_face.clear();
-  const bool colors = !input.colors.empty(), texcoords = !input.texcoords.empty();
-  auto take_prev = [&](uint32_t p) {
-    uint32_t& id = new_id_prev_[p];
-    if (id == kNone) {
-      id = static_cast<uint32_t>(out.positions.size());
-      out.positions.push_back(prev_out.positions[p]);
-      if (colors) out.colors.push_back(prev_out.colors[p]);
-      if (texcoords) out.texcoords.push_back(prev_out.texcoords[p]);
-    }
-    return id;
-  };
-  auto take_region = [&](uint32_t x) {
-    uint32_t& id = new_id_region_[x];
+  auto take = [&](uint32_t x) {
+    uint32_t id = new_id_region_[x];
     if (id == kNone) {
       if (seam_map_[x] != kNone) {
-        id = take_prev(seam_map_[x]);
+        id = seam_map_[x];
       } else {
-        id = static_cast<uint32_t>(out.positions.size());
-        out.positions.push_back(reg_out.positions[x]);
-        if (colors) out.colors.push_back(reg_out.colors[x]);
-        if (texcoords) out.texcoords.push_back(reg_out.texcoords[x]);
+        id = new_vertex_slot();
+        out.positions[id] = reg_out.positions[x];
+        if (colors) out.colors[id] = reg_out.colors[x];
+        if (texcoords) out.texcoords[id] = reg_out.texcoords[x];
+        change.vertices.push_back(id);
       }
+      new_id_region_[x] = id;
     }
+    ++vertex_refs_[id];
     return id;
   };
-  for (uint32_t f = 0; f < Fn; ++f) {
-    if (is_dirty(f)) {
-      const uint32_t lf = local_face_[f];
-      for (uint32_t k = region_patch_start_[lf]; k < region_patch_start_[lf + 1]; ++k) {
-        const Triangle& t = reg_out.triangles[k];
-        out.triangles.push_back({take_region(t[0]), take_region(t[1]), take_region(t[2])});
-        next_.face_kind.push_back(region_result_.face_kind[k]);
-        next_.source_face.push_back(f);
+  size_t reused = 0;
+  for (uint32_t f : region_faces_) {
+    if (!is_dirty(f)) continue;
+    const uint32_t lf = local_face_[f];
+    uint32_t tail = kNone;
+    for (uint32_t k = region_patch_start_[lf]; k < region_patch_start_[lf + 1]; ++k) {
+      uint32_t slot;
+      if (reused < free_faces_.size()) {
+        slot = free_faces_[reused++];
+      } else {
+        slot = out.face_count();
+        out.triangles.emplace_back();
+        result_.face_kind.emplace_back();
+        result_.source_face.push_back(f);
+        next_in_patch_.push_back(kNone);
       }
-    } else {
-      for (uint32_t k = patch_start_[f]; k < patch_start_[f + 1]; ++k) {
-        const Triangle& t = prev_out.triangles[k];
-        out.triangles.push_back({take_prev(t[0]), take_prev(t[1]), take_prev(t[2])});
-        next_.face_kind.push_back(result_.face_kind[k]);
-        next_.source_face.push_back(f);
+      const Triangle& t = reg_out.triangles[k];
+      out.triangles[slot] = {take(t[0]), take(t[1]), take(t[2])};
+      result_.face_kind[slot] = region_result_.face_kind[k];
+      result_.source_face[slot] = f;
+      next_in_patch_[slot] = kNone;
+      if (tail == kNone) {
+        patch_first_[f] = slot;
+      } else {
+        next_in_patch_[tail] = slot;
       }
+      tail = slot;
+      ++patch_size_[f];
+      change.faces.push_back(slot);
     }
+  }
+  if (reused < free_faces_.size()) {
+    std::sort(free_faces_.begin() + static_cast<std::ptrdiff_t>(reused), free_faces_.end());
+    size_t lo = reused, hi = free_faces_.size();
+    uint32_t n = out.face_count();
+    while (lo < hi) {
+      if (free_faces_[hi - 1] == n - 1) {
+        --hi;  // the last face is free itself
+      } else {
+        move_face(n - 1, free_faces_[lo++]);
+      }
+      --n;
+    }
+    out.triangles.resize(n);
+    result_.face_kind.resize(n);
+    result_.source_face.resize(n);
+    next_in_patch_.resize(n);
   }
   if (!input.normals.empty()) {
     out.normals = compute_vertex_normals(out);
+    change.whole = true;
   } else {
     out.normals.clear();
   }
+  // Garbage bound: too many free vertex slots, renumber.
+  if (free_vertices_.size() > 1024 + out.vertex_count() / 8) relayout(input_slots_);
 }
 
 namespace {
@@ -718,14 +948,12 @@ uint32_t IncrementalSubdivider::mark_view_changes(const Mesh& input) {
   }
   const bool deeper = options_.levels > 1;
   const QuietFaces before(previous_view_), after(options_.view);
-  const uint32_t patched =
-      static_cast<uint32_t>(patch_start_.empty() ? 0 : patch_start_.size() - 1);
+  const uint32_t patched = static_cast<uint32_t>(patch_size_.size());
   uint32_t faces = 0;
   for (uint32_t f = 0; f < Fn; ++f) {
     bool redo = target_before_[f] != target_after_[f];
     if (!redo && deeper) {
-      const bool refined =
-          target_after_[f] || f >= patched || patch_start_[f + 1] - patch_start_[f] > 1;
+      const bool refined = target_after_[f] || f >= patched || patch_size_[f] > 1;
       if (refined) {
         const Triangle& t = input.triangles[f];
         const Vec3f a = input.positions[t[0]], b = input.positions[t[1]], c = input.positions[t[2]];
@@ -783,6 +1011,7 @@ uint32_t IncrementalSubdivider::mark_view_changes_of_bent_faces(const Mesh& inpu
 
 Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* changes) {
   stats_ = {};
+  open_change();
   const bool view_changed = view_changed_;
   view_changed_ = false;
   if (view_changed && has_previous_ && previous_view_.enabled != options_.view.enabled)
@@ -802,7 +1031,6 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
   if (!table_.apply(input, changed_faces_, old_corners_)) {
     return full_update(input);  // reports the problem (non-manifold) with the whole mesh's view
   }
-  const uint32_t previous_vertices = previous_.vertex_count();
   bring_previous_up_to_date(input);
   refresh_face_normals(input);
   if (bent_valid_) refresh_bent(input);
@@ -810,7 +1038,10 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
     stats_.view_faces = mark_view_changes(input);
   stats_.changed_vertices = static_cast<uint32_t>(changed_list_.size());
   const uint32_t Fn = input.face_count();
-  if (changed_list_.empty() && Fn + 1 == patch_start_.size()) return {};
+  if (changed_list_.empty() && Fn == patch_size_.size()) return {};
+  // New input vertices need their slots (input vertex i is output vertex i).
+  if (input.vertex_count() > input_slots_)
+    relayout(input.vertex_count() + headroom_for(input.vertex_count()));
   for (uint32_t attempt = 0; attempt < incremental_.max_attempts; ++attempt) {
     stats_.attempts = attempt + 1;
     stats_.dirty_faces = grow_region(input, attempt);
@@ -823,9 +1054,7 @@ Status IncrementalSubdivider::update(const Mesh& input, const InputChanges* chan
     }
     compute_patch_starts(region_result_.source_face, region_.face_count(), region_patch_start_);
     if (!seam_matches()) continue;  // the closure reached further: grow the region
-    splice(input, previous_vertices);
-    std::swap(result_, next_);
-    compute_patch_starts(result_.source_face, Fn, patch_start_);
+    splice(input);
     clear_vertex_marks();
     return {};
   }

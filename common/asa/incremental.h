@@ -12,9 +12,16 @@
 // identity of every seam vertex. If they differ (ASA closure reached further
 // than the region), the region grows; after a few tries, or when most of the
 // mesh changed, the whole mesh is subdivided again.
+//
+// The result is kept in place: an update rewrites only the output faces of
+// the input faces it redid and the output vertices it made or moved (O(change),
+// no copy of the whole output), so its faces are not in input-face order and
+// it may hold unused vertex slots (see result()).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <deque>
 #include <span>
 #include <vector>
 
@@ -38,6 +45,9 @@ struct IncrementalStats {
   uint32_t region_faces = 0;      // faces of the submesh that was subdivided
   uint32_t attempts = 0;          // subdivisions of a region this update
   uint32_t view_faces = 0;        // input faces redone because the view changed
+  // The result was made anew (a full or view-region run, or its vertices
+  // renumbered): a copy of it is copied whole once.
+  bool rebuilt = false;
 };
 
 // What changed in the input since the previous update, as the decoder
@@ -61,11 +71,13 @@ class IncrementalSubdivider {
   // with the previous input by index: vertex i is unchanged when its position
   // (and attributes) are bit-identical, face f when it has the same three
   // indices; new vertices and faces are appended (as the decoder does).
-  // The result equals subdivide(input, options) face for face (same order and
-  // bit-identical corner positions; vertex numbering may differ beyond the
-  // input vertices, which keep their indices). Errors as subdivide(); after an
-  // error the next update is a full one.
-  // Cost: O(changed region) subdivision + O(output) copying; the level-0
+  // The result equals subdivide(input, options) as a set of faces: the same
+  // triangles (bit-identical corner positions, same corner order) with the
+  // same face kinds, in another order; canonical() gives them face for face
+  // in subdivide()'s order. Errors as subdivide(); after an error the next
+  // update is a full one.
+  // Cost: O(changed region) subdivision and splice (no O(output) pass,
+  // except vertex normals when the input has normals); the level-0
   // adjacency (asa::LiveCornerTable) and face normals are kept up to date
   // with what changed, not rebuilt. With `changes` finding what changed
   // costs the change too; without, one comparison pass over the input.
@@ -75,7 +87,37 @@ class IncrementalSubdivider {
   // mesh.
   Status update(const Mesh& input, const InputChanges* changes = nullptr);
 
+  // The output, in place: input vertex i is output vertex i; output vertices
+  // [input vertex count, input_slots()) and the free slots beyond it are used
+  // by no face (their positions are old or another vertex's, so a bounding
+  // box of the positions stays on the surface); source_face names each
+  // face's input face (patches are not contiguous). The unused vertices are
+  // at most 1/8 of the output's plus headroom for the input's growth; past
+  // that (or when the input outgrows its slots) the vertices are renumbered
+  // (O(output), that update is a whole change).
   const AsaResult& result() const { return result_; }
+  uint32_t input_slots() const { return input_slots_; }
+  // Output vertex slots no face uses: result().mesh.vertex_count() minus
+  // this is subdivide()'s vertex count. O(1).
+  uint32_t unused_vertices() const {
+    const uint32_t inputs = std::min(previous_.vertex_count(), input_slots_);
+    return input_slots_ - inputs + static_cast<uint32_t>(free_vertices_.size());
+  }
+  // The result as subdivide() gives it: faces in input-face order (each
+  // patch in its order), input vertices first, then the others as first
+  // used. O(output); for tests and tools.
+  AsaResult canonical() const;
+
+  // Each update that may change result() gives it a new version (unique
+  // across instances). copy_result_into brings a copy of result() made at
+  // version `version` up to date by copying only what the updates since then
+  // changed (O(change)) when they are still logged, else copies all of it;
+  // then sets `version` (0: a copy of nothing yet). After it, `mesh` and
+  // `kinds` equal result().mesh (its arrays: positions, triangles, colors,
+  // texcoords, normals) and result().face_kind element for element. True
+  // when only the changes were copied.
+  uint64_t version() const { return version_; }
+  bool copy_result_into(Mesh& mesh, std::vector<FaceKind>& kinds, uint64_t& version) const;
   const IncrementalStats& last_update() const { return stats_; }
   // Forgets the previous input: the next update subdivides everything.
   void reset() { has_previous_ = false; }
@@ -120,17 +162,45 @@ class IncrementalSubdivider {
   void close_region_fans(const Mesh& input);
   void extract_region(const Mesh& input);
   bool seam_matches();
-  void splice(const Mesh& input, uint32_t previous_vertices);
+  void splice(const Mesh& input);
+  // In-place layout (see result()).
+  void adopt_canonical(uint32_t input_vertices, uint32_t input_faces);
+  void relayout(uint32_t input_slots);
+  uint32_t headroom_for(uint32_t input_vertices) const;
+  uint32_t new_vertex_slot();
+  void release_vertex(uint32_t v);
+  void move_face(uint32_t from, uint32_t to);
+  struct Change;
+  void open_change();
+  Change& current_change() { return log_.back(); }
 
   AsaOptions options_;
   IncrementalOptions incremental_;
   AsaWorkspace workspace_;
   bool has_previous_ = false;
-  bool view_changed_ = false;          // set_view since the last update
-  AsaView previous_view_;              // the view the result was made for
-  Mesh previous_;                      // the previous input
-  std::vector<uint32_t> patch_start_;  // per previous input face, into result_ faces (+1 sentinel)
+  bool view_changed_ = false;  // set_view since the last update
+  AsaView previous_view_;      // the view the result was made for
+  Mesh previous_;              // the previous input
   AsaResult result_;
+  // Per previous input face: its patch as a list of result_ faces, in the
+  // patch's order (first face, then next_in_patch_ per face; kNone ends it).
+  std::vector<uint32_t> patch_first_, patch_size_, next_in_patch_;
+  std::vector<uint32_t> vertex_refs_;    // per output vertex: corners using it
+  std::vector<uint32_t> free_vertices_;  // unused output vertices >= input_slots_
+  uint32_t input_slots_ = 0;
+  // What each recent update changed in result_ (by index), for copies.
+  struct Change {
+    uint64_t version = 0;
+    bool whole = false;
+    std::vector<uint32_t> faces, vertices;
+  };
+
+ public:
+  static constexpr size_t kLoggedChanges = 8;  // a copy this many updates behind is patched
+
+ private:
+  std::deque<Change> log_;
+  uint64_t version_ = 0;
   IncrementalStats stats_;
   // Level 0 of the previous input, kept up to date with the changes.
   bool level0_valid_ = false;
@@ -168,10 +238,11 @@ class IncrementalSubdivider {
   uint32_t generation_ = 0;
   std::vector<uint32_t> dirty_stamp_, region_stamp_, face_seen_, vertex_seen_, local_stamp_;
   // Scratch reused between updates.
-  AsaResult region_result_, next_;
+  AsaResult region_result_;
   Mesh region_;
   std::vector<uint32_t> local_vertex_, global_vertex_, region_faces_;
-  std::vector<uint32_t> local_face_, region_patch_start_, seam_map_, new_id_prev_, new_id_region_;
+  std::vector<uint32_t> local_face_, region_patch_start_, seam_map_, new_id_, new_id_region_;
+  std::vector<uint32_t> free_faces_, patch_tail_;
   std::vector<uint32_t> frontier_, next_frontier_, seam_faces_;
 };
 

@@ -235,6 +235,8 @@ uint32_t drop_isolated_twins(Mesh& mesh, const std::vector<uint8_t>& had_twin,
   return before - mesh.face_count();
 }
 
+}  // namespace
+
 uint32_t drop_unreferenced(Mesh& mesh) {
   const uint32_t n = mesh.vertex_count();
   std::vector<uint8_t> used(n, 0);
@@ -250,8 +252,6 @@ uint32_t drop_unreferenced(Mesh& mesh) {
   renumber(mesh, new_index, count);
   return n - count;
 }
-
-}  // namespace
 
 bool CleanReport::changed() const {
   return welded_vertices || degenerate_faces || duplicate_faces || unreferenced_vertices ||

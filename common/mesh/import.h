@@ -95,4 +95,8 @@ Result<ImportedMesh> import_mesh(const std::string& path, const ImportOptions& o
 // The cleaning step alone, on a mesh already in memory (same rules as import).
 Result<CleanReport> clean_mesh(Mesh& mesh, const ImportOptions& options = {});
 
+// Drops the vertices no face uses (per-vertex arrays follow, the others keep
+// their order); returns how many. O(V + F).
+uint32_t drop_unreferenced(Mesh& mesh);
+
 }  // namespace meshstream

@@ -10,21 +10,7 @@
 namespace meshstream {
 namespace {
 
-// A decoder-like refinement: a new vertex inside face f, lifted off the
-// plane; f is replaced in place and two faces are appended.
-void insert_vertex(Mesh& m, uint32_t f, float lift) {
-  const Triangle t = m.triangles[f];
-  const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
-  const Vec3f n = normalized(cross(b - a, c - a));
-  const float size = length(b - a);
-  const uint32_t v = m.vertex_count();
-  m.positions.push_back((a + b + c) / 3.0f + n * (lift * size));
-  if (!m.colors.empty()) m.colors.push_back({0.5f, 0.5f, 0.5f, 1});
-  m.triangles[f] = {t[0], t[1], v};
-  m.triangles.push_back({t[1], t[2], v});
-  m.triangles.push_back({t[2], t[0], v});
-}
-
+using asa_test::insert_vertex;
 using asa_test::same_output;
 
 void run_records(const Mesh& start, const AsaOptions& options, int records, const char* what,
@@ -46,8 +32,8 @@ void run_records(const Mesh& start, const AsaOptions& options, int records, cons
     partial += !inc.last_update().full;
     auto full = subdivide(m, options);
     ASSERT_TRUE(full.has_value());
-    EXPECT_TRUE(same_output(inc.result(), *full)) << what << " after record " << r;
-    EXPECT_TRUE(asa_test::conforming(m, inc.result())) << what << " after record " << r;
+    EXPECT_TRUE(asa_test::same_incremental(inc, *full)) << what << " after record " << r;
+    EXPECT_TRUE(asa_test::conforming_incremental(m, inc)) << what << " after record " << r;
   }
   if (expect_partial) {
     EXPECT_GT(partial, records / 2) << what << ": most updates should be partial";
@@ -102,13 +88,14 @@ TEST(AsaIncremental, BatchesTooLargeForARegionStayExact) {
       for (int i = 0; i < 600; ++i) insert_vertex(m, rng() % m.face_count(), 0.15f);
       ASSERT_TRUE(inc.update(m).has_value());
       EXPECT_GT(inc.last_update().dirty_faces, m.face_count() / 4) << "the batch fit a region";
-      EXPECT_TRUE(same_output(inc.result(), *subdivide(m, o))) << camera << " batch " << round;
+      EXPECT_TRUE(asa_test::same_incremental(inc, *subdivide(m, o)))
+          << camera << " batch " << round;
       for (int r = 0; r < 3; ++r) {
         insert_vertex(m, rng() % m.face_count(), r % 2 ? 0.2f : -0.1f);
         ASSERT_TRUE(inc.update(m).has_value());
         partial_after_batch += !inc.last_update().full && inc.last_update().dirty_faces > 0 &&
                                inc.last_update().dirty_faces < m.face_count() / 4;
-        EXPECT_TRUE(same_output(inc.result(), *subdivide(m, o)))
+        EXPECT_TRUE(asa_test::same_incremental(inc, *subdivide(m, o)))
             << camera << " batch " << round << " record " << r;
       }
     }
@@ -130,7 +117,7 @@ TEST(AsaIncremental, ColorsFollowAndNothingChangedIsFree) {
   insert_vertex(m, 300, 0.3f);
   ASSERT_TRUE(inc.update(m).has_value());
   auto full = subdivide(m, o);
-  EXPECT_TRUE(same_output(inc.result(), *full));
+  EXPECT_TRUE(asa_test::same_incremental(inc, *full));
   ASSERT_EQ(inc.result().mesh.colors.size(), inc.result().mesh.positions.size());
   // Bad input after good: an error, and the next good update is full.
   Mesh bad = m;

@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include "common/asa/incremental.h"
 #include "common/asa/level_mesh.h"
 #include "common/asa/subdivide.h"
 #include "common/mesh/adjacency.h"
@@ -153,6 +155,90 @@ inline ::testing::AssertionResult same_output(const AsaResult& a, const AsaResul
 inline uint32_t edge_count(const Mesh& m) {
   auto adj = Adjacency::build(m);
   return adj ? adj->edge_count() : 0;
+}
+
+// Each face as its corners' position bits and its kind, sorted: the mesh's
+// faces as a set (vertex numbering and face order left out).
+// Kinds left out (0) when `kinds` is null.
+inline std::vector<std::array<uint32_t, 10>> face_set(const Mesh& m,
+                                                      const std::vector<FaceKind>* kinds) {
+  std::vector<std::array<uint32_t, 10>> keys;
+  keys.reserve(m.face_count());
+  for (uint32_t f = 0; f < m.face_count(); ++f) {
+    std::array<uint32_t, 10> k{};
+    for (int i = 0; i < 3; ++i) std::memcpy(&k[3 * i], &m.positions[m.triangles[f][i]], 12);
+    k[9] = kinds ? static_cast<uint32_t>((*kinds)[f]) : 0;
+    keys.push_back(k);
+  }
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+inline std::vector<std::array<uint32_t, 10>> face_set(const AsaResult& r) {
+  return face_set(r.mesh, &r.face_kind);
+}
+
+// The incremental subdivider's in-place result against a full run: face
+// for face once put in subdivide()'s order (canonical()), and the in-place
+// faces themselves the same set of triangles (corner positions bit for bit,
+// corner order, kinds), every index in range.
+inline ::testing::AssertionResult same_incremental(const IncrementalSubdivider& inc,
+                                                   const AsaResult& full) {
+  const AsaResult canonical = inc.canonical();
+  if (auto same = same_output(canonical, full); !same) return same << " (canonical order)";
+  const AsaResult& in_place = inc.result();
+  if (in_place.face_kind.size() != in_place.mesh.face_count() ||
+      in_place.source_face.size() != in_place.mesh.face_count())
+    return ::testing::AssertionFailure() << "per-face arrays of the in-place result";
+  for (const Triangle& t : in_place.mesh.triangles)
+    for (uint32_t v : t)
+      if (v >= in_place.mesh.vertex_count())
+        return ::testing::AssertionFailure() << "in-place face refers to vertex " << v;
+  if (face_set(in_place) != face_set(full))
+    return ::testing::AssertionFailure() << "in-place faces differ from the full run's as a set";
+  return ::testing::AssertionSuccess();
+}
+
+// conforming() of the canonical result, and of the in-place mesh itself:
+// manifold, the same boundary edges, the input's vertices in their slots,
+// unused vertex slots within the subdivider's bound.
+inline ::testing::AssertionResult conforming_incremental(const Mesh& input,
+                                                         const IncrementalSubdivider& inc) {
+  const AsaResult canonical = inc.canonical();
+  if (auto ok = conforming(input, canonical); !ok) return ok << " (canonical)";
+  const Mesh& out = inc.result().mesh;
+  if (out.positions.size() < input.positions.size() ||
+      std::memcmp(out.positions.data(), input.positions.data(),
+                  sizeof(Vec3f) * input.positions.size()) != 0)
+    return ::testing::AssertionFailure() << "in place: input vertices not in their slots";
+  auto adj = Adjacency::build(out);
+  auto canonical_adj = Adjacency::build(canonical.mesh);
+  if (!adj)
+    return ::testing::AssertionFailure() << "in place not manifold: " << adj.error().message;
+  if (!canonical_adj || adj->boundary_edge_count() != canonical_adj->boundary_edge_count())
+    return ::testing::AssertionFailure() << "in place: boundary edges differ";
+  const uint32_t unused = out.vertex_count() - canonical.mesh.vertex_count();
+  if (unused != inc.unused_vertices())
+    return ::testing::AssertionFailure()
+           << unused << " unused vertex slots, unused_vertices() says " << inc.unused_vertices();
+  const uint32_t bound = (inc.input_slots() - input.vertex_count()) + 1024 + out.vertex_count() / 8;
+  if (unused > bound)
+    return ::testing::AssertionFailure() << unused << " unused vertex slots, bound " << bound;
+  return ::testing::AssertionSuccess();
+}
+
+// A decoder-like refinement: a new vertex inside face f, lifted off the
+// plane; f is replaced in place and two faces are appended.
+inline void insert_vertex(Mesh& m, uint32_t f, float lift) {
+  const Triangle t = m.triangles[f];
+  const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+  const Vec3f n = normalized(cross(b - a, c - a));
+  const float size = length(b - a);
+  const uint32_t v = m.vertex_count();
+  m.positions.push_back((a + b + c) / 3.0f + n * (lift * size));
+  if (!m.colors.empty()) m.colors.push_back({0.5f, 0.5f, 0.5f, 1});
+  m.triangles[f] = {t[0], t[1], v};
+  m.triangles.push_back({t[1], t[2], v});
+  m.triangles.push_back({t[2], t[0], v});
 }
 
 }  // namespace meshstream::asa_test

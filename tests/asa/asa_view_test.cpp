@@ -187,7 +187,7 @@ void check_camera_moves(const Mesh& start, const std::string& name, bool expect_
   ASSERT_TRUE(inc.update(start).has_value());
   // The first update subdivides only what the screen may refine, when that
   // is a small region: the same as a full run.
-  EXPECT_TRUE(same_output(inc.result(), run(start, o))) << name << " first update";
+  EXPECT_TRUE(asa_test::same_incremental(inc, run(start, o))) << name << " first update";
   Mesh m = start;
   std::mt19937 rng(5);
   int partial = 0;
@@ -210,8 +210,8 @@ void check_camera_moves(const Mesh& start, const std::string& name, bool expect_
     AsaOptions full_options = o;
     full_options.view = view;
     const AsaResult full = run(m, full_options);
-    EXPECT_TRUE(same_output(inc.result(), full)) << name << " step " << step;
-    EXPECT_TRUE(conforming(m, inc.result())) << name << " step " << step;
+    EXPECT_TRUE(asa_test::same_incremental(inc, full)) << name << " step " << step;
+    EXPECT_TRUE(asa_test::conforming_incremental(m, inc)) << name << " step " << step;
   }
   if (expect_partial) EXPECT_GT(partial, 0) << name << ": some camera moves should be partial";
 }
