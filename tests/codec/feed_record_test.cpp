@@ -72,8 +72,9 @@ TEST(FeedRecord, ARecordBeforeItsNeedsIsRefusedAndChangesNothing) {
 
   auto early = decoder.feed_record(3, record_bytes(3));
   ASSERT_FALSE(early);
-  EXPECT_EQ(early.error().message,
-            "record 3" + of + ": needs records 0 to 2 first (a record needs every record before it)");
+  EXPECT_EQ(
+      early.error().message,
+      "record 3" + of + ": needs records 0 to 2 first (a record needs every record before it)");
   EXPECT_EQ(decoder.records_decoded(), 0u);
 
   ASSERT_TRUE(decoder.feed_record(0, record_bytes(0)));

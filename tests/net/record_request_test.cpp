@@ -62,7 +62,8 @@ class CleanupModels : public ::testing::Environment {
 };
 const auto* const cleanup_registration = ::testing::AddGlobalTestEnvironment(new CleanupModels);
 
-v1::StreamRequest ranged(const std::string& model, const std::vector<std::pair<uint32_t, uint32_t>>& ranges) {
+v1::StreamRequest ranged(const std::string& model,
+                         const std::vector<std::pair<uint32_t, uint32_t>>& ranges) {
   v1::StreamRequest request;
   request.set_model(model);
   v1::RecordSelection* selection = request.mutable_records();
@@ -116,8 +117,9 @@ RangedReply read_ranged(TestClient& client) {
 
 // The record whose bytes hold stream offset `at`.
 uint32_t record_at(const StreamIndex& index, uint64_t at) {
-  auto it = std::upper_bound(index.records.begin(), index.records.end(), at,
-                             [](uint64_t o, const RecordEntry& r) { return o < r.offset + r.size; });
+  auto it =
+      std::upper_bound(index.records.begin(), index.records.end(), at,
+                       [](uint64_t o, const RecordEntry& r) { return o < r.offset + r.size; });
   return static_cast<uint32_t>(it - index.records.begin());
 }
 
@@ -142,7 +144,8 @@ ServerProcess* RangedTest::server_ = nullptr;
 TEST_F(RangedTest, SendsExactlyTheRecordsAskedInTheOrderAsked) {
   const std::vector<uint8_t>& file = models().synthetic;
   const StreamIndex index = *read_stream_index(file);
-  const std::vector<std::pair<uint32_t, uint32_t>> ranges{{40, 60}, {0, 1}, {7, 9}, {1, 2}, {20, 30}};
+  const std::vector<std::pair<uint32_t, uint32_t>> ranges{
+      {40, 60}, {0, 1}, {7, 9}, {1, 2}, {20, 30}};
   TestClient c = connected();
   v1::StreamRequest request = ranged("synthetic", ranges);
   request.set_max_chunk_bytes(4096);  // several chunks per range, records split
@@ -218,7 +221,8 @@ TEST_F(RangedTest, BadListsAreRefusedNamingTheRangeAndEveryoneGoesOn) {
   std::vector<Case> cases{
       {ranged("synthetic", {}), "records: the list of ranges is empty"},
       {ranged("synthetic", {{3, 3}}), "records.ranges[0] [3, 3) is empty"},
-      {ranged("synthetic", {{0, 1}, {9, 4}}), "records.ranges[1] [9, 4) is reversed (end before first)"},
+      {ranged("synthetic", {{0, 1}, {9, 4}}),
+       "records.ranges[1] [9, 4) is reversed (end before first)"},
       {ranged("synthetic", {{55, 61}}),
        "records.ranges[0] [55, 61) is out of bounds: the stream has 60 records, 0 to 59"},
       {ranged("synthetic", {{4000000000u, 4000000001u}}),
@@ -291,7 +295,8 @@ TEST_F(RangedTest, RecordsBeforeTheirNeedsArriveAndTheDecoderRefusesThem) {
       const uint32_t rec = record_at(index, at);
       const uint64_t stop = std::min<uint64_t>(index.records[rec].offset + index.records[rec].size,
                                                piece.offset() + piece.data().size());
-      records[rec].insert(records[rec].end(), piece.data().begin() + std::ptrdiff_t(at - piece.offset()),
+      records[rec].insert(records[rec].end(),
+                          piece.data().begin() + std::ptrdiff_t(at - piece.offset()),
                           piece.data().begin() + std::ptrdiff_t(stop - piece.offset()));
       at = stop;
     }
