@@ -34,8 +34,9 @@ std::vector<Vec3i> coarse_positions(const std::vector<Vec3i>& q, int shift) {
   return coarse;
 }
 
-// Encoder-side truth of the base vertices, in decoder ids: true positions,
-// residuals against their coarse anchors, and star areas as the weights.
+// Encoder-side truth of the base vertices, in decoder ids: their input ids
+// (so their true positions), and star areas as the weights. `whole`: room
+// for every vertex of the mesh at once (a prefix encode grows as it goes).
 EncoderTruth base_truth(const Mesh& mesh, const std::vector<Vec3i>& q,
                         const std::vector<Vec3f>& input_normals, const ChosenBase& base,
                         const RefinementState& state, const TriangleBvh* surface, bool whole) {
