@@ -280,20 +280,19 @@ class LayerBuilder {
   }
 
   // Tries to remove v; returns true, fills `removal` and appends its ring
-  // (apex first) to `ring_pool` on success. removal.ring is left empty:
-  // the pool may still grow (decimate_layers points the rings into it once
-  // the layer is done).
+  // (apex first) to `ring_pool` on success.
   bool try_remove(uint32_t v, Removal& removal, std::vector<uint32_t>& ring_pool) {
     double error = 0;
     const uint32_t best_apex = this->best_apex(v, error);
     if (best_apex == kNone) return false;
     const uint32_t k = static_cast<uint32_t>(ring_.size());
     const bool boundary = m_.is_boundary(v);
-    const auto& p = m_.positions();
     removal.vertex = v;
-    removal.position = p[v];
+    removal.ring_first = static_cast<uint32_t>(ring_pool.size());
+    removal.ring_size = static_cast<uint16_t>(k);
     for (uint32_t i = 0; i < k; ++i) ring_pool.push_back(ring_[(best_apex + i) % k]);
-    removal.open = boundary ? (2 * k - 1 - best_apex) % k : kNone;
+    removal.open_edge =
+        boundary ? static_cast<uint16_t>((2 * k - 1 - best_apex) % k) : Removal::kInterior;
     m_.remove_vertex(v, ring_, corners_, best_apex);
     if (!quadrics.empty()) quadrics[ring_[best_apex]].add(quadrics[v]);
     return true;
@@ -357,7 +356,6 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
       options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   std::vector<double> cost(n, -1);
   std::vector<Candidate> candidates;
-  std::vector<uint32_t> ring, corners, ring_start;
   std::vector<uint8_t> layer_locked;
   while (alive_count > target && result.layers.size() < options.max_layers) {
     update_costs(mesh, field, alive, cost, threads);
@@ -375,38 +373,28 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
       return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
     });
     std::fill(blocked.begin(), blocked.end(), 0);
-    std::vector<Removal> layer;
-    std::vector<uint32_t> pool;
-    ring_start.clear();
+    DecimationLayer layer;
     // The cheapest share first; all candidates when none of those is removable.
     const size_t share = static_cast<size_t>(kCandidateShare * double(candidates.size()));
     for (size_t limit : {std::max<size_t>(share, 1), candidates.size()}) {
       for (size_t i = 0; i < limit && i < candidates.size(); ++i) {
-        if (alive_count - layer.size() <= target) break;
+        if (alive_count - layer.removals.size() <= target) break;
         const uint32_t v = candidates[i].vertex;
         if (blocked[v]) continue;
         Removal r;
-        const size_t start = pool.size();
-        if (!builder.try_remove(v, r, pool)) continue;
+        if (!builder.try_remove(v, r, layer.rings)) continue;
         blocked[v] = 1;
-        for (size_t k = start; k < pool.size(); ++k) blocked[pool[k]] = 1;
+        for (uint32_t u : layer.ring(r)) blocked[u] = 1;
         alive[v] = 0;
-        ring_start.push_back(static_cast<uint32_t>(start));
-        layer.push_back(r);
+        layer.removals.push_back(r);
       }
-      if (!layer.empty()) break;
+      if (!layer.removals.empty()) break;
     }
-    if (layer.empty()) break;
-    alive_count -= static_cast<uint32_t>(layer.size());
+    if (layer.removals.empty()) break;
+    alive_count -= static_cast<uint32_t>(layer.removals.size());
     // Kept until the encode ends: no growth slack.
-    layer.shrink_to_fit();
-    pool.shrink_to_fit();
-    ring_start.push_back(static_cast<uint32_t>(pool.size()));
-    for (size_t i = 0; i < layer.size(); ++i) {
-      layer[i].ring =
-          std::span<const uint32_t>(pool.data() + ring_start[i], ring_start[i + 1] - ring_start[i]);
-    }
-    result.ring_pools.push_back(std::move(pool));
+    layer.removals.shrink_to_fit();
+    layer.rings.shrink_to_fit();
     result.layers.push_back(std::move(layer));
     if (options.progress) options.progress(double(n - alive_count) / double(n - target));
   }

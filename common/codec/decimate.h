@@ -50,33 +50,42 @@ namespace meshstream {
 
 inline constexpr uint32_t kMaxRemovalValence = 16;
 
+// 12 bytes a removal: its position is the input's (decimation moves no
+// vertex: q[vertex]), its ring a range of its layer's ring pool. It was 40
+// (a copy of the position and a span) and, before the pools, 48 plus a heap
+// block; the layers are kept until the encode ends (issue 15's memory).
 struct Removal {
-  uint32_t vertex = 0;  // id in the input mesh
-  Vec3i position;
-  // kNone for an interior vertex; for a boundary vertex the index i of the
-  // ring edge (ring[i], ring[i+1]) that its removal turned into a boundary edge.
-  uint32_t open = kNone;
-  // ring[0] is the fan apex; CCW around vertex. A view into its layer's
-  // ring pool (DecimationResult::ring_pools): one flat array a layer
-  // instead of a heap block a removal (80 bytes a removed vertex with the
-  // vector; 40 + 4 a ring vertex now).
-  std::span<const uint32_t> ring;
+  static constexpr uint16_t kInterior = 0xFFFF;
+
+  uint32_t vertex = 0;      // id in the input mesh
+  uint32_t ring_first = 0;  // its ring: DecimationLayer::rings[ring_first, + ring_size)
+  uint16_t ring_size = 0;   // at most kMaxRemovalValence
+  // kInterior for an interior vertex; for a boundary vertex the index i of
+  // the ring edge (ring[i], ring[i+1]) that its removal turned into a
+  // boundary edge.
+  uint16_t open_edge = kInterior;
+
+  // open_edge, kNone for an interior vertex.
+  uint32_t open() const { return open_edge == kInterior ? kNone : open_edge; }
+};
+static_assert(sizeof(Removal) == 12);
+
+// One layer: its removals and their rings (ring[0] is the fan apex; CCW
+// around the vertex), back to back in one array.
+struct DecimationLayer {
+  std::vector<Removal> removals;
+  std::vector<uint32_t> rings;
+
+  std::span<const uint32_t> ring(const Removal& r) const {
+    return {rings.data() + r.ring_first, r.ring_size};
+  }
 };
 
-// Move-only: the removals' rings point into ring_pools (moving the vectors
-// keeps their buffers; a copy would point into the original's).
 struct DecimationResult {
-  DecimationResult() = default;
-  DecimationResult(DecimationResult&&) = default;
-  DecimationResult& operator=(DecimationResult&&) = default;
-  DecimationResult(const DecimationResult&) = delete;
-  DecimationResult& operator=(const DecimationResult&) = delete;
-
   // layers[0] was removed first (finest); the decoder restores the last first.
-  std::vector<std::vector<Removal>> layers;
-  std::vector<std::vector<uint32_t>> ring_pools;  // layer i's rings, back to back
-  std::vector<uint32_t> base_vertices;            // input ids of the vertices left, ascending
-  std::vector<Triangle> base_faces;               // in input ids
+  std::vector<DecimationLayer> layers;
+  std::vector<uint32_t> base_vertices;  // input ids of the vertices left, ascending
+  std::vector<Triangle> base_faces;     // in input ids
 };
 
 struct DecimateOptions {

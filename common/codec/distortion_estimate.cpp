@@ -12,18 +12,35 @@ double displacement_error2(Vec3i recon, Vec3i truth) {
   return squared_length(to_double(recon - truth));
 }
 
+namespace {
+
+// A grid point as one integer, unique for every axis in [0, 2^kMaxQuantBits)
+// (reconstruct() clamps to the grid); kNotOnGrid for any other point,
+// which is then never looked up in the cache.
+static_assert(3 * kMaxQuantBits <= 63);
+constexpr uint64_t kNotOnGrid = ~uint64_t(0);
+uint64_t pack_grid_point(Vec3i p) {
+  if ((uint32_t(p.x) | uint32_t(p.y) | uint32_t(p.z)) >> kMaxQuantBits) return kNotOnGrid;
+  return uint64_t(uint32_t(p.x)) | uint64_t(uint32_t(p.y)) << kMaxQuantBits |
+         uint64_t(uint32_t(p.z)) << (2 * kMaxQuantBits);
+}
+
+}  // namespace
+
 double vertex_error2(EncoderTruth& t, uint32_t v, Vec3i recon) {
-  if (!t.surface) return displacement_error2(recon, t.position[v]);
-  if (recon == t.position[v]) return 0;  // an original vertex lies on the original surface
+  const Vec3i truth = t.position(v);
+  if (!t.surface) return displacement_error2(recon, truth);
+  if (recon == truth) return 0;  // an original vertex lies on the original surface
   if (t.cached.size() <= v) t.cached.resize(v + 1);
   EncoderTruth::CachedError& c = t.cached[v];
+  const uint64_t packed = pack_grid_point(recon);
   for (int i = 0; i < 2; ++i)
-    if (c.error2[i] >= 0 && c.position[i] == recon) return c.error2[i];
+    if (c.error2[i] >= 0 && c.position[i] == packed && packed != kNotOnGrid) return c.error2[i];
   const ClosestHit hit = t.surface->closest(to_double(recon), c.triangle);
   c.triangle = hit.triangle;
   c.position[1] = c.position[0];
   c.error2[1] = c.error2[0];
-  c.position[0] = recon;
+  c.position[0] = packed;
   c.error2[0] = hit.squared_distance;
   return hit.squared_distance;
 }

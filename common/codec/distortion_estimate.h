@@ -21,14 +21,21 @@ namespace meshstream {
 // (and residual against its anchor) and the weight of its error in the
 // distortion estimate; and, by input id, unit normals of the original.
 struct EncoderTruth {
-  std::vector<Vec3i> position;
-  std::vector<Vec3i> residual;
+  // The grid points by input id (the caller's, shared by every candidate),
+  // and every decoder vertex's input id: its true position is
+  // input_position[input_of[v]] (4 bytes a vertex instead of a copy of 12).
+  std::span<const Vec3i> input_position;
+  std::vector<uint32_t> input_of;
+  // Its residual against its anchor is position(v) - the anchor (fixed
+  // once the vertex is in: RefinementState::geometry).
+  Vec3i position(uint32_t v) const { return input_position[input_of[v]]; }
   // Star area when the vertex got its geometry x sqrt(vertex count then):
   // the area its error spreads over shrinks as the mesh refines around it;
   // area(now) ~ weight / sqrt(vertices now) measured better than 1 / n
   // (refinement is not uniform: flat regions stay coarse) or no decay.
   std::vector<double> weight;
   // By input id; the same for every candidate, so computed once and shared.
+  // Read only without a surface (the displacement estimate).
   std::span<const Vec3f> input_normal;
   // The original surface in grid units; when set, a vertex's error is its
   // distance to that surface instead of its displacement from its truth.
@@ -37,8 +44,10 @@ struct EncoderTruth {
   // (a group's next plane is evaluated again when the group grows, and its
   // "after" becomes the next evaluation's "before"), and the triangle found
   // last, which starts the next search nearby.
+  // The positions as packed grid points (pack_grid_point: kMaxQuantBits
+  // bits an axis fit 64), 40 bytes an entry instead of 48.
   struct CachedError {
-    Vec3i position[2];
+    uint64_t position[2] = {0, 0};
     double error2[2] = {-1, -1};
     uint32_t triangle = TriangleBvh::kNoHint;
   };
@@ -54,7 +63,7 @@ double displacement_error2(Vec3i recon, Vec3i truth);
 // Decoder vertex v's squared error when shown at `recon`: its distance to
 // the original surface, or (no surface) its displacement from its true
 // position. Surface answers are remembered (EncoderTruth::cached), so `t`
-// changes. Precondition: v < t.position.size(). Cost: one closest-point
+// changes. Precondition: v < t.input_of.size(). Cost: one closest-point
 // query when the answer is not cached.
 double vertex_error2(EncoderTruth& t, uint32_t v, Vec3i recon);
 

@@ -441,14 +441,19 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
       if (to) *to = std::move(from);
     }
   } hand_out{surface_out, surface};
-  const std::vector<Vec3f> input_normals = vertex_normals(q, mesh.triangles);
+  // The input's normals, for the displacement estimate only: computed when
+  // a candidate uses it, freed before a surface-distance winner's encode
+  // (12 bytes a vertex beside the surface hierarchy at the peak).
+  std::vector<Vec3f> input_normals;
+  if (!std::all_of(orderings.begin(), orderings.end(), uses_surface))
+    input_normals = vertex_normals(q, mesh.triangles);
   auto encode_candidate = [&](size_t i, uint32_t bytes, EncodeReport* candidate_report,
                               const std::function<void(double)>& candidate_progress,
-                              uint64_t stop_after_bytes = 0) {
+                              uint64_t stop_after_bytes = 0, bool last = false) {
     const RecordOrdering& o = orderings[i];
     return encode_once(mesh, *grid, q, input_normals, dec, options, bytes, o.plane_calibration,
                        candidate_report, uses_surface(o) ? &surface : nullptr, candidate_progress,
-                       stop_after_bytes);
+                       stop_after_bytes, last ? &dec : nullptr);
   };
   const RecordSizing sizing(mesh.vertex_count(), options);
   const bool parallel =
@@ -500,15 +505,19 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
     if (*best == 0) return finish(streams[0]);
     progress.stage("coding the winner", measured_at, 1.0);
     if (uses_surface(orderings[*best])) {
+      input_normals = {};
       if (surface.empty()) {
         surface = grid_surface(mesh, q, options.threads);
       } else if (auto st = to_grid_units(surface, mesh, q); !st) {
         return tl::unexpected(st.error());
       }
     }
+    // The prefixes are measured: only the first stream may still be needed.
+    streams.resize(1);
     EncodeReport winner_report;
+    // The decimation's last encode: its layers go as they are written.
     auto winner = encode_candidate(*best, first->record_bytes, report ? &winner_report : nullptr,
-                                   progress.within_function());
+                                   progress.within_function(), 0, true);
     if (!winner) return tl::unexpected(winner.error());
     if (sizing.automatic && sizing.granular(streams[0]) && !sizing.granular(*winner))
       return finish(streams[0]);

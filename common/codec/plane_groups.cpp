@@ -36,7 +36,7 @@ size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32
   for (uint32_t v = first; v < first + count; ++v) {
     VertexGeometry geo = s.geometry[v];
     if (geo.shift == 0) continue;
-    PlainPlaneWriter io{{enc, t.residual[v]}, models};
+    PlainPlaneWriter io{{enc, t.position(v) - geo.anchor}, models};
     plane_step(unused, io, geo, prev_new, s.max_coordinate);
   }
   return enc.finish().size();
@@ -53,7 +53,7 @@ void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g) {
     ++g.pending;
     g.top_plane = std::max(g.top_plane, geo.shift - 1);
     const Vec3i before = s.mesh.positions()[v];
-    PlaneBitOracle io{t.residual[v]};
+    PlaneBitOracle io{t.position(v) - geo.anchor};
     uint8_t prev_new = 0;
     plane_step(scratch, io, geo, prev_new, s.max_coordinate);
     const Vec3i after = reconstruct(geo, s.max_coordinate);

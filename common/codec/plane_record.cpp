@@ -62,7 +62,7 @@ Status apply_plane_record(RefinementState& state, std::span<const uint8_t> paylo
 }
 
 std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, uint32_t count,
-                                        const std::vector<Vec3i>& residuals) {
+                                        std::span<const Vec3i> residuals) {
   std::vector<uint8_t> out;
   out.push_back(kRecordPlane);
   put_varint(out, first);
@@ -72,7 +72,7 @@ std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, 
   for (uint32_t v = first; v < first + count; ++v) {
     VertexGeometry& g = state.geometry[v];
     if (g.shift == 0) continue;
-    PlaneBitWriter io{enc, residuals[v]};
+    PlaneBitWriter io{enc, residuals[v - first]};
     plane_step(state.geometry_models, io, g, prev_new, state.max_coordinate);
     state.vertex_shift[v] = g.shift;
     state.mesh.set_position(v, reconstruct(g, state.max_coordinate));

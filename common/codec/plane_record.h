@@ -18,9 +18,10 @@ namespace meshstream {
 // go to the mesh and `applied.moved_vertices`. O(count).
 Status apply_plane_record(RefinementState& state, std::span<const uint8_t> payload,
                           AppliedRecord& applied);
-// Encoder of the same; `residuals[v]` is vertex v's true residual against
-// its anchor. Applies the step to `state` as the decoder will.
+// Encoder of the same; `residuals[v - first]` is vertex v's true residual
+// against its anchor (count of them). Applies the step to `state` as the
+// decoder will.
 std::vector<uint8_t> write_plane_record(RefinementState& state, uint32_t first, uint32_t count,
-                                        const std::vector<Vec3i>& residuals);
+                                        std::span<const Vec3i> residuals);
 
 }  // namespace meshstream

@@ -34,20 +34,22 @@ std::vector<Vec3i> coarse_positions(const std::vector<Vec3i>& q, int shift) {
   return coarse;
 }
 
-// Encoder-side truth of the base vertices, in decoder ids: true positions,
-// residuals against their coarse anchors, and star areas as the weights.
+// Encoder-side truth of the base vertices, in decoder ids: their input ids
+// (so their true positions), and star areas as the weights. `whole`: room
+// for every vertex of the mesh at once (a prefix encode grows as it goes).
 EncoderTruth base_truth(const Mesh& mesh, const std::vector<Vec3i>& q,
                         const std::vector<Vec3f>& input_normals, const ChosenBase& base,
-                        const RefinementState& state, const TriangleBvh* surface) {
+                        const RefinementState& state, const TriangleBvh* surface, bool whole) {
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
   EncoderTruth truth;
+  truth.input_position = q;
   truth.input_normal = input_normals;
   truth.surface = surface;
   // Every vertex gets an entry as the records restore it: room for all at
-  // once (growth by doubling kept up to twice this, and a copy while it grew).
-  const uint32_t n = mesh.vertex_count();
-  truth.position.reserve(n);
-  truth.residual.reserve(n);
+  // once for a whole stream (growth by doubling kept up to twice this, and
+  // a copy while it grew); a prefix grows them as far as it goes.
+  const uint32_t n = whole ? mesh.vertex_count() : 0;
+  truth.input_of.reserve(n);
   truth.weight.reserve(n);
   if (surface) truth.cached.reserve(n);
   std::vector<double> star_area(base_n, 0.0);
@@ -57,9 +59,7 @@ EncoderTruth base_truth(const Mesh& mesh, const std::vector<Vec3i>& q,
   }
   for (uint32_t d = 0; d < base_n; ++d) {
     const uint32_t in = base.to_input[d];
-    truth.position.push_back(q[in]);
-    const Vec3i anchor = state.geometry[d].anchor;
-    truth.residual.push_back(q[in] - anchor);
+    truth.input_of.push_back(in);
     truth.weight.push_back(star_area[d] * std::sqrt(double(base_n)));
   }
   return truth;
@@ -79,7 +79,8 @@ class RecordScheduler {
     // vertices restored so far (0..1).
     const std::function<void(double)>& progress;
     uint32_t total_vertices;
-    uint64_t stop_after_bytes = 0;  // encode_once's: 0 = the whole mesh
+    uint64_t stop_after_bytes = 0;        // encode_once's: 0 = the whole mesh
+    DecimationResult* release = nullptr;  // encode_once's: &dec, or none
   };
 
   // `state` is the decoder's state after the base, `truth` the encoder's
@@ -185,6 +186,10 @@ class RecordScheduler {
   // first) when the current one is done.
   Status write_structure_record() {
     if (!writer_.layer_open()) {
+      // The layer written last is done with (the writer holds only the
+      // open one): freed when this is the decimation's last encode.
+      if (in_.release && next_layer_ < in_.release->layers.size())
+        in_.release->layers[next_layer_] = DecimationLayer{};
       --next_layer_;
       writer_.start_layer(in_.dec.layers[next_layer_], to_decoder_);
     }
@@ -215,17 +220,20 @@ class RecordScheduler {
     const uint32_t steps = g.pending;
     const int plane = g.top_plane;
     uint64_t sign_bits = 0;  // for the raw comparison: signs sent on becoming significant
+    // The group's true residuals (the truth keeps positions, not residuals).
+    residuals_.clear();
     for (uint32_t v = g.first; v < g.first + g.count; ++v) {
       const VertexGeometry& geo = state_.geometry[v];
+      const Vec3i residual = truth_.position(v) - geo.anchor;
+      residuals_.push_back(residual);
       if (geo.shift == 0 || geo.normal_axis == kBaseVertexAxis) continue;
       for (int a = 0; a < 3; ++a)
-        sign_bits += geo.mag[a] == 0 &&
-                     ((uint32_t(std::abs(truth_.residual[v][a])) >> (geo.shift - 1)) & 1u);
+        sign_bits += geo.mag[a] == 0 && ((uint32_t(std::abs(residual[a])) >> (geo.shift - 1)) & 1u);
     }
     if (report)
       report->plane_bytes_plain +=
           plain_plane_bytes(state_, truth_, g.first, g.count, plain_models_);
-    f.payload = write_plane_record(state_, g.first, g.count, truth_.residual);
+    f.payload = write_plane_record(state_, g.first, g.count, residuals_);
     f.vertices = state_.mesh.vertex_count();
     f.faces = state_.mesh.face_slot_count();
     f.drop = g.scaled_drop / std::sqrt(n_now);
@@ -261,6 +269,7 @@ class RecordScheduler {
   // Coded bits per plane step, by plane, learned from the records written.
   double plane_bits_per_step_[kMaxShift + 1];
   std::vector<std::pair<uint32_t, uint32_t>> inserted_;
+  std::vector<Vec3i> residuals_;  // write_plane_step's, reused
   PlainPlaneModels plain_models_;
   uint64_t refinement_bytes_ = 0;  // records after the base, trailers counted
 };
@@ -306,7 +315,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                   uint32_t record_bytes, double plane_calibration,
                                   EncodeReport* report, const TriangleBvh* surface,
                                   const std::function<void(double)>& progress,
-                                  uint64_t stop_after_bytes) {
+                                  uint64_t stop_after_bytes, DecimationResult* release) {
   // The base: coarse positions, the smaller coder, the decoder's state.
   const int bits = grid.bits;
   // check_options let only writable formats through.
@@ -319,16 +328,20 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                                  base_shift);
   if (!state) return tl::unexpected(state.error());
   state->format = format;
-  // The replay ends at the whole mesh: its arrays sized for it once.
-  state->mesh.reserve(mesh.vertex_count(), mesh.face_count());
-  state->vertices.reserve(mesh.vertex_count());
-  state->vertex_layer.reserve(mesh.vertex_count());
-  state->vertex_shift.reserve(mesh.vertex_count());
-  state->geometry.reserve(mesh.vertex_count());
+  // The replay of a whole stream ends at the whole mesh: its arrays sized
+  // for it once (a prefix grows them as far as it goes).
+  if (stop_after_bytes == 0) {
+    state->mesh.reserve(mesh.vertex_count(), mesh.face_count());
+    state->vertices.reserve(mesh.vertex_count());
+    state->vertex_layer.reserve(mesh.vertex_count());
+    state->vertex_shift.reserve(mesh.vertex_count());
+    state->geometry.reserve(mesh.vertex_count());
+  }
   const uint32_t base_n = static_cast<uint32_t>(base.decoded.positions.size());
   const uint32_t base_faces = static_cast<uint32_t>(base.decoded.faces.size());
 
-  EncoderTruth truth = base_truth(mesh, q, input_normals, base, *state, surface);
+  EncoderTruth truth =
+      base_truth(mesh, q, input_normals, base, *state, surface, stop_after_bytes == 0);
   std::vector<uint32_t> to_decoder(mesh.vertex_count(), kNone);
   for (uint32_t d = 0; d < base.to_input.size(); ++d) to_decoder[base.to_input[d]] = d;
 
@@ -348,7 +361,8 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                        report,
                                        progress,
                                        mesh.vertex_count(),
-                                       stop_after_bytes};
+                                       stop_after_bytes,
+                                       release};
   RecordScheduler scheduler(inputs, format, *state, truth, std::move(to_decoder), records);
   if (report) {
     report->records.clear();

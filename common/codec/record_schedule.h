@@ -38,7 +38,9 @@ struct EncodedStream {
 // records' bytes (trailers counted) to at least that many: the stream is
 // then a prefix, record for record the full stream's, whose header names
 // the mesh the prefix shows (for measuring orderings, encoder.cpp); its
-// cost is about that share of a full encode.
+// cost is about that share of a full encode. `release` (optional) is &dec
+// for the decimation's last encode: each layer is freed once written (the
+// stream is the same; dec keeps its layer count, the layers are empty).
 Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                   const std::vector<Vec3i>& q,
                                   const std::vector<Vec3f>& input_normals,
@@ -46,6 +48,7 @@ Result<EncodedStream> encode_once(const Mesh& mesh, const QuantGrid& grid,
                                   uint32_t record_bytes, double plane_calibration,
                                   EncodeReport* report, const TriangleBvh* surface,
                                   const std::function<void(double)>& progress = {},
-                                  uint64_t stop_after_bytes = 0);
+                                  uint64_t stop_after_bytes = 0,
+                                  DecimationResult* release = nullptr);
 
 }  // namespace meshstream

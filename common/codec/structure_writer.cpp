@@ -7,14 +7,15 @@
 
 namespace meshstream {
 
-void StructureWriter::start_layer(const std::vector<Removal>& removals,
+void StructureWriter::start_layer(const DecimationLayer& layer,
                                   const std::vector<uint32_t>& to_decoder) {
+  const std::vector<Removal>& removals = layer.removals;
   removals_ = &removals;
   ring_ids_.clear();
   ring_start_.clear();
   for (const Removal& r : removals) {
     ring_start_.push_back(static_cast<uint32_t>(ring_ids_.size()));
-    for (uint32_t u : r.ring) ring_ids_.push_back(to_decoder[u]);
+    for (uint32_t u : layer.ring(r)) ring_ids_.push_back(to_decoder[u]);
   }
   ring_start_.push_back(static_cast<uint32_t>(ring_ids_.size()));
   const uint32_t n = s_.mesh.vertex_count();
@@ -181,8 +182,8 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   if (!open_edges_.empty()) {
     uint32_t choice = 0;
     for (uint32_t e = 0; e < open_edges_.size(); ++e)
-      if (open_edges_[e] == r.open) choice = e + 1;
-    if (r.open != kNone && choice == 0)
+      if (open_edges_[e] == r.open()) choice = e + 1;
+    if (r.open() != kNone && choice == 0)
       return make_error(ErrorCode::kInternal, "encoder replay: the open edge of input vertex " +
                                                   std::to_string(r.vertex) +
                                                   "'s boundary patch is not on the boundary");
@@ -195,7 +196,7 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
     } else {
       m.open_edge.encode(enc, choice);
     }
-  } else if (r.open != kNone) {
+  } else if (r.open() != kNone) {
     return make_error(ErrorCode::kInternal, "encoder replay: the boundary patch of input vertex " +
                                                 std::to_string(r.vertex) +
                                                 " has no boundary edges");
@@ -205,8 +206,8 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   predict_insertion(s_, patches_[j].ring, min_shift, prediction);
   const int shift = format_.embedded ? prediction.shift : 0;
   if (bits_) enc.set_cost_sink(&bits_->residual);
-  encode_coarse_residual(m, enc, prediction.ctx, r.position, prediction.predicted, shift,
-                         geometry_[j]);
+  encode_coarse_residual(m, enc, prediction.ctx, t_.input_position[r.vertex], prediction.predicted,
+                         shift, geometry_[j]);
   return {};
 }
 
@@ -216,22 +217,25 @@ double StructureWriter::apply_patches(std::vector<std::pair<uint32_t, uint32_t>>
   double drop = 0;
   for (uint32_t j = 0; j < count; ++j) {
     const Removal& r = (*removals_)[order_[j].second];
+    const Vec3i position = t_.input_position[r.vertex];
     const VertexGeometry& g = geometry_[j];
     // Distortion estimate: before, the true point lies off the fan by
     // about its normal offset from the prediction; after, by the error of
     // its reconstruction; both spread over the patch as a hat (integral
     // of a hat of height h over area A: A h^2 / 6).
     const double area = ring_area(s_.mesh.positions(), patches_[j].ring);
-    const Vec3f nrm = t_.input_normal[r.vertex];
     const Vec3i pred = g.anchor;
-    const double dn = dot(to_double(r.position - pred), to_double(nrm));
     const Vec3i recon = reconstruct(g, s_.max_coordinate);
-    const double before =
-        t_.surface ? fan_distance2(s_.mesh.positions(), patches_[j].ring, r.position) : dn * dn;
-    const uint32_t v = apply_patch(s_, patches_[j], r.open, g, nullptr);
+    double before = 0;
+    if (t_.surface) {
+      before = fan_distance2(s_.mesh.positions(), patches_[j].ring, position);
+    } else {  // its offset along the input's normal there
+      const double dn = dot(to_double(position - pred), to_double(t_.input_normal[r.vertex]));
+      before = dn * dn;
+    }
+    const uint32_t v = apply_patch(s_, patches_[j], r.open(), g, nullptr);
     inserted.push_back({r.vertex, v});
-    t_.position.push_back(r.position);
-    t_.residual.push_back(r.position - pred);
+    t_.input_of.push_back(r.vertex);
     t_.weight.push_back(area * std::sqrt(double(vertices_before + count)));
     drop += area * (before - vertex_error2(t_, v, recon)) / 6.0;
   }

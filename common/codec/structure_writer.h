@@ -48,10 +48,10 @@ class StructureWriter {
   bool layer_open() const { return remaining_ > 0; }
 
   // Starts the next layer (the previous one must be written out).
-  // `removals` are in input vertex ids and must outlive the layer;
+  // `layer` is in input vertex ids and must outlive the layer;
   // `to_decoder` maps their ring vertices (all restored before the layer
   // starts) to decoder ids. Only the mapped rings are copied, flat.
-  void start_layer(const std::vector<Removal>& removals, const std::vector<uint32_t>& to_decoder);
+  void start_layer(const DecimationLayer& layer, const std::vector<uint32_t>& to_decoder);
 
   // Writes the next record of the open layer, about `target` bytes.
   // `inserted` gets (input id, decoder id) of every vertex it put back.

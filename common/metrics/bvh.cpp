@@ -103,14 +103,27 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh, unsigned threads) {
   // often outgrown (doubling the array): keep only what the tree uses.
   bvh.nodes_.shrink_to_fit();
 
+  // The corners' points numbered in the order the leaves first use them,
+  // so a leaf's points lie together as its copied corners did.
+  constexpr uint32_t kUnused = 0xffffffffu;
+  std::vector<uint32_t> point_of(mesh.vertex_count(), kUnused);
   bvh.triangles_.resize(n);
   bvh.slot_of_.resize(n);
   for (uint32_t s = 0; s < n; ++s) {
     const Triangle& t = mesh.triangles[refs[s]];
-    bvh.triangles_[s] =
-        Slot{{mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]}, refs[s]};
+    Slot& slot = bvh.triangles_[s];
+    for (int k = 0; k < 3; ++k) {
+      uint32_t& p = point_of[t[k]];
+      if (p == kUnused) {
+        p = static_cast<uint32_t>(bvh.points_.size());
+        bvh.points_.push_back(mesh.positions[t[k]]);
+      }
+      slot.corners[k] = p;
+    }
+    slot.triangle = refs[s];
     bvh.slot_of_[refs[s]] = s;
   }
+  bvh.points_.shrink_to_fit();
   return bvh;
 }
 
@@ -243,9 +256,9 @@ Status TriangleBvh::refit(const Mesh& mesh) {
                           " triangles, the hierarchy has " + std::to_string(triangles_.size()));
   if (triangles_.empty()) return {};
   inflate_ = inflation_for(mesh);
-  for (Slot& s : triangles_) {
+  for (const Slot& s : triangles_) {
     const Triangle& t = mesh.triangles[s.triangle];
-    s.corners = {mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]};
+    for (int k = 0; k < 3; ++k) points_[s.corners[k]] = mesh.positions[t[k]];
   }
   // Children follow their parent in the array, so going backwards meets
   // both children before the parent. A leaf's box is its corners' (padded
@@ -258,7 +271,7 @@ Status TriangleBvh::refit(const Mesh& mesh) {
     if (node.count > 0) {
       Box box;
       for (uint32_t s = node.first; s < node.first + node.count; ++s)
-        for (const Vec3f& c : triangles_[s].corners) box.grow(to_double(c));
+        for (uint32_t c : triangles_[s].corners) box.grow(to_double(points_[c]));
       const Vec3d lo = box.lo - pad, hi = box.hi + pad;
       node.lo = {round_down(lo.x), round_down(lo.y), round_down(lo.z)};
       node.hi = {round_up(hi.x), round_up(hi.y), round_up(hi.z)};
@@ -279,8 +292,9 @@ ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
   best.squared_distance = std::numeric_limits<double>::infinity();
   auto test_slot = [&](uint32_t s) {
     const Slot& t = triangles_[s];
-    const Vec3d q = closest_point_on_triangle(query, to_double(t.corners[0]),
-                                              to_double(t.corners[1]), to_double(t.corners[2]));
+    const Vec3d q = closest_point_on_triangle(query, to_double(points_[t.corners[0]]),
+                                              to_double(points_[t.corners[1]]),
+                                              to_double(points_[t.corners[2]]));
     const double d2 = squared_length(query - q);
     if (d2 < best.squared_distance) {
       best.squared_distance = d2;

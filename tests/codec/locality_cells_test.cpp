@@ -73,11 +73,12 @@ TEST(LocalityCells, EveryPatchLiesInOneCellOfItsLayer) {
   EXPECT_EQ(per_axis.back(), 1u);
   size_t removals = 0, in_cells = 0;
   for (uint32_t layer = 0; layer < dec.layers.size(); ++layer) {
-    for (const Removal& r : dec.layers[layer]) {
+    for (const Removal& r : dec.layers[layer].removals) {
       ++removals;
       if (per_axis[layer] < 2) continue;
       const uint32_t cell = locality_cell(q[r.vertex], per_axis[layer], 12);
-      for (uint32_t u : r.ring) ASSERT_EQ(locality_cell(q[u], per_axis[layer], 12), cell);
+      for (uint32_t u : dec.layers[layer].ring(r))
+        ASSERT_EQ(locality_cell(q[u], per_axis[layer], 12), cell);
       ++in_cells;
     }
   }
