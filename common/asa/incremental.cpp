@@ -6,7 +6,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <numbers>
 #include <optional>
 
@@ -302,17 +301,9 @@ void IncrementalSubdivider::refresh_bent_block(const Mesh& input, uint32_t block
   BentBlock& b = bent_blocks_[block];
   b = {};
   b.stale = false;
-  const uint32_t group = block / kBentGroup;
-  if (group >= bent_groups_.size()) bent_groups_.resize(group + 1);
-  if (!bent_groups_[group].stale) {
-    bent_groups_[group].stale = true;
-    stale_groups_.push_back(group);
-  }
-  const std::vector<uint32_t>& opposite = table_.opposite();
   const uint32_t first = block * kBentBlock;
   const uint32_t end = std::min<uint32_t>(first + kBentBlock, input.face_count());
-  Vec3f lo{}, hi{}, normals{};
-  float shortest = std::numeric_limits<float>::max();
+  Vec3f lo{}, hi{};
   for (uint32_t f = first; f < end; ++f) {
     if (!bent_mask_[f]) continue;
     if (b.bent_faces == 0) lo = hi = input.positions[input.triangles[f][0]];
@@ -322,92 +313,15 @@ void IncrementalSubdivider::refresh_bent_block(const Mesh& input, uint32_t block
       hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
     }
     for (uint32_t i = 0; i < 3; ++i)
-      if (bent_mask_[f] & (1u << i)) {
-        const float l = length(input.positions[input.triangles[f][(i + 2) % 3]] -
-                               input.positions[input.triangles[f][(i + 1) % 3]]);
-        b.longest = std::max(b.longest, l);
-        shortest = std::min(shortest, l);
-        normals = normals + face_normal_[f] + face_normal_[opposite[3 * f + i] / 3];
-      }
+      if (bent_mask_[f] & (1u << i))
+        b.longest = std::max(b.longest, length(input.positions[input.triangles[f][(i + 2) % 3]] -
+                                               input.positions[input.triangles[f][(i + 1) % 3]]));
     ++b.bent_faces;
   }
   if (b.bent_faces == 0) return;
   b.centre = (lo + hi) * 0.5f;
   // Half the box's diagonal, a little over: every edge midpoint is inside the box.
   b.radius = 1.0001f * length(hi - lo) * 0.5f + 1e-6f * length(b.centre);
-  b.shortest = 0.999f * shortest;
-  // The normals' cone: around their mean, as wide as the farthest one.
-  const float n = length(normals);
-  if (!(n > 1e-3f)) return;  // no axis: any direction (cone 4 > pi)
-  b.axis = normals / n;
-  float lowest = 1;
-  for (uint32_t f = first; f < end; ++f)
-    for (uint32_t i = 0; i < 3; ++i)
-      if (bent_mask_[f] & (1u << i))
-        lowest = std::min({lowest, dot(b.axis, face_normal_[f]),
-                           dot(b.axis, face_normal_[opposite[3 * f + i] / 3])});
-  b.cone = std::acos(std::clamp(lowest, -1.0f, 1.0f)) + 1e-3f;
-}
-
-void IncrementalSubdivider::refresh_bent_group(uint32_t group) {
-  BentGroup& g = bent_groups_[group];
-  g = {};
-  const uint32_t first = group * kBentGroup;
-  const uint32_t end = std::min<uint32_t>(first + kBentGroup, bent_blocks_.size());
-  Vec3f lo{}, hi{};
-  for (uint32_t k = first; k < end; ++k) {
-    const BentBlock& b = bent_blocks_[k];
-    if (b.bent_faces == 0) continue;
-    const Vec3f r{b.radius, b.radius, b.radius};
-    if (g.bent_faces == 0) {
-      lo = b.centre - r;
-      hi = b.centre + r;
-    }
-    const Vec3f l = b.centre - r, h = b.centre + r;
-    lo = {std::min(lo.x, l.x), std::min(lo.y, l.y), std::min(lo.z, l.z)};
-    hi = {std::max(hi.x, h.x), std::max(hi.y, h.y), std::max(hi.z, h.z)};
-    g.longest = std::max(g.longest, b.longest);
-    g.bent_faces += b.bent_faces;
-  }
-  if (g.bent_faces == 0) return;
-  g.centre = (lo + hi) * 0.5f;
-  g.radius = 1.0001f * length(hi - lo) * 0.5f + 1e-6f * length(g.centre);
-}
-
-bool IncrementalSubdivider::bent_blocks_consistent(const Mesh& input) const {
-  if (!bent_valid_) return true;
-  const std::vector<uint32_t>& opposite = table_.opposite();
-  const uint32_t Fn = input.face_count();
-  if (bent_blocks_.size() * kBentBlock < Fn) return false;
-  for (uint32_t k = 0; k < bent_blocks_.size(); ++k) {
-    const BentBlock& b = bent_blocks_[k];
-    if (b.stale) continue;  // recomputed before the next use
-    uint32_t bent = 0;
-    for (uint32_t f = k * kBentBlock; f < std::min<uint32_t>((k + 1) * kBentBlock, Fn); ++f) {
-      if (bent_mask_[f] != bent_bits(f)) return false;
-      if (!bent_mask_[f]) continue;
-      ++bent;
-      for (uint32_t i = 0; i < 3; ++i) {
-        if (!(bent_mask_[f] & (1u << i))) continue;
-        const Vec3f a = input.positions[input.triangles[f][(i + 1) % 3]];
-        const Vec3f c = input.positions[input.triangles[f][(i + 2) % 3]];
-        const float l = length(c - a);
-        if (l > b.longest || l < b.shortest) return false;
-        if (length((a + c) * 0.5f - b.centre) > b.radius) return false;
-        if (b.cone < 3)
-          for (Vec3f n : {face_normal_[f], face_normal_[opposite[3 * f + i] / 3]})
-            if (std::acos(std::clamp(dot(b.axis, n), -1.0f, 1.0f)) > b.cone) return false;
-      }
-    }
-    if (bent != b.bent_faces) return false;
-    if (b.bent_faces == 0) continue;
-    const uint32_t group = k / kBentGroup;
-    if (group >= bent_groups_.size()) return false;
-    const BentGroup& g = bent_groups_[group];
-    if (g.stale) continue;
-    if (b.longest > g.longest || length(b.centre - g.centre) + b.radius > g.radius) return false;
-  }
-  return true;
 }
 
 // From scratch: the feature tags and the bent faces. O(F).
@@ -417,12 +331,8 @@ void IncrementalSubdivider::rebuild_bent(const Mesh& input) {
   bent_mask_.assign(Fn, 0);
   bent_blocks_.assign((Fn + kBentBlock - 1) / kBentBlock, BentBlock{});
   stale_blocks_.clear();
-  bent_groups_.assign((bent_blocks_.size() + kBentGroup - 1) / kBentGroup, BentGroup{});
-  stale_groups_.clear();
   for (uint32_t f = 0; f < Fn; ++f) bent_mask_[f] = bent_bits(f);
   for (uint32_t b = 0; b < bent_blocks_.size(); ++b) refresh_bent_block(input, b);
-  for (uint32_t g : stale_groups_) refresh_bent_group(g);
-  stale_groups_.clear();
   bent_valid_ = true;
 }
 
@@ -1079,39 +989,21 @@ uint32_t IncrementalSubdivider::mark_view_changes_of_bent_faces(const Mesh& inpu
   };
   for (uint32_t b : stale_blocks_) refresh_bent_block(input, b);
   stale_blocks_.clear();
-  for (uint32_t g : stale_groups_) refresh_bent_group(g);
-  stale_groups_.clear();
-  using Verdict = asa::ViewTest::Verdict;
   const uint32_t Fn = input.face_count();
   uint32_t faces = 0;
-  for (uint32_t g = 0; g < bent_groups_.size(); ++g) {
-    const BentGroup& group = bent_groups_[g];
-    if (group.bent_faces == 0) continue;
-    if (test_before && !test_before->may_matter(group.centre, group.radius, group.longest) &&
-        !test_after.may_matter(group.centre, group.radius, group.longest))
+  for (uint32_t b = 0; b < bent_blocks_.size(); ++b) {
+    const BentBlock& block = bent_blocks_[b];
+    if (block.bent_faces == 0) continue;
+    // No edge of the block matters in either view: no target flips.
+    if (test_before && !test_before->may_matter(block.centre, block.radius, block.longest) &&
+        !test_after.may_matter(block.centre, block.radius, block.longest))
       continue;
-    const uint32_t last = std::min<uint32_t>((g + 1) * kBentGroup, bent_blocks_.size());
-    for (uint32_t b = g * kBentGroup; b < last; ++b) {
-      const BentBlock& block = bent_blocks_[b];
-      if (block.bent_faces == 0) continue;
-      // Every edge of the block gets one answer, the same in both views: no
-      // target flips (no view before: every bent face was a target).
-      const Verdict after = test_after.verdict(block.centre, block.radius, block.shortest,
-                                               block.longest, block.axis, block.cone);
-      if (after != Verdict::kSome) {
-        const Verdict before =
-            test_before ? test_before->verdict(block.centre, block.radius, block.shortest,
-                                               block.longest, block.axis, block.cone)
-                        : Verdict::kAll;
-        if (before == after) continue;
-      }
-      const uint32_t end = std::min<uint32_t>((b + 1) * kBentBlock, Fn);
-      for (uint32_t f = b * kBentBlock; f < end; ++f) {
-        if (!bent_mask_[f]) continue;
-        if (target(f, test_before ? &*test_before : nullptr) == target(f, &test_after)) continue;
-        ++faces;
-        for (uint32_t v : input.triangles[f]) mark_vertex(v);
-      }
+    const uint32_t end = std::min<uint32_t>((b + 1) * kBentBlock, Fn);
+    for (uint32_t f = b * kBentBlock; f < end; ++f) {
+      if (!bent_mask_[f]) continue;
+      if (target(f, test_before ? &*test_before : nullptr) == target(f, &test_after)) continue;
+      ++faces;
+      for (uint32_t v : input.triangles[f]) mark_vertex(v);
     }
   }
   return faces;

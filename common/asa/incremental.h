@@ -218,39 +218,15 @@ class IncrementalSubdivider {
   // move skips a block whose edges no view can ask for (ViewTest::
   // may_matter) without looking at its faces. A block is recomputed when
   // one of its faces' bits are set again (stale).
-  // A block also keeps its shortest bent edge and a cone (axis, half-angle
-  // in radians) holding the normals of both faces of each bent edge, so
-  // that a block whose every edge gets one answer in both views is skipped
-  // too (ViewTest::verdict). Groups of kBentGroup blocks keep a sphere
-  // holding their blocks' spheres and the longest edge, so that a move
-  // skips a group no view can ask about without looking at its blocks.
   static constexpr uint32_t kBentBlock = 64;
-  static constexpr uint32_t kBentGroup = 32;
   struct BentBlock {
-    uint32_t bent_faces = 0;
-    Vec3f centre{}, axis{};
-    float radius = 0, longest = 0, shortest = 0, cone = 4;
-    bool stale = false;  // listed in stale_blocks_
-  };
-  struct BentGroup {
     uint32_t bent_faces = 0;
     Vec3f centre{};
     float radius = 0, longest = 0;
-    bool stale = false;  // listed in stale_groups_
+    bool stale = false;  // listed in stale_blocks_
   };
   std::vector<BentBlock> bent_blocks_;
   std::vector<uint32_t> stale_blocks_;
-  std::vector<BentGroup> bent_groups_;
-  std::vector<uint32_t> stale_groups_;
-  void refresh_bent_group(uint32_t group);
-
- public:
-  // For tests: every block and group holds what it says (its faces' bent
-  // edges, their lengths and normals; its blocks' spheres), recomputed
-  // from scratch. O(F).
-  bool bent_blocks_consistent(const Mesh& input) const;
-
- private:
   std::vector<uint32_t> refreshed_faces_;  // faces whose normals this update recomputed
   // What changed this update: vertex marks (all zero between updates) and
   // their list; changed faces with their previous corners.

@@ -14,7 +14,6 @@
 //    backface_margin (cosine); the silhouette band stays refined.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -104,46 +103,6 @@ class ViewTest {
     if ((std::fabs(x) - z * tan_x_) * inv_x_ > reach) return false;
     if ((std::fabs(y) - z * tan_y_) * inv_y_ > reach) return false;
     return true;
-  }
-
-  // What matters() says for every edge of a group, when one answer holds
-  // for all of them: the edges are at least `shortest` and at most
-  // `longest` long, their midpoints lie within `radius` of `centre`, and
-  // the normals of their faces within `cone` radians of the unit `axis`
-  // (cone >= pi: any). kSome when the group may hold both answers. Each
-  // bound is conservative by a margin above the tests' rounding.
-  enum class Verdict { kNone, kAll, kSome };
-  Verdict verdict(Vec3f centre, float radius, float shortest, float longest, Vec3f axis,
-                  float cone) const {
-    if (!may_matter(centre, radius, longest)) return Verdict::kNone;
-    const float h = 0.5f * longest;
-    const Vec3f rel = centre - eye_;
-    const float dist = length(rel);
-    const float eps = 1e-5f * (dist + radius + h);
-    const float reach = radius + h + eps;
-    if (!(dist - reach > 0)) return Verdict::kSome;  // an edge's sphere may hold the eye
-    bool back = false, front = !cull_;
-    if (cull_ && cone < 3.0f) {
-      // The angle between the direction to a midpoint and a face normal
-      // (turned by the facing sign) is within phi +- (cone + delta).
-      constexpr float kSlack = 1e-3f;  // radians, far above the rounding of the dot products
-      const float delta = std::asin(std::min(1.0f, (radius + eps) / dist));
-      const float phi = std::acos(std::clamp(dot(rel, axis) * sign_ / dist, -1.0f, 1.0f));
-      const float widest = phi + cone + delta + kSlack, narrowest = phi - cone - delta - kSlack;
-      back = widest < 3.14159f && std::cos(widest) > backface_ + kSlack;
-      front = std::cos(std::max(0.0f, narrowest)) < backface_ - kSlack;
-    }
-    if (back) return Verdict::kNone;  // both faces of every edge turned away
-    if (!front) return Verdict::kSome;
-    // Size: every edge's sphere at least shortest / 2 at a midpoint no
-    // farther than dist + radius.
-    if (!(shortest * focal_px_ > 1.001f * tolerance_ * (dist + reach))) return Verdict::kSome;
-    // Frustum: every midpoint in front of the eye and inside the side planes.
-    const float z = dot(rel, forward_), x = dot(rel, right_), y = dot(rel, up_);
-    if (!(z - reach > 0)) return Verdict::kSome;
-    if (!((std::fabs(x) - z * tan_x_) * inv_x_ + reach < 0)) return Verdict::kSome;
-    if (!((std::fabs(y) - z * tan_y_) * inv_y_ + reach < 0)) return Verdict::kSome;
-    return Verdict::kAll;
   }
 
   bool matters(Vec3f a, Vec3f b, Vec3f n1, Vec3f n2) const {
