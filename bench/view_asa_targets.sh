@@ -10,7 +10,7 @@
 # Usage: bench/view_asa_targets.sh BUILD_DIR BIG_DIR [MODEL...]
 #   (default models: dragon_x1 dragon_x2; BIG_DIR holds MODEL.hcs)
 # Prints one line per run; the raw JSON events stay in $OUT (default
-# /tmp/view_asa_targets).
+# /tmp/view_asa_targets). ORBIT_ONLY=1 skips the client runs (1.).
 set -euo pipefail
 build=${1:?build dir}
 big=${2:?folder with the .hcs streams}
@@ -61,6 +61,7 @@ EOF
 
 echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 for m in "${models[@]}"; do
+  [ -z "${ORBIT_ONLY:-}" ] || break
   for round in 1 2; do
     run_client "$m.no-asa.$round" "$m" --no-asa
     run_client "$m.asa.$round" "$m" --asa on
