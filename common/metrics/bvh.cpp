@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <future>
 #include <limits>
 #include <string>
@@ -77,6 +78,7 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh, unsigned threads) {
   TriangleBvh bvh;
   const uint32_t n = mesh.face_count();
   if (n == 0) return bvh;
+  if (n >= kMaxTriangles) std::abort();  // the nodes' 29-bit indices (bvh.h)
   // Corner bounds are read from the mesh as needed (no copy of the corners:
   // it was the largest array of the build).
   std::vector<Vec3d> centroids(n);
@@ -175,8 +177,7 @@ uint32_t TriangleBvh::build_node(Builder& out, std::vector<uint32_t>& refs, uint
   nodes_[index].hi = {round_up(hi.x), round_up(hi.y), round_up(hi.z)};
 
   auto make_leaf = [&] {
-    nodes_[index].first = begin;
-    nodes_[index].count = count;
+    nodes_[index].set(begin, count);
     return index;
   };
   if (count <= kMaxLeafTriangles) return make_leaf();
@@ -236,7 +237,7 @@ uint32_t TriangleBvh::build_node(Builder& out, std::vector<uint32_t>& refs, uint
     right_done.get();
     right = static_cast<uint32_t>(nodes_.size());
     for (Node node : right_out.nodes) {
-      if (node.count == 0) node.first += right;  // an inner node's right child
+      if (node.count() == 0) node.set(node.first() + right, 0);  // an inner node's right child
       nodes_.push_back(node);
     }
     out.depth = std::max(out.depth, right_out.depth);
@@ -244,8 +245,7 @@ uint32_t TriangleBvh::build_node(Builder& out, std::vector<uint32_t>& refs, uint
     build_node(out, refs, begin, mid, depth + 1, mesh, centroids, 0);
     right = build_node(out, refs, mid, end, depth + 1, mesh, centroids, 0);
   }
-  nodes_[index].first = right;
-  nodes_[index].count = 0;
+  nodes_[index].set(right, 0);
   return index;
 }
 
@@ -268,16 +268,16 @@ Status TriangleBvh::refit(const Mesh& mesh) {
   const Vec3d pad{inflate_, inflate_, inflate_};
   for (size_t i = nodes_.size(); i-- > 0;) {
     Node& node = nodes_[i];
-    if (node.count > 0) {
+    if (node.count() > 0) {
       Box box;
-      for (uint32_t s = node.first; s < node.first + node.count; ++s)
+      for (uint32_t s = node.first(), e = s + node.count(); s < e; ++s)
         for (uint32_t c : triangles_[s].corners) box.grow(to_double(points_[c]));
       const Vec3d lo = box.lo - pad, hi = box.hi + pad;
       node.lo = {round_down(lo.x), round_down(lo.y), round_down(lo.z)};
       node.hi = {round_up(hi.x), round_up(hi.y), round_up(hi.z)};
     } else {
       const Node& l = nodes_[i + 1];
-      const Node& r = nodes_[node.first];
+      const Node& r = nodes_[node.first()];
       for (int k = 0; k < 3; ++k) {
         node.lo[k] = std::min(l.lo[k], r.lo[k]);
         node.hi[k] = std::max(l.hi[k], r.hi[k]);
@@ -320,12 +320,12 @@ ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
     // box farther than the best so far cannot hold a strictly better one.
     if (e.d2 > best.squared_distance) continue;
     const Node& node = nodes_[e.node];
-    if (node.count > 0) {
-      for (uint32_t s = node.first; s < node.first + node.count; ++s) test_slot(s);
+    if (node.count() > 0) {
+      for (uint32_t s = node.first(), end = s + node.count(); s < end; ++s) test_slot(s);
       continue;
     }
     const uint32_t left = e.node + 1;
-    const uint32_t right = node.first;
+    const uint32_t right = node.first();
     const double dl = box_d2(nodes_[left]);
     const double dr = box_d2(nodes_[right]);
     // Push the farther child first so the nearer one is searched first.

@@ -27,13 +27,19 @@ struct ClosestHit {
 class TriangleBvh {
  public:
   static constexpr uint32_t kNoHint = 0xffffffffu;
+  // Nodes pack their first slot or right child into 29 bits; a tree has
+  // fewer than 2 nodes a triangle, so 2^28 triangles keep every index in range.
+  static constexpr uint32_t kCountShift = 29;
+  static constexpr uint32_t kFirstMask = (1u << kCountShift) - 1;
+  static constexpr uint32_t kMaxTriangles = 1u << 28;
 
   TriangleBvh() = default;
 
   // Builds the hierarchy over every triangle of `mesh` (degenerate ones too).
   // Precondition: every index is in range (validate first; distance.cpp
-  // does). A mesh without triangles gives an empty hierarchy. Deterministic;
-  // O(F log F) time, about 48 bytes per triangle kept and 12 per vertex
+  // does) and fewer than kMaxTriangles triangles (checked: more aborts,
+  // 2^28 triangles would need over 20 GB here alone). A mesh without triangles gives an empty
+  // hierarchy. Deterministic; O(F log F) time, about 44 bytes per triangle kept and 12 per vertex
   // (the build itself needs about 60 more a triangle while it runs). `threads` (0 = one per core)
   // build the top subtrees side by side; the tree is the same for every count.
   static TriangleBvh build(const Mesh& mesh, unsigned threads = 1);
@@ -65,9 +71,17 @@ class TriangleBvh {
     // outwards to floats (half the memory; a looser box only prunes less,
     // so every distance is the same).
     Vec3f lo, hi;
-    uint32_t first = 0;  // leaf: first slot in triangles_; inner: right child
-    uint32_t count = 0;  // leaf: number of triangles; inner: 0
+    // One word, so a node is 28 bytes instead of 32 (issue 15's encoder
+    // memory): the top 3 bits hold count (leaf: its 1..4 triangles;
+    // inner: 0), the low 29 bits first (leaf: its first slot in
+    // triangles_; inner: its right child). Hence build()'s limit of
+    // kMaxTriangles triangles.
+    uint32_t packed = 0;
+    uint32_t first() const { return packed & kFirstMask; }
+    uint32_t count() const { return packed >> kCountShift; }
+    void set(uint32_t first, uint32_t count) { packed = count << kCountShift | first; }
   };
+  static_assert(sizeof(Node) == 28, "a node is two float boxes and one word");
   // The nodes in depth-first order (the root first, a node's left child
   // next): for inspecting the tree's shape.
   const std::vector<Node>& nodes() const { return nodes_; }

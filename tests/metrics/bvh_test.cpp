@@ -134,7 +134,7 @@ TEST(TriangleBvh, SahSplitsAtTheGapBetweenClusters) {
   const TriangleBvh bvh = TriangleBvh::build(m);
   ASSERT_GE(bvh.node_count(), 3u);
   const TriangleBvh::Node& left = bvh.nodes()[1];
-  EXPECT_EQ(left.count, 4u) << "the root's left child is not the small cluster's leaf";
+  EXPECT_EQ(left.count(), 4u) << "the root's left child is not the small cluster's leaf";
   EXPECT_LT(left.hi.x, 1.0f);
 
   // The shape never changes a distance.
