@@ -449,12 +449,12 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
       if (c.base_shift < 1 || c.base_shift + kMinAttributeBits > c.bits)
         return tl::unexpected(parse_error("coarse base shift out of range"));
     }
-    const uint8_t allowed = c.kind == AttributeKind::kTexcoord
-                                ? kPredictBaseAlternative | kPredictLaterFromGeometry | kBaseCoarse
-                            : c.kind == AttributeKind::kNormal
-                                ? kPredictBaseAlternative | kBaseNormalsLate
-                            : c.kind == AttributeKind::kColor ? kBaseCoarse
-                                                              : 0;
+    const uint8_t allowed =
+        c.kind == AttributeKind::kTexcoord
+            ? kPredictBaseAlternative | kPredictLaterFromGeometry | kBaseCoarse | kWedgeRepeat
+        : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative | kBaseNormalsLate
+        : c.kind == AttributeKind::kColor  ? kBaseCoarse
+                                           : 0;
     if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
@@ -508,6 +508,39 @@ WedgeRange wedges_of(const AttributeChannel& c, const AttributeValues& a, uint32
   return c.per_corner ? WedgeRange{a.wedge_start[v], a.wedge_start[v + 1]} : WedgeRange{v, v + 1};
 }
 
+// kWedgeRepeat: the earlier wedges of [w0, w) whose values (n ints each,
+// compared after >> shift) appear first there, in order.
+void distinct_before(const std::vector<int32_t>& d, uint32_t n, uint32_t w0, uint32_t w, int shift,
+                     std::vector<uint32_t>& out) {
+  auto same = [&](uint32_t a, uint32_t b) {
+    for (uint32_t i = 0; i < n; ++i)
+      if ((d[a * n + i] >> shift) != (d[b * n + i] >> shift)) return false;
+    return true;
+  };
+  out.clear();
+  for (uint32_t u = w0; u < w; ++u)
+    if (std::none_of(out.begin(), out.end(), [&](uint32_t k) { return same(k, u); }))
+      out.push_back(u);
+}
+
+// Codes (decodes) whether wedge w repeats one of `earlier` (the index, or
+// earlier.size() for a new value): one bit per candidate, in order.
+struct RepeatModels {
+  BitModel same[3];
+  BitModel& at(size_t k) { return same[std::min<size_t>(k, 2)]; }
+  void encode(RangeEncoder& enc, size_t pick, size_t count) {
+    for (size_t k = 0; k < count; ++k) {
+      enc.encode_bit(at(k), k == pick ? 1 : 0);
+      if (k == pick) return;
+    }
+  }
+  size_t decode(RangeDecoder& dec, size_t count) {
+    for (size_t k = 0; k < count; ++k)
+      if (dec.decode_bit(at(k))) return k;
+    return count;
+  }
+};
+
 // Vertex v's normals (channel ch) shown as the geometric normal of each of
 // its wedges on `m`, until their exact values come.
 void show_geometric_normals(const EditableMesh& m, AttributeValues& a, const AttributeLayout& l,
@@ -528,7 +561,11 @@ void show_geometric_normals(const EditableMesh& m, AttributeValues& a, const Att
 struct ValueCoder {
   const AttributeLayout& layout;
   bool base_record = false;  // record 1 (its prediction flags)
-  std::vector<uint32_t> ring, corners;
+  std::vector<uint32_t> ring, corners, earlier;
+
+  bool repeats(const AttributeChannel& c) const {
+    return c.per_corner && (c.flags & kWedgeRepeat) != 0;
+  }
 
   std::vector<uint8_t> encode(const EditableMesh& m, const AttributeValues& truth, size_t ch,
                               uint32_t first, uint32_t last, ChannelModels* persistent = nullptr) {
@@ -537,11 +574,22 @@ struct ValueCoder {
     const int32_t max = layout.max_value(c);
     ChannelModels fresh;
     ChannelModels& models = persistent ? *persistent : fresh;
+    RepeatModels repeat;
     RangeEncoder enc;
     int32_t pred[4];
     for (uint32_t v = first; v < last; ++v) {
       const auto [w0, w1] = wedges_of(c, truth, v);
       for (uint32_t w = w0; w < w1; ++w) {
+        if (repeats(c) && w > w0) {
+          distinct_before(truth.data[ch], n, w0, w, 0, earlier);
+          size_t pick = 0;
+          while (pick < earlier.size() &&
+                 !std::equal(&truth.data[ch][w * n], &truth.data[ch][w * n] + n,
+                             &truth.data[ch][earlier[pick] * n]))
+            ++pick;
+          repeat.encode(enc, pick, earlier.size());
+          if (pick < earlier.size()) continue;
+        }
         const int ctx =
             predict(m, truth, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i)
@@ -559,11 +607,20 @@ struct ValueCoder {
     const int32_t max = layout.max_value(c);
     ChannelModels fresh;
     ChannelModels& models = persistent ? *persistent : fresh;
+    RepeatModels repeat;
     RangeDecoder dec(bytes);
     int32_t pred[4];
     for (uint32_t v = first; v < last; ++v) {
       const auto [w0, w1] = wedges_of(c, a, v);
       for (uint32_t w = w0; w < w1; ++w) {
+        if (repeats(c) && w > w0) {
+          distinct_before(a.data[ch], n, w0, w, 0, earlier);
+          const size_t pick = repeat.decode(dec, earlier.size());
+          if (pick < earlier.size()) {
+            std::copy_n(&a.data[ch][earlier[pick] * n], n, &a.data[ch][w * n]);
+            continue;
+          }
+        }
         const int ctx =
             predict(m, a, layout, ch, v, w, prediction_of(c, base_record), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
@@ -596,7 +653,19 @@ struct LowBitCoder {
   size_t ch;
   int shift;
   std::vector<BitModel> tree;
-  std::vector<uint32_t> ring, corners;
+  std::vector<uint32_t> ring, corners, earlier;
+  BitModel same;  // kWedgeRepeat: same low bits as the earlier wedge of equal coarse value
+  // kWedgeRepeat: the first earlier wedge of [w0, w) whose coarse value is
+  // wedge w's, or w.
+  uint32_t coarse_twin(const std::vector<int32_t>& d, uint32_t n, uint32_t w0, uint32_t w) {
+    if (!(layout.channels[ch].per_corner && (layout.channels[ch].flags & kWedgeRepeat))) return w;
+    distinct_before(d, n, w0, w, shift, earlier);
+    for (uint32_t u : earlier)
+      if (std::equal(&d[u * n], &d[u * n] + n, &d[w * n],
+                     [&](int32_t x, int32_t y) { return (x >> shift) == (y >> shift); }))
+        return u;
+    return w;
+  }
   LowBitCoder(const AttributeLayout& l, size_t channel)
       : layout(l),
         ch(channel),
@@ -634,6 +703,12 @@ struct LowBitCoder {
     for (uint32_t v = 0; v < base_n; ++v) {
       const auto [w0, w1] = wedges_of(c, truth, v);
       for (uint32_t w = w0; w < w1; ++w) {
+        if (const uint32_t u = coarse_twin(truth.data[ch], n, w0, w); u != w) {
+          const bool equal = std::equal(&truth.data[ch][u * n], &truth.data[ch][u * n] + n,
+                                        &truth.data[ch][w * n]);
+          enc.encode_bit(same, equal ? 1 : 0);
+          if (equal) continue;
+        }
         predict(base, truth, layout, ch, v, w, prediction_of(c, true), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
           const int32_t value = truth.data[ch][w * n + i];
@@ -660,6 +735,10 @@ struct LowBitCoder {
     for (uint32_t v = 0; v < base_n; ++v) {
       const auto [w0, w1] = wedges_of(c, a, v);
       for (uint32_t w = w0; w < w1; ++w) {
+        if (const uint32_t u = coarse_twin(a.data[ch], n, w0, w); u != w && dec.decode_bit(same)) {
+          std::copy_n(&a.data[ch][u * n], n, &a.data[ch][w * n]);
+          continue;
+        }
         predict(base, a, layout, ch, v, w, prediction_of(c, true), pred, ring, corners);
         for (uint32_t i = 0; i < n; ++i) {
           int32_t& value = a.data[ch][w * n + i];
@@ -715,6 +794,7 @@ Result<AttributePlan> plan_attributes(const Mesh& mesh, const std::vector<Vec3i>
   AttributePlan plan;
   plan.extras = &mesh.extra_attributes;
   plan.base_color_bits = options.base_color_bits;
+  plan.wedge_repeat = options.wedge_repeat;
   const size_t corners = 3 * mesh.triangles.size();
   auto finite2 = [](Vec2f v) { return std::isfinite(v.x) && std::isfinite(v.y); };
   auto finite3 = [](Vec3f v) {
@@ -1019,6 +1099,21 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
       c.flags |= kBaseCoarse;
       c.base_shift = uint8_t(c.bits - kBaseCoarseBits);
     }
+  // A texture coordinate shared by several wedges of a vertex (split by
+  // the normals) is coded once (version 16, kWedgeRepeat); where no value
+  // repeats (usb: 573 wedges, none), the flag's bits would only cost (8 B).
+  for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
+    AttributeChannel& c = layout.channels[ch];
+    if (c.kind != AttributeKind::kTexcoord || !c.per_corner || !plan.wedge_repeat) continue;
+    std::vector<uint32_t> earlier;
+    bool any = false;
+    for (uint32_t v = 0; v < n && !any; ++v)
+      for (uint32_t w = truth.wedge_start[v] + 1; w < truth.wedge_start[v + 1] && !any; ++w) {
+        distinct_before(truth.data[ch], 2, truth.wedge_start[v], w + 1, 0, earlier);
+        any = earlier.size() < w + 1 - truth.wedge_start[v];
+      }
+    if (any) c.flags |= kWedgeRepeat;
+  }
   // Colours go coarse only when asked (version 15, base_color_bits):
   // bench/REPORT.md measures what it costs and saves.
   for (AttributeChannel& c : layout.channels)

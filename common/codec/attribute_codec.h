@@ -102,6 +102,17 @@ inline constexpr uint8_t kBaseNormalsLate = 8;
 // the last geometry record when there is none). The first display shows
 // the coarse value at the middle of its range.
 inline constexpr uint8_t kBaseCoarse = 16;
+// A per-corner texture coordinate channel's flag (version 16 on): a wedge
+// after the first of its vertex first says whether its value is that of an
+// earlier wedge of the vertex (one adaptive bit per distinct earlier value,
+// in wedge order; record 1 compares the values it codes, the coarse ones
+// where kBaseCoarse), and only a new value is coded. The wedge table is
+// shared by every channel, so where normals are per face each corner is
+// its own wedge for the UV too (the sphere: 3 840 UV wedges for 729
+// values); with this flag a UV shared by several normal wedges is coded
+// once. The low-bits record says the same for a wedge whose coarse value
+// repeats an earlier wedge's: one bit "same low bits as it".
+inline constexpr uint8_t kWedgeRepeat = 32;
 // The coarse grid record 1 uses for texture coordinates of more bits (the
 // first display shows the small texture level: 1/256 of the UV box).
 inline constexpr int kBaseCoarseBits = 8;
@@ -156,6 +167,7 @@ struct AttributeOptions {
   // the base's colours on this many bits per channel and a low-bits record
   // brings the rest; else kInvalidArgument.
   int base_color_bits = 0;
+  bool wedge_repeat = true;  // kWedgeRepeat where a value repeats (EncodeOptions)
 };
 
 // What the encoder takes from the input before decimation: the layout, the
@@ -167,7 +179,8 @@ struct AttributePlan {
   std::vector<uint8_t> locked;  // input vertex ids
   uint32_t locked_count = 0;
   const std::vector<ExtraAttribute>* extras = nullptr;
-  int base_color_bits = 0;  // AttributeOptions::base_color_bits
+  int base_color_bits = 0;   // AttributeOptions::base_color_bits
+  bool wedge_repeat = true;  // AttributeOptions::wedge_repeat
   bool empty() const { return layout.channels.empty() && (!extras || extras->empty()); }
 };
 

@@ -390,9 +390,9 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   if (auto s = validate_arrays(mesh); !s) return tl::unexpected(s.error());
   if (mesh.triangles.empty()) return make_error(ErrorCode::kInvalidMesh, "mesh has no triangles");
   std::vector<Vec3i> q = quantize_positions(mesh, *grid);
-  auto plan = plan_attributes(
-      mesh, q,
-      {options.quant_normal, options.quant_uv, options.quant_color, options.base_color_bits});
+  auto plan = plan_attributes(mesh, q,
+                              {options.quant_normal, options.quant_uv, options.quant_color,
+                               options.base_color_bits, options.wedge_repeat});
   if (!plan) return tl::unexpected(plan.error());
   auto editable = EditableMesh::build(q, mesh.triangles);
   if (!editable) return tl::unexpected(editable.error());

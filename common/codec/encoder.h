@@ -104,6 +104,10 @@ struct EncodeOptions {
   // base_color_bits; bench/REPORT.md weighs the first display against the
   // total). `meshstream encode --base-color-bits`.
   int base_color_bits = 0;
+  // Texture coordinates shared by several wedges of a vertex coded once
+  // (version 16, kWedgeRepeat); false: every wedge's value coded (version
+  // 15's cost, for measuring).
+  bool wedge_repeat = true;
   // The locality experiment (issue 17, docs/view-dependent-records.md):
   // 0 = off (the default; the stream is unchanged). Else each decimation
   // layer keeps the borders of a grid of cells of at least about this many

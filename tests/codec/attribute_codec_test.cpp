@@ -484,6 +484,43 @@ TEST(AttributeCodec, CoarseBaseTexcoordsThenTheirLowBits) {
   expect_valid_prefixes(*stream);
 }
 
+// Version 16 (kWedgeRepeat): a hard-edged cube (normals per face, so the
+// vertices on its edges have two or three wedges) whose texture coordinates
+// are per vertex, shared by those wedges: each is coded once, so the
+// stream is smaller than with every wedge's value coded, and both decode
+// exactly, at every prefix valid.
+TEST(AttributeCodec, SharedTexcoordsOfHardEdgesAreCodedOnce) {
+  Mesh cube = faceted_cube(6);
+  cube.corner_texcoords.values.clear();
+  cube.corner_texcoords.corners.clear();
+  for (const Vec3f& p : cube.positions)
+    cube.corner_texcoords.values.push_back({p.x + 0.3f * p.z, p.y + 0.7f * p.z});
+  for (const auto& t : cube.triangles)
+    for (uint32_t v : t) cube.corner_texcoords.corners.push_back(v);
+  ASSERT_TRUE(check_attribute_counts(cube)) << check_attribute_counts(cube).error().message;
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  std::vector<uint8_t> streams[2];
+  for (bool repeat : {false, true}) {
+    o.wedge_repeat = repeat;
+    auto stream = encode_hcs(cube, o);
+    ASSERT_TRUE(stream) << stream.error().message;
+    const RecordPlaces at = record_places(*stream, AttributeKind::kTexcoord);
+    ASSERT_NE(at.flags, 0xFF);
+    EXPECT_EQ((at.flags & kWedgeRepeat) != 0, repeat);
+    auto decoded = decode_hcs(*stream);
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    Mesh expected = expected_mesh(cube, o);
+    expected.textures = cube.textures;
+    EXPECT_TRUE(faces_of(*decoded) == faces_of(expected)) << repeat;
+    expect_valid_prefixes(*stream);
+    streams[repeat] = std::move(*stream);
+  }
+  // 152 edge vertices of 2-3 wedges: far more than one bit per wedge saved.
+  EXPECT_LT(streams[1].size() + 100, streams[0].size())
+      << streams[1].size() << " vs " << streams[0].size();
+}
+
 // An icosphere of 2 562 vertices with smooth per-vertex colours that use
 // all 8 bits (so the low bits are not a constant).
 Mesh coloured_icosphere(uint32_t subdivisions) {

@@ -37,7 +37,11 @@
 //                 (Apache-2.0) at kEncoderVersion 15, `meshstream encode
 //                 --no-asa-guidance --base-color-bits 4`: record 1's colours
 //                 on a 4-bit grid (layout flag bit 4 on colours), which a
-//                 version-14 decoder refuses.
+//                 version-14 decoder refuses;
+//   container3_v15_sphere_uv_per_wedge.hcs Draco's textured sphere at
+//                 kEncoderVersion 15, default options: every UV wedge's
+//                 value coded (3 840 for 729 texture coordinates), which
+//                 version 16 codes once per vertex (kWedgeRepeat).
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -293,6 +297,13 @@ TEST(LegacyStreams, VersionFourteenLowBitsAfterTheGeometryDecodeAsWhenWritten) {
 TEST(LegacyStreams, VersionFifteenCoarseColoursDecodeAsWhenWritten) {
   expect_decodes_as_when_written(read_sample("container3_v15_pos_color_coarse_base.hcs"),
                                  0x378a6e80e31dc375ull, 0);
+}
+
+// Version 15: the sphere's texture coordinates coded per wedge (no
+// kWedgeRepeat); the same mesh as the version-14 sphere above.
+TEST(LegacyStreams, VersionFifteenUvPerWedgeDecodeAsWhenWritten) {
+  expect_decodes_as_when_written(read_sample("container3_v15_sphere_uv_per_wedge.hcs"),
+                                 0x09209576d7d677d2ull, 1);
 }
 
 }  // namespace
