@@ -66,6 +66,16 @@ struct IncrementalDecoder::State {
     return r.offset + r.size;
   }
 
+  // Bytes fed next start at `offset`, a record boundary reached: whatever
+  // the buffer held is dropped and a recoverable error cleared.
+  void restart_at(uint64_t offset) {
+    error.reset();
+    error_recoverable = false;
+    buffer.clear();
+    buffer_start = offset;
+    stream_pos = offset;
+  }
+
   // `e` with the record it concerns named first.
   Error about_record(uint32_t i, const Error& e) const {
     return Error{e.code, "record " + std::to_string(i) + " of " +
@@ -471,12 +481,7 @@ Result<uint32_t> IncrementalDecoder::feed_record(uint32_t record, std::span<cons
                                                        " bytes, given " +
                                                        std::to_string(bytes.size()));
   }
-  // Whatever partial bytes the buffer held are dropped: this record is whole.
-  s.error.reset();
-  s.error_recoverable = false;
-  s.buffer.clear();
-  s.buffer_start = rec.offset;
-  s.stream_pos = rec.offset;
+  s.restart_at(rec.offset);  // partial bytes the buffer held are dropped: this record is whole
   return feed(bytes);
 }
 
@@ -495,11 +500,7 @@ Status IncrementalDecoder::resume_at(uint64_t offset) {
                       "cannot resume at byte " + std::to_string(offset) +
                           ": not a record boundary this decoder has reached");
   }
-  s.error.reset();
-  s.error_recoverable = false;
-  s.buffer.clear();
-  s.buffer_start = offset;
-  s.stream_pos = offset;
+  s.restart_at(offset);
   return {};
 }
 

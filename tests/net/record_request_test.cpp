@@ -75,46 +75,6 @@ v1::StreamRequest ranged(const std::string& model,
   return request;
 }
 
-// One ranged stream's replies: the header, every chunk, the end (or an error).
-struct RangedReply {
-  std::string problem;  // empty when header ... end came
-  v1::StreamHeader header;
-  std::vector<v1::Chunk> chunks;
-  v1::StreamEnd end;
-  std::optional<v1::Error> error;
-};
-
-RangedReply read_ranged(TestClient& client) {
-  RangedReply r;
-  bool have_header = false;
-  while (true) {
-    v1::ServerMessage m;
-    if (client.read(m, 20000ms) != ReadEnd::kMessage) {
-      r.problem = "no reply";
-      return r;
-    }
-    if (m.has_error()) {
-      r.error = m.error();
-      r.problem = "error: " + m.error().message();
-      return r;
-    }
-    if (m.has_header()) {
-      r.header = m.header();
-      have_header = true;
-    } else if (m.has_chunk()) {
-      if (!have_header) {
-        r.problem = "chunk before header";
-        return r;
-      }
-      r.chunks.push_back(m.chunk());
-    } else if (m.has_end()) {
-      r.end = m.end();
-      if (!have_header) r.problem = "end before header";
-      return r;
-    }
-  }
-}
-
 // The record whose bytes hold stream offset `at`.
 uint32_t record_at(const StreamIndex& index, uint64_t at) {
   auto it =
@@ -150,8 +110,8 @@ TEST_F(RangedTest, SendsExactlyTheRecordsAskedInTheOrderAsked) {
   v1::StreamRequest request = ranged("synthetic", ranges);
   request.set_max_chunk_bytes(4096);  // several chunks per range, records split
   ASSERT_TRUE(c.stream(request));
-  const RangedReply r = read_ranged(c);
-  ASSERT_TRUE(r.problem.empty()) << r.problem;
+  const StreamResult r = read_stream(c);
+  ASSERT_TRUE(r.ok) << r.problem;
   EXPECT_TRUE(r.header.ranged());
   EXPECT_EQ(r.header.first_record(), 40u);
   EXPECT_EQ(r.header.end_record(), 30u);
@@ -254,8 +214,8 @@ TEST_F(RangedTest, BadListsAreRefusedNamingTheRangeAndEveryoneGoesOn) {
   }
   // The connection still serves a good ranged request.
   ASSERT_TRUE(c.stream(ranged("synthetic", {{5, 6}})));
-  const RangedReply r = read_ranged(c);
-  ASSERT_TRUE(r.problem.empty()) << r.problem;
+  const StreamResult r = read_stream(c);
+  ASSERT_TRUE(r.ok) << r.problem;
   EXPECT_EQ(r.end.reason(), v1::StreamEnd::RECORDS_SENT);
   other.join();
   EXPECT_TRUE(other_problem.empty()) << other_problem;
@@ -287,8 +247,8 @@ TEST_F(RangedTest, RecordsBeforeTheirNeedsArriveAndTheDecoderRefusesThem) {
   // The later half first, then the rest.
   const uint32_t middle = count / 2;
   ASSERT_TRUE(c.stream(ranged("sphere", {{middle, count}, {1, middle}})));
-  const RangedReply r = read_ranged(c);
-  ASSERT_TRUE(r.problem.empty()) << r.problem;
+  const StreamResult r = read_stream(c);
+  ASSERT_TRUE(r.ok) << r.problem;
   std::vector<std::vector<uint8_t>> records(count);
   for (const v1::Chunk& piece : r.chunks) {
     for (uint64_t at = piece.offset(); at < piece.offset() + piece.data().size();) {
