@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "common/base/parallel_blocks.h"
 #include "common/codec/range_coder.h"
 
 namespace meshstream {
@@ -43,46 +42,22 @@ size_t plain_plane_bytes(const RefinementState& s, const EncoderTruth& t, uint32
   return enc.finish().size();
 }
 
-void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g, unsigned threads,
-                    std::vector<double>& drops) {
+void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g) {
   g.pending = 0;
   g.top_plane = 0;
   g.scaled_drop = 0;
-  // Each vertex's drop reads and fills only its own cache entry, so the
-  // drops can be computed in any order on any number of threads; they are
-  // summed in vertex order below, so the sum is the same for every count.
-  drops.assign(g.count, 0.0);
-  auto drop_of = [&](uint32_t i, GeometryModels& scratch) {  // the oracle ignores models
-    const uint32_t v = g.first + i;
+  GeometryModels scratch;  // the oracle ignores models
+  for (uint32_t v = g.first; v < g.first + g.count; ++v) {
     VertexGeometry geo = s.geometry[v];
-    if (geo.shift == 0) return;
+    if (geo.shift == 0) continue;
+    ++g.pending;
+    g.top_plane = std::max(g.top_plane, geo.shift - 1);
     const Vec3i before = s.mesh.positions()[v];
     PlaneBitOracle io{t.position(v) - geo.anchor};
     uint8_t prev_new = 0;
     plane_step(scratch, io, geo, prev_new, s.max_coordinate);
     const Vec3i after = reconstruct(geo, s.max_coordinate);
-    drops[i] = t.weight[v] * (vertex_error2(t, v, before) - vertex_error2(t, v, after)) / 6.0;
-  };
-  // Only surface distances (closest-point queries) are worth the threads.
-  constexpr uint32_t kBlock = 512;
-  if (t.surface && threads != 1 && g.count >= 2 * kBlock) {
-    // vertex_error2 grows the cache as it goes: grown here, before the threads.
-    if (t.cached.size() < g.first + g.count) t.cached.resize(g.first + g.count);
-    for_each_block((g.count + kBlock - 1) / kBlock, threads, [&](size_t b) {
-      GeometryModels scratch;
-      const uint32_t end = std::min<uint32_t>(g.count, uint32_t(b + 1) * kBlock);
-      for (uint32_t i = uint32_t(b) * kBlock; i < end; ++i) drop_of(i, scratch);
-    });
-  } else {
-    GeometryModels scratch;
-    for (uint32_t i = 0; i < g.count; ++i) drop_of(i, scratch);
-  }
-  for (uint32_t i = 0; i < g.count; ++i) {
-    const VertexGeometry& geo = s.geometry[g.first + i];
-    if (geo.shift == 0) continue;
-    ++g.pending;
-    g.top_plane = std::max(g.top_plane, geo.shift - 1);
-    g.scaled_drop += drops[i];
+    g.scaled_drop += t.weight[v] * (vertex_error2(t, v, before) - vertex_error2(t, v, after)) / 6.0;
   }
 }
 

@@ -8,7 +8,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #include "common/codec/distortion_estimate.h"
 #include "common/codec/embedded_geometry.h"
@@ -27,11 +26,8 @@ struct PlaneGroup {
 
 // Recomputes g's pending count, top plane and the drop of its next plane
 // step from the state (which it does not change) and the truth (whose
-// surface-distance cache it fills). O(g.count) error evaluations, on
-// `threads` threads (0: one per core) when they are surface distances; the
-// result is the same for every count. `drops` is scratch space.
-void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g, unsigned threads,
-                    std::vector<double>& drops);
+// surface-distance cache it fills). O(g.count) error evaluations.
+void evaluate_group(const RefinementState& s, EncoderTruth& t, PlaneGroup& g);
 
 // A plain coder for plane bits, the comparison EncodeReport::plane_bytes_plain
 // measures: one adaptive model per plane and one for signs, persisting across

@@ -95,8 +95,7 @@ class RecordScheduler {
         to_decoder_(std::move(to_decoder)),
         records_(records),
         group_vertices_(std::max<uint32_t>(16, in.record_bytes * 8 / 4)),
-        writer_(state, truth, format, in.report ? &in.report->structure_bits : nullptr,
-                in.options.threads),
+        writer_(state, truth, format, in.report ? &in.report->structure_bits : nullptr),
         next_layer_(in.dec.layers.size()) {
     std::fill(std::begin(plane_bits_per_step_), std::end(plane_bits_per_step_), 3.0);
   }
@@ -150,7 +149,7 @@ class RecordScheduler {
         groups_.back().count += take;
         first += take;
         count -= take;
-        evaluate_group(state_, truth_, groups_.back(), in_.options.threads, drops_);
+        evaluate_group(state_, truth_, groups_.back());
         continue;
       }
       PlaneGroup g;
@@ -158,7 +157,7 @@ class RecordScheduler {
       g.count = std::min(count, group_vertices_);
       first += g.count;
       count -= g.count;
-      evaluate_group(state_, truth_, g, in_.options.threads, drops_);
+      evaluate_group(state_, truth_, g);
       groups_.push_back(g);
     }
   }
@@ -250,7 +249,7 @@ class RecordScheduler {
       report->records.push_back(
           {true, f.vertices, uint32_t(f.payload.size()), hash_state(), f.drop});
     }
-    evaluate_group(state_, truth_, g, in_.options.threads, drops_);
+    evaluate_group(state_, truth_, g);
     refinement_bytes_ += f.payload.size() + 4;
     records_.push_back(std::move(f));
   }
@@ -271,7 +270,6 @@ class RecordScheduler {
   double plane_bits_per_step_[kMaxShift + 1];
   std::vector<std::pair<uint32_t, uint32_t>> inserted_;
   std::vector<Vec3i> residuals_;  // write_plane_step's, reused
-  std::vector<double> drops_;     // evaluate_group's scratch, reused
   PlainPlaneModels plain_models_;
   uint64_t refinement_bytes_ = 0;  // records after the base, trailers counted
 };

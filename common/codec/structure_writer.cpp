@@ -5,8 +5,6 @@
 #include <cmath>
 #include <string>
 
-#include "common/base/parallel_blocks.h"
-
 namespace meshstream {
 
 void StructureWriter::start_layer(const DecimationLayer& layer,
@@ -40,8 +38,7 @@ Status StructureWriter::write_record(uint32_t target, int min_shift, WrittenReco
                                      std::vector<std::pair<uint32_t, uint32_t>>& inserted) {
   RangeEncoder enc;
   uint32_t walk_steps = 0, insertions = 0;
-  inserted_drops_.clear();
-  step_insertions_.clear();
+  double drop = 0;
   while (remaining_ > 0) {
     uint32_t u = kNone;
     if (auto st = next_walk_vertex(u); !st) return st;
@@ -58,8 +55,7 @@ Status StructureWriter::write_record(uint32_t target, int min_shift, WrittenReco
       if (auto st = code_patch(enc, u, j, min_shift, free_left); !st) return st;
     }
     enc.set_cost_sink(nullptr);
-    apply_patches(inserted);
-    step_insertions_.push_back(count);
+    drop += apply_patches(inserted);
     insertions += count;
     remaining_ -= count;
     if (enc.bytes_so_far() >= target) break;
@@ -72,42 +68,8 @@ Status StructureWriter::write_record(uint32_t target, int min_shift, WrittenReco
   out.payload.insert(out.payload.end(), coded.begin(), coded.end());
   out.vertices = s_.mesh.vertex_count();
   out.faces = s_.mesh.face_slot_count();
-  out.drop = record_drop();
+  out.drop = drop;
   return {};
-}
-
-double StructureWriter::record_drop() {
-  // A new vertex's error reads and fills only its own cache entry and the
-  // truth (both complete once it is inserted), never the mesh, so the
-  // errors can wait for the record's end and be computed in any order.
-  const size_t n = inserted_drops_.size();
-  errors_.resize(n);
-  auto error_of = [&](size_t i) {
-    const PendingDrop& p = inserted_drops_[i];
-    errors_[i] = vertex_error2(t_, p.vertex, p.recon);
-  };
-  constexpr size_t kBlock = 256;
-  if (t_.surface && threads_ != 1 && n >= 2 * kBlock) {
-    // vertex_error2 grows the cache as it goes: grown here, before the threads.
-    const uint32_t end = s_.mesh.vertex_count();
-    if (t_.cached.size() < end) t_.cached.resize(end);
-    for_each_block((n + kBlock - 1) / kBlock, threads_, [&](size_t b) {
-      for (size_t i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i) error_of(i);
-    });
-  } else {
-    for (size_t i = 0; i < n; ++i) error_of(i);
-  }
-  double drop = 0;
-  size_t i = 0;
-  for (uint32_t count : step_insertions_) {
-    double step = 0;
-    for (uint32_t j = 0; j < count; ++j, ++i) {
-      const PendingDrop& p = inserted_drops_[i];
-      step += p.area * (p.before - errors_[i]) / 6.0;
-    }
-    drop += step;
-  }
-  return drop;
 }
 
 Status StructureWriter::next_walk_vertex(uint32_t& u) {
@@ -249,9 +211,10 @@ Status StructureWriter::code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, in
   return {};
 }
 
-void StructureWriter::apply_patches(std::vector<std::pair<uint32_t, uint32_t>>& inserted) {
+double StructureWriter::apply_patches(std::vector<std::pair<uint32_t, uint32_t>>& inserted) {
   const uint32_t count = static_cast<uint32_t>(order_.size());
   const uint32_t vertices_before = s_.mesh.vertex_count();
+  double drop = 0;
   for (uint32_t j = 0; j < count; ++j) {
     const Removal& r = (*removals_)[order_[j].second];
     const Vec3i position = t_.input_position[r.vertex];
@@ -274,8 +237,9 @@ void StructureWriter::apply_patches(std::vector<std::pair<uint32_t, uint32_t>>& 
     inserted.push_back({r.vertex, v});
     t_.input_of.push_back(r.vertex);
     t_.weight.push_back(area * std::sqrt(double(vertices_before + count)));
-    inserted_drops_.push_back({v, recon, area, before});
+    drop += area * (before - vertex_error2(t_, v, recon)) / 6.0;
   }
+  return drop;
 }
 
 }  // namespace meshstream

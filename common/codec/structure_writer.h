@@ -37,11 +37,10 @@ class StructureWriter {
   // `state` is the decoder's state the records are replayed on and `truth`
   // the encoder's knowledge of it (both grow with every inserted vertex);
   // `format` the refinement format written; `bits` (optional) receives the
-  // cost of each symbol class; `threads` (0: one per core) run the
-  // records' surface-distance queries, the same records for every count.
+  // cost of each symbol class.
   StructureWriter(RefinementState& state, EncoderTruth& truth, RefinementFormatInfo format,
-                  StructureBits* bits, unsigned threads = 1)
-      : s_(state), t_(truth), format_(format), bits_(bits), threads_(threads) {
+                  StructureBits* bits)
+      : s_(state), t_(truth), format_(format), bits_(bits) {
     s_.models.use_fast_start_models = format.fast_start_structure_models;
   }
 
@@ -71,19 +70,14 @@ class StructureWriter {
   Status code_patch_count(RangeEncoder& enc, uint32_t u, uint32_t& free_faces);
   // Codes patch j of u: valence, start rank, open edge, coarse residual.
   Status code_patch(RangeEncoder& enc, uint32_t u, uint32_t j, int min_shift, uint32_t& free_left);
-  // Inserts the coded patches as the decoder will; their estimated
-  // distortion drops wait in inserted_drops_ for record_drop().
-  void apply_patches(std::vector<std::pair<uint32_t, uint32_t>>& inserted);
-  // The record's estimated distortion drop: the inserted vertices' errors
-  // (on threads_ when they are surface distances), summed as one sum per
-  // walk step in insertion order, whatever the thread count.
-  double record_drop();
+  // Inserts the coded patches as the decoder will; returns their estimated
+  // distortion drop.
+  double apply_patches(std::vector<std::pair<uint32_t, uint32_t>>& inserted);
 
   RefinementState& s_;
   EncoderTruth& t_;
   RefinementFormatInfo format_;
   StructureBits* bits_;
-  unsigned threads_;
   // Removal i's ring in decoder ids.
   std::span<const uint32_t> ring(uint32_t i) const {
     return {ring_ids_.data() + ring_start_[i], ring_start_[i + 1] - ring_start_[i]};
@@ -100,15 +94,6 @@ class StructureWriter {
   std::vector<VertexGeometry> geometry_;
   std::vector<uint8_t> used_;
   std::vector<int64_t> scores_;
-  // An inserted vertex's drop before its error at `recon` is known.
-  struct PendingDrop {
-    uint32_t vertex;
-    Vec3i recon;
-    double area, before;
-  };
-  std::vector<PendingDrop> inserted_drops_;  // this record's, in insertion order
-  std::vector<uint32_t> step_insertions_;    // this record's, per walk step
-  std::vector<double> errors_;               // record_drop()'s scratch
 };
 
 }  // namespace meshstream

@@ -3,7 +3,6 @@
 // every thread count, and a progress report that moves forward smoothly.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -28,35 +27,6 @@ TEST(EncoderThreads, TheStreamIsTheSameForEveryThreadCount) {
   ASSERT_TRUE(reference) << reference.error().message;
   for (uint32_t threads : {0u, 2u, 5u}) {
     EncodeOptions options;
-    options.threads = threads;
-    auto stream = encode_hcs(mesh, options);
-    ASSERT_TRUE(stream) << stream.error().message;
-    EXPECT_EQ(*stream, *reference) << threads << " threads";
-  }
-}
-
-// The surface-distance estimate's closest-point queries run on threads
-// where a record inserts or a plane group holds enough vertices (512-vertex
-// blocks in groups of at least 1024, 256-insertion blocks in records of at
-// least 512): large records make both happen on this mesh.
-TEST(EncoderThreads, SurfaceQueriesOnThreadsGiveTheSameStream) {
-  const Mesh& mesh = scale_mesh();
-  EncodeOptions one;
-  one.threads = 1;
-  one.asa_guidance = false;
-  one.distortion_estimate = DistortionEstimate::kSurfaceDistance;
-  one.record_bytes = 4096;  // plane groups of 8192 vertices
-  EncodeReport report;
-  auto reference = encode_hcs(mesh, one, &report);
-  ASSERT_TRUE(reference) << reference.error().message;
-  // Records large enough for the threads: some insert 512 vertices or more.
-  uint32_t largest = 0;
-  for (size_t i = 1; i < report.records.size(); ++i)
-    if (!report.records[i].plane)
-      largest = std::max(largest, report.records[i].vertices - report.records[i - 1].vertices);
-  EXPECT_GE(largest, 512u);
-  for (uint32_t threads : {2u, 3u}) {
-    EncodeOptions options = one;
     options.threads = threads;
     auto stream = encode_hcs(mesh, options);
     ASSERT_TRUE(stream) << stream.error().message;
