@@ -561,7 +561,9 @@ void show_geometric_normals(const EditableMesh& m, AttributeValues& a, const Att
 struct ValueCoder {
   const AttributeLayout& layout;
   bool base_record = false;  // record 1 (its prediction flags)
-  std::vector<uint32_t> ring, corners, earlier;
+  // Scratch reused across vertices (initialised empty: aggregate
+  // initialisation names only the two fields above).
+  std::vector<uint32_t> ring = {}, corners = {}, earlier = {};
 
   bool repeats(const AttributeChannel& c) const {
     return c.per_corner && (c.flags & kWedgeRepeat) != 0;
