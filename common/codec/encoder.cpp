@@ -82,6 +82,11 @@ Status check_options(const EncodeOptions& options) {
                       "locality unlocked share " + std::to_string(options.locality_unlocked_share) +
                           " is not in 0..1");
   }
+  if (!(options.layer_candidate_share > 0 && options.layer_candidate_share <= 1)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "layer candidate share " + std::to_string(options.layer_candidate_share) +
+                          " is not in (0, 1]");
+  }
   if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
     return make_error(ErrorCode::kInvalidArgument,
                       "base shift " + std::to_string(*options.base_shift) + " is not 0.." +
@@ -409,6 +414,7 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   progress.stage("decimating", 0.0, decimated_at);
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
+  dopt.candidate_share = options.layer_candidate_share;
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
   if (!options.measure_unlocked_seams) dopt.locked = plan->locked;
