@@ -127,7 +127,13 @@ void add_encode_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--layer-candidates", args->layer_candidates,
                   "each decimation layer removes vertices from this cheapest share of its "
                   "candidates, (0, 1]: larger makes fewer, larger layers")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            // 0 takes no vertex at all: a usage error (exit 2), like 1.5.
+            const double share = std::strtod(text.c_str(), nullptr);
+            return share > 0 && share <= 1 ? std::string() : "share " + text + " is not in (0, 1]";
+          },
+          "(0, 1]"))
       ->capture_default_str();
   cmd->add_option("--base-shift", args->base_shift,
                   "low bits of the base positions sent later as bit planes, 0..12 (default: "
