@@ -60,8 +60,7 @@ TEST(SurfaceErrorCache, EveryAnswerIsTheExactQuerys) {
         break;
     }
     last[v] = recon;
-    const double want =
-        recon == t ? 0.0 : surface.closest(to_double(recon)).squared_distance;
+    const double want = recon == t ? 0.0 : surface.closest(to_double(recon)).squared_distance;
     ASSERT_EQ(vertex_error2(truth, v, recon), want) << i;
     for (int a = 0; a < 3; ++a) far += std::abs(recon[a] - t[a]) >= 512;
   }
