@@ -1,5 +1,5 @@
 // `meshstream encode IN -o OUT.hcs [--quant-bits 12] [--base-vertices N]
-//   [--record-bytes N] [--base-shift B] [--no-bit-planes] [--threads N]
+//   [--record-bytes N] [--base-shift B] [--layer-candidates S] [--no-bit-planes] [--threads N]
 //   [--quant-normal 8] [--quant-uv 12] [--quant-color 8] [--progress | --no-progress]`:
 // import and clean a mesh, encode it into one progressive .hcs stream
 // (common/codec/encoder.h), write it, and say what was made.
@@ -22,6 +22,7 @@ struct EncodeArgs {
   int quant_bits = EncodeOptions{}.quant_bits;
   uint32_t base_vertices = EncodeOptions{}.target_base_vertices;
   uint32_t record_bytes = EncodeOptions{}.record_bytes;
+  double layer_candidates = EncodeOptions{}.layer_candidate_share;
   std::optional<int> base_shift;  // empty: automatic
   bool no_bit_planes = false;
   bool no_asa_guidance = false;
@@ -52,6 +53,7 @@ int run_encode(const EncodeArgs& args) {
   options.quant_bits = args.quant_bits;
   options.target_base_vertices = args.base_vertices;
   options.record_bytes = args.record_bytes;
+  options.layer_candidate_share = args.layer_candidates;
   options.base_shift = args.base_shift;
   options.embedded = !(args.no_bit_planes || args.old_flag);
   options.threads = args.threads;
@@ -121,6 +123,17 @@ void add_encode_command(CLI::App& app, int& exit_code) {
          "close a refinement record at about this size (0: automatic, at least min(n/50, 200) "
          "records, none above 2 % of the stream)")
       ->check(CLI::Range(0u, 1u << 26))
+      ->capture_default_str();
+  cmd->add_option("--layer-candidates", args->layer_candidates,
+                  "each decimation layer removes vertices from this cheapest share of its "
+                  "candidates, (0, 1]: larger makes fewer, larger layers")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            // 0 takes no vertex at all: a usage error (exit 2), like 1.5.
+            const double share = std::strtod(text.c_str(), nullptr);
+            return share > 0 && share <= 1 ? std::string() : "share " + text + " is not in (0, 1]";
+          },
+          "(0, 1]"))
       ->capture_default_str();
   cmd->add_option("--base-shift", args->base_shift,
                   "low bits of the base positions sent later as bit planes, 0..12 (default: "

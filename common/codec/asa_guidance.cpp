@@ -396,7 +396,7 @@ class GuidanceMeasure {
     for (uint32_t f = 0; f < shown.triangles.size(); ++f)
       if (kind_of(f) == Probes::kProbe) probed.push_back(f);
     const WeightedSamples from_shown = quadrature_samples(shown, cell_area_, probed);
-    probed = {};
+    std::vector<uint32_t>().swap(probed);  // freed (`= {}` would keep the capacity)
     const double to_original = weighted_rms_distance(from_shown, *bvh_, threads_);
     if (diagonal_ > 0 && to_original / diagonal_ >= give_up_at) return {to_original / diagonal_, 0};
 

@@ -452,9 +452,10 @@ Result<AttributeLayout> read_layout(std::span<const uint8_t> bytes) {
     const uint8_t allowed =
         c.kind == AttributeKind::kTexcoord
             ? kPredictBaseAlternative | kPredictLaterFromGeometry | kBaseCoarse | kWedgeRepeat
-        : c.kind == AttributeKind::kNormal ? kPredictBaseAlternative | kBaseNormalsLate
-        : c.kind == AttributeKind::kColor  ? kBaseCoarse
-                                           : 0;
+        : c.kind == AttributeKind::kNormal
+            ? kPredictBaseAlternative | kBaseNormalsLate | kWedgeRepeat
+        : c.kind == AttributeKind::kColor ? kBaseCoarse
+                                          : 0;
     if (c.flags & ~allowed) return tl::unexpected(parse_error("unknown prediction flags"));
     if (c.kind == AttributeKind::kMaterial && !c.per_corner)
       return tl::unexpected(parse_error("face materials must be per corner"));
@@ -561,7 +562,9 @@ void show_geometric_normals(const EditableMesh& m, AttributeValues& a, const Att
 struct ValueCoder {
   const AttributeLayout& layout;
   bool base_record = false;  // record 1 (its prediction flags)
-  std::vector<uint32_t> ring, corners, earlier;
+  // Scratch reused across vertices (initialised empty: aggregate
+  // initialisation names only the two fields above).
+  std::vector<uint32_t> ring = {}, corners = {}, earlier = {};
 
   bool repeats(const AttributeChannel& c) const {
     return c.per_corner && (c.flags & kWedgeRepeat) != 0;
@@ -1100,16 +1103,19 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
       c.base_shift = uint8_t(c.bits - kBaseCoarseBits);
     }
   // A texture coordinate shared by several wedges of a vertex (split by
-  // the normals) is coded once (version 16, kWedgeRepeat); where no value
-  // repeats (usb: 573 wedges, none), the flag's bits would only cost (8 B).
+  // the normals) is coded once (version 16, kWedgeRepeat), and so is a
+  // normal shared by the wedges the texture coordinates split (version 17);
+  // where no value repeats (usb's UV: 573 wedges, none), the flag's bits
+  // would only cost (8 B).
   for (size_t ch = 0; ch < layout.channels.size(); ++ch) {
     AttributeChannel& c = layout.channels[ch];
-    if (c.kind != AttributeKind::kTexcoord || !c.per_corner || !plan.wedge_repeat) continue;
+    const bool may_repeat = c.kind == AttributeKind::kTexcoord || c.kind == AttributeKind::kNormal;
+    if (!may_repeat || !c.per_corner || !plan.wedge_repeat) continue;
     std::vector<uint32_t> earlier;
     bool any = false;
     for (uint32_t v = 0; v < n && !any; ++v)
       for (uint32_t w = truth.wedge_start[v] + 1; w < truth.wedge_start[v + 1] && !any; ++w) {
-        distinct_before(truth.data[ch], 2, truth.wedge_start[v], w + 1, 0, earlier);
+        distinct_before(truth.data[ch], c.components(), truth.wedge_start[v], w + 1, 0, earlier);
         any = earlier.size() < w + 1 - truth.wedge_start[v];
       }
     if (any) c.flags |= kWedgeRepeat;

@@ -102,7 +102,8 @@ inline constexpr uint8_t kBaseNormalsLate = 8;
 // the last geometry record when there is none). The first display shows
 // the coarse value at the middle of its range.
 inline constexpr uint8_t kBaseCoarse = 16;
-// A per-corner texture coordinate channel's flag (version 16 on): a wedge
+// A per-corner texture coordinate (version 16 on) or normal (17 on)
+// channel's flag: a wedge
 // after the first of its vertex first says whether its value is that of an
 // earlier wedge of the vertex (one adaptive bit per distinct earlier value,
 // in wedge order; record 1 compares the values it codes, the coarse ones
@@ -111,7 +112,10 @@ inline constexpr uint8_t kBaseCoarse = 16;
 // its own wedge for the UV too (the sphere: 3 840 UV wedges for 729
 // values); with this flag a UV shared by several normal wedges is coded
 // once. The low-bits record says the same for a wedge whose coarse value
-// repeats an earlier wedge's: one bit "same low bits as it".
+// repeats an earlier wedge's: one bit "same low bits as it". From version
+// 17 per-corner normals may carry it too: a normal shared by the wedges
+// that the texture coordinates split is coded once (normals are never
+// coarse, so only their values and normals records read it).
 inline constexpr uint8_t kWedgeRepeat = 32;
 // The coarse grid record 1 uses for texture coordinates of more bits (the
 // first display shows the small texture level: 1/256 of the UV box).

@@ -9,12 +9,9 @@ namespace meshstream {
 namespace {
 
 constexpr double kMinFanCosine = 0.2;
-// Each layer considers only the cheapest half of its candidates: the
-// independent set is then drawn from the least important vertices, so the
-// coarse meshes keep the shape (measured on the bunny at a quarter of the
-// stream: RMS -30 %, Hausdorff -55 %), while layers still remove about a
-// fifth of the vertices and the stream does not grow.
-constexpr double kCandidateShare = 0.5;
+// Each layer considers only the cheapest DecimateOptions::candidate_share
+// of its candidates (default half): the independent set is then drawn from
+// the least important vertices, so the coarse meshes keep the shape.
 // Weights in the removal cost and apex choice (see decimate.h). Measured
 // with bench/decimation_bench on all 13 real models (RMS at the LOD chain's
 // cumulative bytes, docs/hcs-format.md "Layers"): a prediction weight of
@@ -375,7 +372,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
     std::fill(blocked.begin(), blocked.end(), 0);
     DecimationLayer layer;
     // The cheapest share first; all candidates when none of those is removable.
-    const size_t share = static_cast<size_t>(kCandidateShare * double(candidates.size()));
+    const size_t share = static_cast<size_t>(options.candidate_share * double(candidates.size()));
     for (size_t limit : {std::max<size_t>(share, 1), candidates.size()}) {
       for (size_t i = 0; i < limit && i < candidates.size(); ++i) {
         if (alive_count - layer.removals.size() <= target) break;

@@ -14,15 +14,17 @@ double displacement_error2(Vec3i recon, Vec3i truth) {
 
 namespace {
 
-// A grid point as one integer, unique for every axis in [0, 2^kMaxQuantBits)
-// (reconstruct() clamps to the grid); kNotOnGrid for any other point,
-// which is then never looked up in the cache.
-static_assert(3 * kMaxQuantBits <= 63);
-constexpr uint64_t kNotOnGrid = ~uint64_t(0);
-uint64_t pack_grid_point(Vec3i p) {
-  if ((uint32_t(p.x) | uint32_t(p.y) | uint32_t(p.z)) >> kMaxQuantBits) return kNotOnGrid;
-  return uint64_t(uint32_t(p.x)) | uint64_t(uint32_t(p.y)) << kMaxQuantBits |
-         uint64_t(uint32_t(p.z)) << (2 * kMaxQuantBits);
+// `p` as an offset from `truth`, 10 bits an axis (|offset| < 512), as one
+// integer below 2^30; kNoKey when an axis is farther (never looked up).
+constexpr int32_t kOffsetReach = 512;
+uint32_t offset_key(Vec3i p, Vec3i truth) {
+  uint32_t key = 0;
+  for (int a = 0; a < 3; ++a) {
+    const int64_t d = int64_t(p[a]) - int64_t(truth[a]) + kOffsetReach;
+    if (d < 0 || d >= 2 * kOffsetReach) return EncoderTruth::CachedError::kNoKey;
+    key |= uint32_t(d) << (10 * a);
+  }
+  return key;
 }
 
 }  // namespace
@@ -33,14 +35,15 @@ double vertex_error2(EncoderTruth& t, uint32_t v, Vec3i recon) {
   if (recon == truth) return 0;  // an original vertex lies on the original surface
   if (t.cached.size() <= v) t.cached.resize(v + 1);
   EncoderTruth::CachedError& c = t.cached[v];
-  const uint64_t packed = pack_grid_point(recon);
-  for (int i = 0; i < 2; ++i)
-    if (c.error2[i] >= 0 && c.position[i] == packed && packed != kNotOnGrid) return c.error2[i];
-  const ClosestHit hit = t.surface->closest(to_double(recon), c.triangle);
-  c.triangle = hit.triangle;
+  const uint32_t key = offset_key(recon, truth);
+  if (key != EncoderTruth::CachedError::kNoKey)
+    for (int i = 0; i < 2; ++i)
+      if (c.position[i] == key) return c.error2[i];
+  const ClosestHit hit = t.surface->closest_from_slot(to_double(recon), c.slot);
+  c.slot = hit.slot;
   c.position[1] = c.position[0];
   c.error2[1] = c.error2[0];
-  c.position[0] = packed;
+  c.position[0] = key;
   c.error2[0] = hit.squared_distance;
   return hit.squared_distance;
 }

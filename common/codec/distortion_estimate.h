@@ -42,15 +42,23 @@ struct EncoderTruth {
   const TriangleBvh* surface = nullptr;
   // Per vertex, the surface errors of the last two positions asked about
   // (a group's next plane is evaluated again when the group grows, and its
-  // "after" becomes the next evaluation's "before"), and the triangle found
-  // last, which starts the next search nearby.
-  // The positions as packed grid points (pack_grid_point: kMaxQuantBits
-  // bits an axis fit 64), 40 bytes an entry instead of 48.
+  // "after" becomes the next evaluation's "before"), and the hierarchy
+  // slot found last, which starts the next search nearby
+  // (TriangleBvh::closest_from_slot). A position is kept as its offset from
+  // the vertex's true position, 10 bits an axis (offset_key in the .cpp); a
+  // farther one is not kept and is searched again, with the same answer.
+  // Packed to 4-byte alignment: 28 bytes an entry (issue 15's encoder
+  // memory; 48 with whole positions, 40 with packed ones). Only lookups
+  // and their cost depend on the cache: every answer is the exact query's.
+#pragma pack(push, 4)
   struct CachedError {
-    uint64_t position[2] = {0, 0};
+    static constexpr uint32_t kNoKey = 0xffffffffu;
+    uint32_t position[2] = {kNoKey, kNoKey};
+    uint32_t slot = TriangleBvh::kNoHint;
     double error2[2] = {-1, -1};
-    uint32_t triangle = TriangleBvh::kNoHint;
   };
+#pragma pack(pop)
+  static_assert(sizeof(CachedError) == 28, "two offsets, a slot and two errors");
   std::vector<CachedError> cached;
 };
 

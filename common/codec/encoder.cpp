@@ -82,6 +82,11 @@ Status check_options(const EncodeOptions& options) {
                       "locality unlocked share " + std::to_string(options.locality_unlocked_share) +
                           " is not in 0..1");
   }
+  if (!(options.layer_candidate_share > 0 && options.layer_candidate_share <= 1)) {
+    return make_error(ErrorCode::kInvalidArgument,
+                      "layer candidate share " + std::to_string(options.layer_candidate_share) +
+                          " is not in (0, 1]");
+  }
   if (options.base_shift && (*options.base_shift < 0 || *options.base_shift > kMaxBaseShift)) {
     return make_error(ErrorCode::kInvalidArgument,
                       "base shift " + std::to_string(*options.base_shift) + " is not 0.." +
@@ -409,6 +414,7 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
   progress.stage("decimating", 0.0, decimated_at);
   DecimateOptions dopt;
   dopt.target_vertices = options.target_base_vertices;
+  dopt.candidate_share = options.layer_candidate_share;
   dopt.threads = options.threads;
   dopt.progress = progress.within_function();
   if (!options.measure_unlocked_seams) dopt.locked = plan->locked;
@@ -433,12 +439,15 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
                   : std::any_of(orderings.begin(), orderings.end(), uses_surface))
     surface = grid_surface(mesh, q, options.threads);
   // The hierarchy over the original goes to the caller (the ASA guidance
-  // measures against the same triangles) whichever way this returns.
+  // measures against the same triangles) whichever way this returns, with
+  // its triangle hints (dropped for the winner's encode, below).
   struct HandOut {
     TriangleBvh* to;
     TriangleBvh& from;
     ~HandOut() {
-      if (to) *to = std::move(from);
+      if (!to) return;
+      from.restore_triangle_hints();
+      *to = std::move(from);
     }
   } hand_out{surface_out, surface};
   // The input's normals, for the displacement estimate only: computed when
@@ -505,15 +514,22 @@ Result<std::vector<uint8_t>> encode_records(const Mesh& mesh, const EncodeOption
     if (*best == 0) return finish(streams[0]);
     progress.stage("coding the winner", measured_at, 1.0);
     if (uses_surface(orderings[*best])) {
-      input_normals = {};
+      // (Not `= {}`: that assigns an empty list and keeps the capacity.)
+      std::vector<Vec3f>().swap(input_normals);
       if (surface.empty()) {
         surface = grid_surface(mesh, q, options.threads);
       } else if (auto st = to_grid_units(surface, mesh, q); !st) {
         return tl::unexpected(st.error());
       }
+      // The cache's hints are slots (vertex_error2): the triangle-to-slot
+      // map is not needed while the replay is alive.
+      surface.drop_triangle_hints();
     }
-    // The prefixes are measured: only the first stream may still be needed.
+    // The prefixes are measured: only the first stream may still be needed,
+    // and its vertex map only for attribute records (4 bytes a vertex).
     streams.resize(1);
+    if (options.measure_unlocked_seams || plan->empty())
+      std::vector<uint32_t>().swap(streams[0].to_decoder);
     EncodeReport winner_report;
     // The decimation's last encode: its layers go as they are written.
     auto winner = encode_candidate(*best, first->record_bytes, report ? &winner_report : nullptr,

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/base/result.h"
+#include "common/codec/decimate.h"
 #include "common/codec/encode_progress.h"
 #include "common/codec/stream_format.h"
 #include "common/mesh/mesh.h"
@@ -33,6 +34,11 @@ enum class DistortionEstimate : uint8_t {
 struct EncodeOptions {
   int quant_bits = 12;                  // 8..20, grid over the bounding box
   uint32_t target_base_vertices = 300;  // stop decimating at about this many
+  // Each decimation layer draws its independent set from this cheapest
+  // share of its candidates (DecimateOptions::candidate_share): larger
+  // shares make fewer, larger layers. (0, 1], else kInvalidArgument.
+  // `meshstream encode --layer-candidates`.
+  double layer_candidate_share = kDefaultCandidateShare;
   // Close a refinement record at about this size; 0 = automatic (sized
   // for min(n / 50, 200) boundaries and no record beyond the base above 2 %
   // of the stream; re-encoded with smaller records when missed).

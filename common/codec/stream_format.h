@@ -17,7 +17,7 @@ inline constexpr uint16_t kContainerVersion = 3;
 // Bumped whenever the bytes an encoder writes for the same input change, so
 // caches keyed by (content hash, encoder version) stay correct. What each
 // bump changed: docs/hcs-format.md ("Encoder versions").
-inline constexpr uint32_t kEncoderVersion = 16;
+inline constexpr uint32_t kEncoderVersion = 17;
 
 // Which coder made record 0, the base mesh (header `base_coder`,
 // base_coder.h).

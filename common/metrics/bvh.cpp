@@ -98,7 +98,7 @@ TriangleBvh TriangleBvh::build(const Mesh& mesh, unsigned threads) {
   Builder out;
   out.nodes.reserve(2 * n / kMaxLeafTriangles + 1);
   bvh.build_node(out, refs, 0, n, 0, mesh, centroids, spawn_levels);
-  centroids = {};
+  std::vector<Vec3d>().swap(centroids);  // freed (`= {}` would keep the capacity)
   bvh.nodes_ = std::move(out.nodes);
   bvh.depth_ = out.depth;
   // Leaves hold 1..kMaxLeafTriangles triangles, so the reserve above is
@@ -287,7 +287,17 @@ Status TriangleBvh::refit(const Mesh& mesh) {
   return {};
 }
 
+void TriangleBvh::restore_triangle_hints() {
+  if (slot_of_.size() == triangles_.size()) return;
+  slot_of_.resize(triangles_.size());
+  for (uint32_t s = 0; s < triangles_.size(); ++s) slot_of_[triangles_[s].triangle] = s;
+}
+
 ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
+  return closest_from_slot(query, hint < slot_of_.size() ? slot_of_[hint] : kNoHint);
+}
+
+ClosestHit TriangleBvh::closest_from_slot(Vec3d query, uint32_t slot_hint) const {
   ClosestHit best;
   best.squared_distance = std::numeric_limits<double>::infinity();
   auto test_slot = [&](uint32_t s) {
@@ -300,9 +310,10 @@ ClosestHit TriangleBvh::closest(Vec3d query, uint32_t hint) const {
       best.squared_distance = d2;
       best.point = q;
       best.triangle = t.triangle;
+      best.slot = s;
     }
   };
-  if (hint < slot_of_.size()) test_slot(slot_of_[hint]);
+  if (slot_hint < triangles_.size()) test_slot(slot_hint);
 
   struct Entry {
     uint32_t node;

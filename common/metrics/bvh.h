@@ -22,6 +22,7 @@ struct ClosestHit {
   double squared_distance = 0;
   Vec3d point{};          // on the surface
   uint32_t triangle = 0;  // index into the mesh's triangles
+  uint32_t slot = 0;      // its place in the hierarchy (TriangleBvh::closest_from_slot's hint)
 };
 
 class TriangleBvh {
@@ -65,6 +66,14 @@ class TriangleBvh {
   // triangle). `hint` (a triangle index, e.g. the previous query's answer)
   // only speeds the search up. Precondition: !empty(). O(log F) typical.
   ClosestHit closest(Vec3d query, uint32_t hint = kNoHint) const;
+  // closest() with the hint a slot (an earlier hit's `slot`) instead of a
+  // triangle: the same search, without the triangle-to-slot map.
+  ClosestHit closest_from_slot(Vec3d query, uint32_t slot_hint = kNoHint) const;
+  // Frees the triangle-to-slot map (4 bytes a triangle) while only
+  // closest_from_slot() is used: closest() then searches without its hint
+  // (the same distances, more slowly) until restore_triangle_hints().
+  void drop_triangle_hints() { std::vector<uint32_t>().swap(slot_of_); }
+  void restore_triangle_hints();
 
   struct Node {
     // Bounds, inflated a hair so rounding never escapes them, then rounded
@@ -109,7 +118,7 @@ class TriangleBvh {
   std::vector<Node> nodes_;
   std::vector<Slot> triangles_;    // in leaf order
   std::vector<Vec3f> points_;      // the corners' points, in the order the leaves first use them
-  std::vector<uint32_t> slot_of_;  // triangle index -> slot
+  std::vector<uint32_t> slot_of_;  // triangle index -> slot (empty after drop_triangle_hints)
   double inflate_ = 0;
   uint32_t depth_ = 0;
 };

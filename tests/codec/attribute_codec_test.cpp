@@ -521,6 +521,48 @@ TEST(AttributeCodec, SharedTexcoordsOfHardEdgesAreCodedOnce) {
       << streams[1].size() << " vs " << streams[0].size();
 }
 
+// The faceted cube's face charts (UV per face, so every edge vertex has 2-3
+// wedges) with smooth normals: each vertex's normal is the same in all its
+// wedges, the case version 17 codes once.
+Mesh smooth_cube_with_face_charts(int n) {
+  Mesh cube = faceted_cube(n);
+  cube.corner_normals.values.clear();
+  cube.corner_normals.corners.clear();
+  for (const Vec3f& p : cube.positions) cube.corner_normals.values.push_back(normalized(p));
+  for (const auto& t : cube.triangles)
+    for (uint32_t v : t) cube.corner_normals.corners.push_back(v);
+  return cube;
+}
+
+// A normal repeated across the wedges that the texture coordinates split is
+// coded once (version 17: kWedgeRepeat on the normals), exact at full rate
+// and valid at every prefix either way.
+TEST(AttributeCodec, SharedNormalsOfUvSeamsAreCodedOnce) {
+  const Mesh cube = smooth_cube_with_face_charts(6);
+  ASSERT_TRUE(check_attribute_counts(cube)) << check_attribute_counts(cube).error().message;
+  EncodeOptions o;
+  o.target_base_vertices = 40;
+  std::vector<uint8_t> streams[2];
+  for (bool repeat : {false, true}) {
+    o.wedge_repeat = repeat;
+    auto stream = encode_hcs(cube, o);
+    ASSERT_TRUE(stream) << stream.error().message;
+    const RecordPlaces at = record_places(*stream, AttributeKind::kNormal);
+    ASSERT_NE(at.flags, 0xFF);
+    EXPECT_EQ((at.flags & kWedgeRepeat) != 0, repeat);
+    auto decoded = decode_hcs(*stream);
+    ASSERT_TRUE(decoded) << decoded.error().message;
+    Mesh expected = expected_mesh(cube, o);
+    expected.textures = cube.textures;
+    EXPECT_TRUE(faces_of(*decoded) == faces_of(expected)) << repeat;
+    expect_valid_prefixes(*stream);
+    streams[repeat] = std::move(*stream);
+  }
+  // 152 edge vertices of 2-3 wedges, one normal each.
+  EXPECT_LT(streams[1].size() + 100, streams[0].size())
+      << streams[1].size() << " vs " << streams[0].size();
+}
+
 // An icosphere of 2 562 vertices with smooth per-vertex colours that use
 // all 8 bits (so the low bits are not a constant).
 Mesh coloured_icosphere(uint32_t subdivisions) {

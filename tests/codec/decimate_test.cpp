@@ -8,8 +8,10 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
+#include "common/codec/encoder.h"
 #include "common/codec/quantize.h"
 
 namespace meshstream {
@@ -189,6 +191,35 @@ TEST(Decimate, CoarseVerticesGoWhereTheSurfaceBends) {
     square_corners += (p.x == 0 || p.x == q[n - 1].x) && (p.y == 0 || p.y == q[n * (n - 1)].y);
   }
   EXPECT_EQ(square_corners, 4);
+}
+
+// The candidate share bounds a layer's size: drawn from every candidate, a
+// layer removes more vertices than from the cheapest half (the default), so
+// the same base takes fewer layers. The encoder refuses shares outside (0, 1].
+TEST(Decimate, CandidateShareBoundsTheLayerSize) {
+  const Mesh cube = subdivided_cube(12);  // 866 vertices
+  DecimateOptions options;
+  options.target_vertices = 100;
+  auto first_layer_and_count = [&](double share) {
+    options.candidate_share = share;
+    const auto decimated = decimate_on_grid(cube, options);
+    EXPECT_TRUE(decimated);
+    EXPECT_EQ(decimated->result.base_vertices.size(), 100u) << share;
+    return std::pair{decimated->result.layers.at(0).removals.size(),
+                     decimated->result.layers.size()};
+  };
+  const auto [half_first, half_layers] = first_layer_and_count(kDefaultCandidateShare);
+  const auto [all_first, all_layers] = first_layer_and_count(1.0);
+  EXPECT_GT(all_first, half_first);
+  EXPECT_LT(all_layers, half_layers);
+
+  EncodeOptions encode;
+  for (double share : {0.0, -0.5, 1.5}) {
+    encode.layer_candidate_share = share;
+    auto refused = encode_hcs(cube, encode);
+    ASSERT_FALSE(refused) << share;
+    EXPECT_EQ(refused.error().code, ErrorCode::kInvalidArgument) << share;
+  }
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The embedded stream on real meshes (skipped when ../shared/meshes is absent): the
 // distance to the original along the record boundaries, the granularity
 // bounds, the encoder's model at every prefix and the decoder controls.
-// The distances run on every real model; the other checks on a subset (time).
+// The distances run on every distinct real model; the other checks on a subset (time).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -45,7 +45,7 @@ uint64_t end_of(const StreamIndex& index, size_t i) {
 class EmbeddedRealMesh : public ::testing::TestWithParam<const char*> {};
 class EmbeddedRealMeshDistance : public ::testing::TestWithParam<const char*> {};
 
-// Distance to the original after every record, on every real model: the
+// Distance to the original after every record, on every distinct real model: the
 // symmetric RMS as the encoder measures it (RdMeasure::relative_rms, 8000
 // samples): fixed area samples on the original and fixed per-triangle
 // quadrature points on the decoded prefix (surface_quadrature.h). Plain area sampling of the prefix
@@ -189,12 +189,16 @@ INSTANTIATE_TEST_SUITE_P(Shared, EmbeddedRealMesh,
                          ::testing::Values("fandisk.off", "casting.off", "hemisphere.off",
                                            "bunny.off"),
                          test_name);
-// Distances after every record: every real model of the manifest.
+// Distances after every record: every distinct real model of the manifest.
+// Two are left out for CI's time (they were 90 of its 320 CPU seconds): bunny.stl
+// is bun_zipper.ply's surface again (the same scan as an unwelded STL), and
+// dragon_res2.ply is the dragon that dragon_res3.ply measures at a quarter of
+// the vertices, with non-manifold edges and duplicate faces of its own.
 INSTANTIATE_TEST_SUITE_P(Shared, EmbeddedRealMeshDistance,
-                         ::testing::Values("bun_zipper.ply", "bunny.off", "bunny.stl",
-                                           "armadillo.obj", "fandisk.off", "crank.off",
-                                           "casting.off", "mask.off", "hemisphere.off", "skull.obj",
-                                           "maneki-neko.off", "dragon_res2.ply", "dragon_res3.ply"),
+                         ::testing::Values("bun_zipper.ply", "bunny.off", "armadillo.obj",
+                                           "fandisk.off", "crank.off", "casting.off", "mask.off",
+                                           "hemisphere.off", "skull.obj", "maneki-neko.off",
+                                           "dragon_res3.ply"),
                          test_name);
 
 }  // namespace

@@ -41,7 +41,12 @@
 //   container3_v15_sphere_uv_per_wedge.hcs Draco's textured sphere at
 //                 kEncoderVersion 15, default options: every UV wedge's
 //                 value coded (3 840 for 729 texture coordinates), which
-//                 version 16 codes once per vertex (kWedgeRepeat).
+//                 version 16 codes once per vertex (kWedgeRepeat);
+//   container3_v16_smooth_cube_normals_per_wedge.hcs the faceted cube with
+//                 face charts and smooth normals (attribute_codec_test's
+//                 smooth_cube_with_face_charts(6)) at kEncoderVersion 16,
+//                 default options: each normal coded once per wedge, which
+//                 version 17 codes once per vertex.
 // The hashes were recorded with the decoder of that time (its output files
 // compared byte for byte with this one's).
 #include <gtest/gtest.h>
@@ -304,6 +309,17 @@ TEST(LegacyStreams, VersionFifteenCoarseColoursDecodeAsWhenWritten) {
 TEST(LegacyStreams, VersionFifteenUvPerWedgeDecodeAsWhenWritten) {
   expect_decodes_as_when_written(read_sample("container3_v15_sphere_uv_per_wedge.hcs"),
                                  0x09209576d7d677d2ull, 1);
+}
+
+// Version 16: texture coordinates with kWedgeRepeat, but a smooth normal
+// coded once per wedge where the face charts split its vertex (no
+// kWedgeRepeat on the normals): the faceted cube of six segments with face
+// charts and smooth normals, default options (attribute_codec_test's
+// smooth_cube_with_face_charts). The hash is what the version-16 decoder
+// gave (its PLY and GLB output and this decoder's are the same bytes).
+TEST(LegacyStreams, VersionSixteenNormalsPerWedgeDecodeAsWhenWritten) {
+  expect_decodes_as_when_written(read_sample("container3_v16_smooth_cube_normals_per_wedge.hcs"),
+                                 0x7059f6bf8f7a7c19ull, 1);
 }
 
 }  // namespace

@@ -192,6 +192,51 @@ TEST(TriangleBvh, RefitToNewPositionsIsExact) {
   expect_matches_brute_force(bvh, m, {{0.3, 0.2, 2}, {-1, 0, 0.5}, {0, 0, 0}});
 }
 
+// A slot hint is the triangle hint it stands for: the same hit (distance,
+// point, triangle, slot) query for query, with the triangle-to-slot map
+// dropped too; without the map closest() still gives every distance, and
+// restore_triangle_hints() brings its hints back.
+TEST(TriangleBvh, SlotHintsGiveTheSameHitsAsTriangleHints) {
+  std::mt19937 rng(13);
+  const Mesh m = triangle_soup(2000, rng);
+  TriangleBvh bvh = TriangleBvh::build(m);
+  std::uniform_real_distribution<double> coord(-12, 12);
+  std::vector<Vec3d> queries;
+  for (int i = 0; i < 600; ++i) queries.push_back({coord(rng), coord(rng), coord(rng)});
+  std::vector<ClosestHit> by_triangle;
+  uint32_t hint = TriangleBvh::kNoHint;
+  for (const Vec3d& q : queries) {
+    by_triangle.push_back(bvh.closest(q, hint));
+    hint = by_triangle.back().triangle;
+  }
+  auto expect_slot_hints_match = [&] {
+    uint32_t slot = TriangleBvh::kNoHint;
+    for (size_t i = 0; i < queries.size(); ++i) {
+      const ClosestHit hit = bvh.closest_from_slot(queries[i], slot);
+      ASSERT_EQ(hit.squared_distance, by_triangle[i].squared_distance) << i;
+      EXPECT_EQ(hit.triangle, by_triangle[i].triangle) << i;
+      EXPECT_EQ(hit.slot, by_triangle[i].slot) << i;
+      EXPECT_EQ(hit.point.x, by_triangle[i].point.x) << i;
+      slot = hit.slot;
+    }
+  };
+  expect_slot_hints_match();
+  bvh.drop_triangle_hints();
+  expect_slot_hints_match();
+  for (size_t i = 0; i < queries.size(); ++i)
+    ASSERT_EQ(bvh.closest(queries[i], i ? by_triangle[i - 1].triangle : TriangleBvh::kNoHint)
+                  .squared_distance,
+              by_triangle[i].squared_distance);
+  bvh.restore_triangle_hints();
+  hint = TriangleBvh::kNoHint;
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const ClosestHit hit = bvh.closest(queries[i], hint);
+    EXPECT_EQ(hit.triangle, by_triangle[i].triangle) << i;
+    EXPECT_EQ(hit.slot, by_triangle[i].slot) << i;
+    hint = hit.triangle;
+  }
+}
+
 TEST(TriangleBvh, RefitRefusesOtherTriangleCounts) {
   const Mesh m = testing::icosphere(1);
   TriangleBvh bvh = TriangleBvh::build(m);

@@ -88,6 +88,8 @@ TEST(FirstChunkGate, StoppedWakersAreNotCalled) {
 
 // ------------------------------------------------- through the real server
 
+const ModelsFolder& gate_folder = register_models_folder("ms_gate_");
+
 struct GateModels {
   std::string dir;
   std::vector<uint8_t> big;  // ~8 MB: many bulk chunks after the first
@@ -96,8 +98,7 @@ struct GateModels {
 const GateModels& gate_models() {
   static const GateModels m = [] {
     GateModels out;
-    out.dir = (fs::temp_directory_path() / ("ms_gate_" + std::to_string(::getpid()))).string();
-    fs::create_directories(out.dir);
+    out.dir = gate_folder.create();
     server::SyntheticStreamOptions big;
     big.records = 200;
     big.payload_bytes = 8 << 20;
@@ -108,15 +109,6 @@ const GateModels& gate_models() {
   }();
   return m;
 }
-
-class CleanupGateModels : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(fs::temp_directory_path() / ("ms_gate_" + std::to_string(::getpid())), ec);
-  }
-};
-const auto* const gate_cleanup = ::testing::AddGlobalTestEnvironment(new CleanupGateModels);
 
 // A server whose bulk hold is far longer than any test: a starting stream
 // that never released the gate would show as a stream taking >= 20 s.

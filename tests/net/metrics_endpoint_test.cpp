@@ -18,6 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+const ModelsFolder& models_folder = register_models_folder("ms_metrics_");
+
 struct MetricsModels {
   std::string dir;
   std::vector<uint8_t> small;
@@ -27,8 +29,7 @@ struct MetricsModels {
 const MetricsModels& models() {
   static const MetricsModels m = [] {
     MetricsModels out;
-    out.dir = (fs::temp_directory_path() / ("ms_metrics_" + std::to_string(::getpid()))).string();
-    fs::create_directories(out.dir);
+    out.dir = models_folder.create();
     server::SyntheticStreamOptions small;
     small.records = 40;
     small.payload_bytes = 120000;
@@ -46,15 +47,6 @@ const MetricsModels& models() {
   }();
   return m;
 }
-
-class CleanupMetricsModels : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(fs::temp_directory_path() / ("ms_metrics_" + std::to_string(::getpid())), ec);
-  }
-};
-const auto* const cleanup = ::testing::AddGlobalTestEnvironment(new CleanupMetricsModels);
 
 class MetricsEndpointTest : public ::testing::Test {
  protected:

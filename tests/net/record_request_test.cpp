@@ -26,6 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+const ModelsFolder& models_folder = register_models_folder("ms_ranged_");
+
 struct Models {
   std::string dir;
   std::vector<uint8_t> synthetic;  // 60 records, some larger than a chunk
@@ -35,8 +37,7 @@ struct Models {
 const Models& models() {
   static const Models m = [] {
     Models out;
-    out.dir = (fs::temp_directory_path() / ("ms_ranged_" + std::to_string(::getpid()))).string();
-    fs::create_directories(out.dir);
+    out.dir = models_folder.create();
     server::SyntheticStreamOptions o;
     o.records = 60;
     o.vertices = 20000;
@@ -52,15 +53,6 @@ const Models& models() {
   }();
   return m;
 }
-
-class CleanupModels : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(fs::temp_directory_path() / ("ms_ranged_" + std::to_string(::getpid())), ec);
-  }
-};
-const auto* const cleanup_registration = ::testing::AddGlobalTestEnvironment(new CleanupModels);
 
 v1::StreamRequest ranged(const std::string& model,
                          const std::vector<std::pair<uint32_t, uint32_t>>& ranges) {

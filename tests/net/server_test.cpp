@@ -17,6 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
+const ModelsFolder& models_folder = register_models_folder("ms_net_");
+
 struct Models {
   std::string dir;
   std::vector<uint8_t> small;  // ~200 KB, 60 records, some larger than a chunk
@@ -27,8 +29,7 @@ struct Models {
 const Models& models() {
   static const Models m = [] {
     Models out;
-    out.dir = (fs::temp_directory_path() / ("ms_net_" + std::to_string(::getpid()))).string();
-    fs::create_directories(out.dir);
+    out.dir = models_folder.create();
     server::SyntheticStreamOptions small;
     small.records = 60;
     small.vertices = 20000;
@@ -48,16 +49,6 @@ const Models& models() {
   }();
   return m;
 }
-
-// Removes the models folder when the suite ends.
-class CleanupModels : public ::testing::Environment {
- public:
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(fs::temp_directory_path() / ("ms_net_" + std::to_string(::getpid())), ec);
-  }
-};
-const auto* const cleanup_registration = ::testing::AddGlobalTestEnvironment(new CleanupModels);
 
 StreamIndex index_of(const std::vector<uint8_t>& bytes) { return *read_stream_index(bytes); }
 
