@@ -115,7 +115,9 @@ TEST(Approximate, FlatRegionsSharpEdgesAndBoundariesStayPut) {
   Mesh bumped = grid;
   ASSERT_TRUE(relax_toward_smooth(bumped));
   for (uint32_t v = 0; v < grid.vertex_count(); ++v)
-    if (on_boundary[v]) EXPECT_EQ(bumped.positions[v], grid.positions[v]) << v;
+    if (on_boundary[v]) {
+      EXPECT_EQ(bumped.positions[v], grid.positions[v]) << v;
+    }
   const auto height = [&](const Mesh& m) {
     return std::abs(dot(m.positions[middle] - grid.positions[0], normal));
   };

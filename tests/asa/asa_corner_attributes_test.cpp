@@ -62,7 +62,9 @@ TEST(AsaCornerAttributes, SubdividingASeamedSphereKeepsTheSeam) {
       EXPECT_EQ(m.face_materials.size(), m.face_count());
       EXPECT_TRUE(result->source_face.empty()) << "only tracked when asked";
       const int seam = check_seam(m, 16);
-      if (uniform) EXPECT_GT(seam, previous_seam) << "new vertices on the seam edges";
+      if (uniform) {
+        EXPECT_GT(seam, previous_seam) << "new vertices on the seam edges";
+      }
       previous_seam = seam;
       // Every texture coordinate in the sphere's chart.
       for (const Vec2f& uv : m.corner_texcoords.values) {

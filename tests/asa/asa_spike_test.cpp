@@ -117,10 +117,11 @@ double worst_ratio(const Mesh& mesh, bool bound, const std::string& name) {
       EXPECT_TRUE(r.has_value()) << name << " " << describe(o);
       if (!r) break;
       const Spike s = worst_spike(input, r->mesh);
-      if (bound)
+      if (bound) {
         EXPECT_LE(s.distance, s.allowed * (1 + 1e-5) + 1e-7)
             << name << " " << describe(o) << " level " << level << ": vertex " << s.vertex << " is "
             << s.distance << " from the surface, its edge allows " << s.allowed;
+      }
       worst = std::max(worst, s.ratio());
       input = std::move(r->mesh);
     }

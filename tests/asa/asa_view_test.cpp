@@ -213,7 +213,9 @@ void check_camera_moves(const Mesh& start, const std::string& name, bool expect_
     EXPECT_TRUE(asa_test::same_incremental(inc, full)) << name << " step " << step;
     EXPECT_TRUE(asa_test::conforming_incremental(m, inc)) << name << " step " << step;
   }
-  if (expect_partial) EXPECT_GT(partial, 0) << name << ": some camera moves should be partial";
+  if (expect_partial) {
+    EXPECT_GT(partial, 0) << name << ": some camera moves should be partial";
+  }
 }
 
 TEST(AsaView, IncrementalCameraMovesEqualFullRuns) {

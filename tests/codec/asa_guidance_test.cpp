@@ -331,7 +331,9 @@ TEST(AsaGuidance, RealMeshesGetTheirOwnChoice) {
         }
       }
     }
-    if (std::string(name) == "bunny.off") EXPECT_TRUE(any_asa) << "a smooth scan gains from ASA";
+    if (std::string(name) == "bunny.off") {
+      EXPECT_TRUE(any_asa) << "a smooth scan gains from ASA";
+    }
   }
 }
 

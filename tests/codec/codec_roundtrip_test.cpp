@@ -148,8 +148,9 @@ TEST_P(ProceduralRoundTrip, DeltasCoverEveryChange) {
       std::sort(touched.begin(), touched.end());
       for (uint32_t f = 0; f < after.face_count(); ++f) {
         const bool changed = f >= before.face_count() || before.triangles[f] != after.triangles[f];
-        if (changed)
+        if (changed) {
           EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), f)) << "face " << f;
+        }
       }
       for (uint32_t f : touched) EXPECT_LT(f, after.face_count());
       ASSERT_EQ(d.added_vertices.size(), after.vertex_count() - before.vertex_count());
@@ -158,11 +159,14 @@ TEST_P(ProceduralRoundTrip, DeltasCoverEveryChange) {
       // Existing vertices move only in plane records, and only those named.
       std::vector<uint32_t> moved = d.moved_vertices;
       std::sort(moved.begin(), moved.end());
-      if (!moved.empty()) EXPECT_TRUE(d.added_vertices.empty());
+      if (!moved.empty()) {
+        EXPECT_TRUE(d.added_vertices.empty());
+      }
       for (uint32_t v = 0; v < before.vertex_count(); ++v) {
-        if (!(before.positions[v] == after.positions[v]))
+        if (!(before.positions[v] == after.positions[v])) {
           EXPECT_TRUE(std::binary_search(moved.begin(), moved.end(), v))
               << "vertex " << v << " moved unnamed";
+        }
       }
       for (uint32_t v : moved) EXPECT_LT(v, before.vertex_count());
     }

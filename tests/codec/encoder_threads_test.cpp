@@ -70,7 +70,9 @@ TEST(EncoderThreads, ProgressAdvancesSmoothlyThroughTheStages) {
     for (size_t i = 0; i < calls.size(); ++i) {
       EXPECT_GE(calls[i].fraction, 0.0);
       EXPECT_LE(calls[i].fraction, 1.0);
-      if (i > 0) EXPECT_GE(calls[i].fraction, calls[i - 1].fraction) << i;
+      if (i > 0) {
+        EXPECT_GE(calls[i].fraction, calls[i - 1].fraction) << i;
+      }
       while (stage < order.size() && calls[i].stage != order[stage]) ++stage;
       ASSERT_LT(stage, order.size()) << "stage " << calls[i].stage << " out of order";
       ++calls_in[stage];

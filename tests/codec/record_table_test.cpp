@@ -69,10 +69,14 @@ TEST(RecordTable, NeedsAreEarlierRecordsAndEveryRecordIsListed) {
       EXPECT_EQ(e.kind == RecordKind::kBase, r == 0);
       for (size_t i = 0; i < e.needs.size(); ++i) {
         EXPECT_LT(e.needs[i], r) << "record " << r;
-        if (i > 0) EXPECT_LT(e.needs[i - 1], e.needs[i]);
+        if (i > 0) {
+          EXPECT_LT(e.needs[i - 1], e.needs[i]);
+        }
       }
       // Every record beyond the base builds on something.
-      if (r > 0) EXPECT_FALSE(e.needs.empty()) << "record " << r;
+      if (r > 0) {
+        EXPECT_FALSE(e.needs.empty()) << "record " << r;
+      }
       structure += e.kind == RecordKind::kStructure;
       plane += e.kind == RecordKind::kPlane;
       if (e.kind == RecordKind::kStructure) {

@@ -309,7 +309,9 @@ TEST(TextureRecords, PreviewFitsItsShareOfTheFirstDisplay) {
     ASSERT_EQ(levels->size(), 2u) << "a checker's JPEG middle level does not pay";
     const TextureLevel& preview = levels->front();
     const size_t record = write_texture_record(preview).size() + 4;  // and its CRC trailer
-    if (preview.width > 1) EXPECT_LE(record + 2, budget) << preview.width;
+    if (preview.width > 1) {
+      EXPECT_LE(record + 2, budget) << preview.width;
+    }
     EXPECT_GE(preview.width, last_width);
     last_width = preview.width;
     EXPECT_EQ(levels->back().bytes, t.bytes);
