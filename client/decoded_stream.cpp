@@ -195,6 +195,17 @@ TakenUpdate DecodedStream::take(FrameMeshPool& pool, std::shared_ptr<const Mesh>
   TakenUpdate u;
   {
     std::lock_guard lock(mutex_);
+    // The final size as the stream's index gives it, bounded as the
+    // decoder bounds its own reservation (decoder.cpp: every inserted vertex
+    // costs well over a bit), so a hostile index cannot make us reserve
+    // gigabytes.
+    if (const StreamIndex* index = decoder_.index(); index && !index->records.empty()) {
+      const uint64_t plausible = uint64_t(index->header.base_vertex_count) + 8 * bytes_received_;
+      const RecordEntry& last = index->records.back();
+      pool.expect(static_cast<uint32_t>(std::min<uint64_t>(last.vertices, plausible)),
+                  static_cast<uint32_t>(std::min<uint64_t>(
+                      last.faces, 2 * plausible + uint64_t(index->header.base_face_count))));
+    }
     // pending_ is what changed in the decoder's mesh since the last take:
     // the pool's meshes follow it by those changes alone.
     mesh = pool.share(decoder_.mesh(), pending_);

@@ -32,9 +32,13 @@ struct MeshViewFacts {
 // `facts` keeps both for the mesh they were computed on: a re-run without
 // new records (the viewer's camera moved, the tolerance changed) reuses
 // them instead of two more passes over a mesh that did not change.
+// Without ASA and without a renderer (--no-asa with no --view or
+// --snapshot) nothing reads the camera: `need_camera` false leaves it
+// unset and skips the fit, four passes over every vertex per update (a
+// third of the client's time on dragon_x2).
 AsaOptions options_with_view(const PipelineSettings& settings,
                              const std::shared_ptr<const Mesh>& decoded, MeshViewFacts& facts,
-                             std::optional<AsaCamera>& camera) {
+                             bool need_camera, std::optional<AsaCamera>& camera) {
   if (facts.mesh != decoded) {
     facts.mesh = decoded;
     facts.fit.reset();
@@ -42,6 +46,12 @@ AsaOptions options_with_view(const PipelineSettings& settings,
   }
   if (settings.view.camera) {
     camera = *settings.view.camera;
+  } else if (!need_camera) {
+    camera.reset();
+    AsaOptions options = settings.asa;
+    options.view.enabled = settings.view.dependent;
+    options.view.pixel_tolerance = settings.view.pixel_tolerance;
+    return options;
   } else {
     if (!facts.fit || facts.fit->width != settings.view.width ||
         facts.fit->height != settings.view.height)
@@ -371,8 +381,11 @@ void DisplayPipeline::loop() {
     const bool options_changed = !used || fresh_builder || asa_settings_changed(effective, *used);
     fresh_builder = false;
     used = effective;
+    // The camera is read by ASA, by the renderer's cull and by snapshots
+    // (which come with cull_for_renderer).
+    const bool need_camera = effective.asa_enabled || settings.view.cull_for_renderer;
     const AsaOptions options =
-        options_with_view(effective, frame.decoded, view_facts, frame.camera);
+        options_with_view(effective, frame.decoded, view_facts, need_camera, frame.camera);
     // Approximating: ASA runs on the relaxed positions. Relaxing moves the
     // neighbours of every changed vertex too, so the decoder's changes do
     // not describe the builder's input: a full update each time.

@@ -1,5 +1,6 @@
 #include "client/frame_mesh_pool.h"
 
+#include <algorithm>
 #include <atomic>
 
 #include "client/surface_attributes.h"
@@ -30,8 +31,17 @@ void fall_behind(MeshChanges& behind, const MeshChanges& changes, const Mesh& mi
   }
 }
 
+// Capacity for `needed` elements: at least `expected` when it has to grow.
+template <class T>
+void reserve_for(std::vector<T>& v, size_t needed, size_t expected) {
+  if (v.capacity() < needed) v.reserve(std::max(needed, expected));
+}
+
 // Brings `mesh` to equal `mirror`, given what changed since it did.
-void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror) {
+void catch_up(Mesh& mesh, const MeshChanges& behind, const Mesh& mirror, uint32_t expected_vertices,
+              uint32_t expected_faces) {
+  reserve_for(mesh.positions, mirror.positions.size(), expected_vertices);
+  reserve_for(mesh.triangles, mirror.triangles.size(), expected_faces);
   if (behind.full) {
     mesh.positions.assign(mirror.positions.begin(), mirror.positions.end());
     mesh.triangles.assign(mirror.triangles.begin(), mirror.triangles.end());
@@ -58,7 +68,7 @@ std::shared_ptr<const Mesh> FrameMeshPool::share(const Mesh& mirror, const MeshC
     // the fence orders our writes after their last reads.
     if (k.mesh.use_count() != 1) continue;
     std::atomic_thread_fence(std::memory_order_acquire);
-    catch_up(*k.mesh, k.behind, mirror);
+    catch_up(*k.mesh, k.behind, mirror, expected_vertices_, expected_faces_);
     if (k.behind.full) {
       ++stats_.whole_copies;
     } else {
@@ -68,7 +78,11 @@ std::shared_ptr<const Mesh> FrameMeshPool::share(const Mesh& mirror, const MeshC
     return k.mesh;
   }
   if (kept_.size() >= kMaxMeshes) kept_.erase(kept_.begin());  // its holders keep it alive
-  kept_.push_back(Kept{std::make_shared<Mesh>(mirror), {}});
+  auto mesh = std::make_shared<Mesh>();
+  MeshChanges whole;
+  whole.full = true;
+  catch_up(*mesh, whole, mirror, expected_vertices_, expected_faces_);
+  kept_.push_back(Kept{std::move(mesh), {}});
   ++stats_.whole_copies;
   return kept_.back().mesh;
 }

@@ -31,6 +31,16 @@ class FrameMeshPool {
   // mesh only while it is the sole owner. O(changes) when a mesh is free.
   std::shared_ptr<const Mesh> share(const Mesh& mirror, const MeshChanges& changes);
 
+  // The sizes the mirror is expected to grow to (the stream's final vertex
+  // and face counts, bounded by what the bytes received can describe): a
+  // mesh that must grow reserves that much at once instead of doubling, so
+  // its arrays are not copied again and again as records arrive. Only a
+  // capacity: the meshes still equal the mirror.
+  void expect(uint32_t vertices, uint32_t faces) {
+    expected_vertices_ = vertices;
+    expected_faces_ = faces;
+  }
+
   const Stats& stats() const { return stats_; }
 
   // At most this many meshes are kept; with all of them held elsewhere the
@@ -44,6 +54,7 @@ class FrameMeshPool {
   };
   std::vector<Kept> kept_;
   Stats stats_;
+  uint32_t expected_vertices_ = 0, expected_faces_ = 0;
 };
 
 }  // namespace meshstream::client

@@ -59,6 +59,41 @@ struct IncrementalDecoder::State {
   std::vector<uint32_t> texture_level;
   std::vector<bool> texture_original;
 
+  uint32_t reserved_vertices = 0;  // the vertex count the arrays were last reserved for
+
+  // Reserves the per-vertex and per-face arrays for the final size, but
+  // never more than the bytes received so far could describe (every
+  // inserted vertex costs well over a bit): neither a hostile header nor a
+  // hostile index (records claiming a gigabyte each that never come) can
+  // make us allocate gigabytes. A whole stream fed at once reserves its
+  // final size with the base. A streamed one reserves again as its bytes
+  // arrive (feed), in steps of at least twice the last one or straight to
+  // the final size, instead of letting every array grow by doubling: that
+  // copied them about twice over and faulted in their pages twice, work an
+  // offline decode never does.
+  void reserve_for_received() {
+    const StreamHeader& h = index->header;
+    const uint64_t received = std::min<uint64_t>(index->total_bytes(), stream_pos);
+    const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * received;
+    const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
+    if (nv <= reserved_vertices ||
+        (nv < h.vertex_count && uint64_t(nv) < 2 * uint64_t(reserved_vertices)))
+      return;
+    const uint32_t nf =
+        static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
+    reserved_vertices = nv;
+    refine->mesh.reserve(nv, nf);
+    refine->vertices.reserve(nv);
+    refine->vertex_layer.reserve(nv);
+    refine->vertex_shift.reserve(nv);
+    // The successive-approximation state (28 bytes a vertex).
+    if (format.embedded) refine->geometry.reserve(nv);
+    if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
+      mesh.positions.reserve(nv);
+      mesh.triangles.reserve(nf);
+    }
+  }
+
   uint64_t consumed_end() const {
     if (!index) return 0;
     if (records_done == 0) return index->payload_offset;
@@ -245,28 +280,10 @@ struct IncrementalDecoder::State {
       if (!state) return where(state.error());
       refine = std::move(*state);
       refine->format = format;
-      // Reserve for the final size, but never more than the bytes received
-      // so far could describe (every inserted vertex costs well over a bit):
-      // neither a hostile header nor a hostile index (records claiming a
-      // gigabyte each that never come) can make us allocate gigabytes. A
-      // whole stream fed at once still reserves its final size; a streamed
-      // one grows as records arrive.
-      const uint64_t received = std::min<uint64_t>(index->total_bytes(), stream_pos);
-      const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * received;
-      const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
-      const uint32_t nf = static_cast<uint32_t>(
-          std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
-      refine->mesh.reserve(nv, nf);
-      refine->vertices.reserve(nv);
-      refine->vertex_layer.reserve(nv);
-      refine->vertex_shift.reserve(nv);
-      // The successive-approximation state (28 bytes a vertex): growing it
-      // by doubling copied it about twice over and faulted in fresh pages.
-      if (format.embedded) refine->geometry.reserve(nv);
       mesh = Mesh{};
+      reserved_vertices = 0;
+      reserve_for_received();
       if (upkeep == DecodedMeshUpkeep::kEveryRecord) {
-        mesh.positions.reserve(nv);
-        mesh.triangles.reserve(nf);
         mesh.positions.resize(base->positions.size());
         for (size_t v = 0; v < base->positions.size(); ++v) {
           mesh.positions[v] = grid.dequantize(refine->mesh.positions()[v]);
@@ -370,6 +387,7 @@ Result<uint32_t> IncrementalDecoder::feed(std::span<const uint8_t> bytes) {
     }
   }
 
+  if (s.refine) s.reserve_for_received();
   uint32_t applied = 0;
   size_t drop = 0;  // buffer bytes before the next record
   while (s.records_done < s.index->records.size()) {
