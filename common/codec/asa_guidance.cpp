@@ -557,6 +557,8 @@ Result<AsaGuidance> measure_asa_guidance(const Mesh& original, std::span<const u
       break;
     const auto group_start = std::chrono::steady_clock::now();
     const uint64_t end = records[p.measured].offset + records[p.measured].size;
+    // Reserved for this prefix, not the stream: the finer ones may go unmeasured.
+    decoder.expect_prefix(end);
     auto applied = decoder.feed(stream.subspan(fed, end - fed));
     if (!applied) return tl::unexpected(applied.error());
     fed = end;

@@ -918,9 +918,9 @@ Result<std::vector<uint8_t>> add_attribute_records(const AttributePlan& plan, co
   const uint32_t base_n = idx.records[0].vertices;
   // The decoder's base and final meshes, as it will hold them.
   IncrementalDecoder base_decoder;
-  if (auto f = base_decoder.feed(stream.subspan(0, idx.records[0].offset + idx.records[0].size));
-      !f)
-    return tl::unexpected(f.error());
+  const uint64_t base_end = idx.records[0].offset + idx.records[0].size;
+  base_decoder.expect_prefix(base_end);
+  if (auto f = base_decoder.feed(stream.subspan(0, base_end)); !f) return tl::unexpected(f.error());
   // The base as the decoder's state holds it after record 0: coarse
   // positions q >> b at the middle of their unknown low bits.
   const int quant_bits = idx.header.quant_bits;

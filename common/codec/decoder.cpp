@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
+#include <utility>
 
 #include "common/codec/attribute_codec.h"
 #include "common/codec/base_coder.h"
@@ -59,28 +61,43 @@ struct IncrementalDecoder::State {
   std::vector<uint32_t> texture_level;
   std::vector<bool> texture_original;
 
-  uint32_t reserved_vertices = 0;  // the vertex count the arrays were last reserved for
+  uint32_t reserved_vertices = 0;    // the vertex count the arrays were last reserved for
+  uint64_t prefix_end = UINT64_MAX;  // the caller feeds no bytes past this (expect_prefix)
 
-  // Reserves the per-vertex and per-face arrays for the final size, but
-  // never more than the bytes received so far could describe (every
-  // inserted vertex costs well over a bit): neither a hostile header nor a
-  // hostile index (records claiming a gigabyte each that never come) can
-  // make us allocate gigabytes. A whole stream fed at once reserves its
-  // final size with the base. A streamed one reserves again as its bytes
-  // arrive (feed), in steps of at least twice the last one or straight to
-  // the final size, instead of letting every array grow by doubling: that
-  // copied them about twice over and faulted in their pages twice, work an
-  // offline decode never does.
+  // The counts after the last record that ends within the caller's prefix
+  // (expect_prefix): the whole stream's unless one was set.
+  std::pair<uint32_t, uint32_t> final_counts() const {
+    const StreamHeader& h = index->header;
+    if (prefix_end >= index->total_bytes()) return {h.vertex_count, h.face_count};
+    const auto& records = index->records;
+    const auto after = std::upper_bound(
+        records.begin(), records.end(), prefix_end,
+        [](uint64_t end, const RecordEntry& r) { return end < r.offset + r.size; });
+    if (after == records.begin()) return {h.base_vertex_count, h.base_face_count};
+    return {std::prev(after)->vertices, std::prev(after)->faces};
+  }
+
+  // Reserves the per-vertex and per-face arrays for the final size (of the
+  // caller's prefix, expect_prefix), but never more than the bytes received
+  // so far could describe (every inserted vertex costs well over a bit):
+  // neither a hostile header nor a hostile index (records claiming a
+  // gigabyte each that never come) can make us allocate gigabytes. A whole
+  // stream fed at once reserves its final size with the base. A streamed
+  // one reserves again as its bytes arrive (feed), in steps of at least
+  // twice the last one or straight to the final size, instead of letting
+  // every array grow by doubling: that copied them about twice over and
+  // faulted in their pages twice, work an offline decode never does.
   void reserve_for_received() {
     const StreamHeader& h = index->header;
+    const auto [final_vertices, final_faces] = final_counts();
     const uint64_t received = std::min<uint64_t>(index->total_bytes(), stream_pos);
     const uint64_t plausible = uint64_t(h.base_vertex_count) + 8 * received;
-    const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(h.vertex_count, plausible));
+    const uint32_t nv = static_cast<uint32_t>(std::min<uint64_t>(final_vertices, plausible));
     if (nv <= reserved_vertices ||
-        (nv < h.vertex_count && uint64_t(nv) < 2 * uint64_t(reserved_vertices)))
+        (nv < final_vertices && uint64_t(nv) < 2 * uint64_t(reserved_vertices)))
       return;
     const uint32_t nf =
-        static_cast<uint32_t>(std::min<uint64_t>(h.face_count, 2 * plausible + h.base_face_count));
+        static_cast<uint32_t>(std::min<uint64_t>(final_faces, 2 * plausible + h.base_face_count));
     reserved_vertices = nv;
     refine->mesh.reserve(nv, nf);
     refine->vertices.reserve(nv);
@@ -429,6 +446,8 @@ const StreamIndex* IncrementalDecoder::index() const {
 }
 uint32_t IncrementalDecoder::records_decoded() const { return state_->records_done; }
 uint64_t IncrementalDecoder::resume_offset() const { return state_->consumed_end(); }
+
+void IncrementalDecoder::expect_prefix(uint64_t end) { state_->prefix_end = end; }
 bool IncrementalDecoder::finished() const {
   return state_->index && state_->records_done == state_->index->records.size();
 }

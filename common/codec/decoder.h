@@ -110,6 +110,11 @@ class IncrementalDecoder {
   // (a checksum failure is recoverable). Returns 1.
   Result<uint32_t> feed_record(uint32_t record, std::span<const uint8_t> bytes);
 
+  // The caller feeds no bytes past `end` (a prefix it measures, the base
+  // alone): the arrays are reserved for the records that end within it, not
+  // for the whole stream. Capacity only: bytes past it still decode.
+  void expect_prefix(uint64_t end);
+
   // Starts over from a resume offset: the caller feeds bytes starting at
   // `offset`, which must be a record boundary this decoder has reached.
   // Clears a recoverable error; any other error is returned again.

@@ -47,13 +47,19 @@ Result<std::vector<RdPoint>> RdMeasure::curve(std::span<const uint8_t> stream,
   const uint32_t n = std::max<uint32_t>(options_.budgets, 1);
   const double lo = std::log(options_.first_fraction * double(reference_bytes));
   const double hi = std::log(options_.last_fraction * double(reference_bytes));
-  IncrementalDecoder decoder;
-  uint64_t fed = 0;
-  for (uint32_t i = 0; i < n; ++i) {
+  auto point_at = [&](uint32_t i) {
     RdPoint p;
     p.budget = static_cast<uint64_t>(std::exp(n == 1 ? hi : lo + (hi - lo) * i / (n - 1)));
     const double within = std::max(0.0, double(p.budget) - double(index_shortfall));
     p.bytes = prefix_for_budget(*index, DecodeBudget{DecodeBudget::Kind::kBytes, within});
+    return p;
+  };
+  IncrementalDecoder decoder;
+  // The largest prefix measured, not the stream, is what the decoder holds.
+  decoder.expect_prefix(point_at(n - 1).bytes);
+  uint64_t fed = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    RdPoint p = point_at(i);
     if (p.bytes > fed) {
       auto applied = decoder.feed(stream.subspan(fed, p.bytes - fed));
       if (!applied) return tl::unexpected(applied.error());
