@@ -72,44 +72,51 @@ uint32_t score_patch_starts_raw(const EditableMesh& mesh, uint32_t apex,
   const uint32_t faces = static_cast<uint32_t>(used.size());
   const uint32_t fan = k - 2;
   const bool boundary = mesh.is_boundary(apex);
-  scratch.best = 0;
-  scratch.second = -1;
-  if (k < 3 || k > kMaxInsertedValence || faces == 0 || (!boundary && fan + 1 > faces) ||
-      (boundary && fan > faces))
-    return 0;
-  if (k > 3) {
-    apex_edge_lengths(mesh, apex, star_ring, faces, scratch);
-    return score_runs_from_edges(used.data(), faces, boundary, k, scratch);
-  }
-  // k = 3: the edge opposite the apex.
+  if (k < 3 || faces == 0 || (!boundary && fan + 1 > faces) || (boundary && fan > faces)) return 0;
   const Vec3i* p = mesh.positions().data();
   auto l2 = [&](uint32_t a, uint32_t b) {
     const int64_t dx = int64_t(p[a].x) - p[b].x, dy = int64_t(p[a].y) - p[b].y,
                   dz = int64_t(p[a].z) - p[b].z;
     return dx * dx + dy * dy + dz * dz;
   };
+  int64_t* edge = scratch.edge;
   int64_t* score = scratch.score;
   uint32_t* out = scratch.start;
-  uint32_t n = 0, best = 0;
-  int64_t best_score = -1, second = -1;
+  uint32_t n = 0;
   const uint32_t last_start = boundary ? faces - fan : faces - 1;
   const size_t ring_n = star_ring.size();
-  for (uint32_t r = 0; r <= last_start; ++r) {
-    if (used[r]) continue;
-    const uint32_t b = r + 1 < ring_n ? r + 1 : 0;
-    const int64_t sc = l2(star_ring[r], star_ring[b]);
-    if (sc > best_score) {
-      second = best_score;
-      best_score = sc;
-      best = n;
-    } else if (sc > second) {
-      second = sc;
+  if (k == 3) {
+    for (uint32_t r = 0; r <= last_start; ++r) {
+      if (used[r]) continue;
+      const uint32_t b = r + 1 < ring_n ? r + 1 : 0;
+      score[n] = l2(star_ring[r], star_ring[b]);
+      out[n++] = r;
     }
-    score[n] = sc;
-    out[n++] = r;
+  } else {
+    // Squared apex edge lengths, then a sliding sum over the k-3 diagonals
+    // of each run (ring entries r+1 .. r+k-3). Indices past the last face
+    // wrap to the start: `edge` holds the first `fan` lengths again after
+    // the last (room for 2 * faces), and `used` is read through a wrapped
+    // index only at the run's far end.
+    for (uint32_t i = 0; i < faces; ++i) edge[i] = l2(apex, star_ring[i]);
+    for (uint32_t i = 0; i < fan; ++i) edge[faces + i] = edge[i];
+    int64_t window = 0;
+    for (uint32_t j = 1; j < fan; ++j) window += edge[j];
+    uint32_t used_in_run = 0;
+    for (uint32_t j = 0; j < fan; ++j) used_in_run += used[j];
+    uint32_t far = fan < faces ? fan : 0;  // (r + fan) wrapped, maintained without division
+    for (uint32_t r = 0; r <= last_start; ++r) {
+      if (used_in_run == 0) {
+        score[n] = window;
+        out[n++] = r;
+      }
+      // Slide the run one face on: drop face r and diagonal r+1, add the next.
+      window += edge[r + fan] - edge[r + 1];
+      used_in_run += used[far];
+      used_in_run -= used[r];
+      if (++far == faces) far = 0;
+    }
   }
-  scratch.best = best;
-  scratch.second = second;
   return n;
 }
 

@@ -10,9 +10,7 @@
 
 #include "common/codec/editable_mesh.h"
 #include "common/codec/embedded_geometry.h"
-#include "common/codec/range_coder.h"
 #include "common/codec/refinement_state.h"
-#include "common/codec/stream_format.h"
 
 namespace meshstream {
 
@@ -97,9 +95,6 @@ struct StartScratch {
   int64_t* edge = edge_small;
   int64_t* score = score_small;
   uint32_t* start = start_small;
-  // Set by the scoring: the index of rank 0 and the runner-up's score.
-  uint32_t best = 0;
-  int64_t second = -1;
   StartScratch() = default;
   explicit StartScratch(uint32_t faces) { prepare(faces); }
   StartScratch(const StartScratch&) = delete;
@@ -126,79 +121,11 @@ struct StartScratch {
 // scratch.start, with their scores in scratch.score (score[i] belongs to
 // start[i]), unsorted; returns their number. The scratch is prepared for
 // used.size() faces. Raw arrays: a push_back per candidate cost more than
-// the scoring of it. Also sets scratch.best (the index of the first of the
-// largest scores: the stable sort's rank 0) and scratch.second (the
-// largest score of the others, -1 when there is none).
+// the scoring of it.
 uint32_t score_patch_starts_raw(const EditableMesh& mesh, uint32_t apex,
                                 const std::vector<uint32_t>& star_ring,
                                 const std::vector<uint8_t>& used, uint32_t k,
                                 StartScratch& scratch);
-
-// The squared lengths of the apex's edges to star ring entries 0 ..
-// faces - 1 into scratch.edge, then the first min(faces, 14) again (a run's
-// diagonals are read past the last face without a wrap test): what every
-// k >= 4 score sums. The decoder computes them once per apex for all its
-// patches. O(faces).
-MESHSTREAM_DECODE_INLINE void apex_edge_lengths(const EditableMesh& mesh, uint32_t apex,
-                                                const std::vector<uint32_t>& star_ring,
-                                                uint32_t faces, StartScratch& scratch) {
-  const Vec3i* p = mesh.positions().data();
-  const Vec3i a = p[apex];
-  const int64_t ax = a.x, ay = a.y, az = a.z;
-  const uint32_t* ring = star_ring.data();
-  int64_t* edge = scratch.edge;
-  for (uint32_t i = 0; i < faces; ++i) {
-    const Vec3i b = p[ring[i]];
-    const int64_t dx = ax - b.x, dy = ay - b.y, dz = az - b.z;
-    edge[i] = dx * dx + dy * dy + dz * dz;
-  }
-  const uint32_t wrap = faces < kMaxInsertedValence - 2 ? faces : kMaxInsertedValence - 2;
-  for (uint32_t i = 0; i < wrap; ++i) edge[faces + i] = edge[i];
-}
-
-// score_patch_starts_raw for k >= 4 from the apex's edge lengths
-// (apex_edge_lengths, same scratch): a sliding sum over the k-3 diagonals
-// of each run (ring entries r+1 .. r+k-3), the best and second best kept on
-// the way. `used` is read through a wrapped index only at the run's far end.
-MESHSTREAM_DECODE_INLINE uint32_t score_runs_from_edges(const uint8_t* used, uint32_t faces,
-                                                        bool boundary, uint32_t k,
-                                                        StartScratch& scratch) {
-  const uint32_t fan = k - 2;
-  const int64_t* edge = scratch.edge;
-  int64_t* score = scratch.score;
-  uint32_t* out = scratch.start;
-  const uint32_t last_start = boundary ? faces - fan : faces - 1;
-  int64_t window = 0;
-  for (uint32_t j = 1; j < fan; ++j) window += edge[j];
-  uint32_t used_in_run = 0;
-  for (uint32_t j = 0; j < fan; ++j) used_in_run += used[j];
-  uint32_t far = fan < faces ? fan : 0;  // (r + fan) wrapped, maintained without division
-  uint32_t n = 0, best = 0;
-  int64_t best_score = -1, second = -1;
-  for (uint32_t r = 0; r <= last_start; ++r) {
-    if (used_in_run == 0) {
-      // Strictly larger wins: ties keep the smaller r, as the stable sort.
-      if (window > best_score) {
-        second = best_score;
-        best_score = window;
-        best = n;
-      } else if (window > second) {
-        second = window;
-      }
-      score[n] = window;
-      out[n++] = r;
-    }
-    // Slide the run one face on: drop face r and diagonal r+1, add the next.
-    window += edge[r + fan] - edge[r + 1];
-    used_in_run += used[far];
-    used_in_run -= used[r];
-    if (++far == faces) far = 0;
-  }
-  scratch.best = best;
-  scratch.second = second;
-  return n;
-}
-
 // Larger score first, ties by r (stable insertion sort: runs are few).
 inline void sort_patch_starts(uint32_t* out, size_t n, int64_t* score) {
   for (size_t i = 1; i < n; ++i) {

@@ -22,37 +22,35 @@ Status bad(const std::string& what) { return make_error(ErrorCode::kCorrupt, wha
 // Format 3's decoder side of the start: the candidates are scored first
 // (their number and the lead of the best score are the rank's context),
 // then the rank is read (nothing for a single candidate) and its start
-// picked: the best is known from the scoring, others need the sort. The
-// apex's edge lengths are computed for its first patch of k >= 4 and kept
-// for the others (`edges_ready`). kNone when the rank is out of range or
-// the run cannot fit.
+// picked, the best by a linear scan. kNone when the rank is out of range.
 template <class DecodeRank>
 MESHSTREAM_DECODE_INLINE uint32_t score_then_select_patch_start(
     const EditableMesh& mesh, uint32_t apex, const std::vector<uint32_t>& star_ring,
-    const std::vector<uint8_t>& used, uint32_t k, bool& edges_ready, StartScratch& scratch,
-    DecodeRank&& decode_rank, uint32_t& rank) {
-  const uint32_t faces = static_cast<uint32_t>(used.size());
-  const uint32_t fan = k - 2;
-  const bool boundary = mesh.is_boundary(apex);
-  rank = 0;
-  size_t n = 0;
-  if (k > 3 && k <= kMaxInsertedValence && (boundary ? fan <= faces : fan + 1 <= faces)) {
-    if (!edges_ready) {
-      scratch.prepare(faces);
-      apex_edge_lengths(mesh, apex, star_ring, faces, scratch);
-      edges_ready = true;
-    }
-    n = score_runs_from_edges(used.data(), faces, boundary, k, scratch);
-  } else if (k == 3) {
-    // Rare: its own scores, which overwrite no edge lengths.
-    scratch.prepare(faces);
-    n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
+    const std::vector<uint8_t>& used, uint32_t k, StartScratch& scratch, DecodeRank&& decode_rank,
+    uint32_t& rank) {
+  scratch.prepare(static_cast<uint32_t>(used.size()));
+  const size_t n = score_patch_starts_raw(mesh, apex, star_ring, used, k, scratch);
+  const uint32_t* starts = scratch.start;
+  if (n == 0) {
+    rank = 0;
+    return kNone;
   }
-  if (n == 0) return kNone;
-  const int64_t best = scratch.score[scratch.best];
-  rank = n > 1 ? decode_rank(start_rank_context(k, n, best, scratch.second)) : 0;
+  // The best (first of the largest: ties keep the smaller r, as the stable
+  // sort orders them) and the second best score.
+  size_t best = 0;
+  int64_t second = -1;
+  for (size_t i = 1; i < n; ++i) {
+    const int64_t sc = scratch.score[i];
+    if (sc > scratch.score[best]) {
+      second = scratch.score[best];
+      best = i;
+    } else if (sc > second) {
+      second = sc;
+    }
+  }
+  rank = n > 1 ? decode_rank(start_rank_context(k, n, scratch.score[best], second)) : 0;
   if (rank >= n) return kNone;
-  if (rank == 0) return scratch.start[scratch.best];
+  if (rank == 0) return starts[best];
   sort_patch_starts(scratch.start, n, scratch.score);
   return scratch.start[rank];
 }
@@ -121,7 +119,6 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
     }
     state.last_count = count;
     if (count == 0) continue;
-    bool edges_ready = false;
     mesh.star(u, star_ring, star_corners);
     // Positions (patch scores), start corners (insert_vertex) and entries
     // (apply_patch) of the ring are read after some bits are decoded: ask
@@ -175,7 +172,7 @@ Status decode_structure_block(RefinementState& state, std::span<const uint8_t> b
         r = select_patch_start(mesh, u, star_ring, used_faces, k, rank, candidates);
       } else {
         r = score_then_select_patch_start(
-            mesh, u, star_ring, used_faces, k, edges_ready, start_scratch,
+            mesh, u, star_ring, used_faces, k, start_scratch,
             [&](uint32_t context) __attribute__((always_inline)) {
               return decode_start_rank_in_context_inline(m, dec, context);
             },
