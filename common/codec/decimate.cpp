@@ -5,6 +5,8 @@
 #include <cmath>
 #include <thread>
 
+#include "common/base/parallel_blocks.h"
+
 namespace meshstream {
 namespace {
 
@@ -368,30 +370,52 @@ uint32_t base_target(uint32_t vertices, const DecimateOptions& options) {
 namespace {
 
 // The removal cost of every live vertex (cost[v]; negative: not
-// removable), on `threads` threads over interleaved blocks of vertex ids.
-// The costs only read the mesh and the quadrics, so every thread sees the
-// same state and the result does not depend on the thread count. (Keeping
-// the costs of vertices no removal touched does not pay: a layer removes
-// about 15 % of the vertices, and their 2-rings, which a cost reads, cover
-// nearly the whole mesh.)
+// removable) and the apex it was priced with, on `threads` threads over
+// blocks of vertex ids handed out one at a time (a thread that gets less
+// of a core under load takes fewer). The costs only read the mesh and the
+// quadrics, so every thread sees the same state and the result does not
+// depend on the thread count. (Keeping the costs of vertices no removal
+// touched does not pay: a layer removes about 15 % of the vertices, and
+// their 2-rings, which a cost reads, cover nearly the whole mesh.)
 void update_costs(EditableMesh& mesh, QuadricField& field, const std::vector<uint8_t>& alive,
                   std::vector<double>& cost, std::vector<uint8_t>& apex, unsigned threads) {
   const uint32_t n = mesh.vertex_count();
   constexpr uint32_t kBlock = 4096;
-  const unsigned count = std::clamp<unsigned>((n + kBlock - 1) / kBlock, 1, std::max(threads, 1u));
-  auto work = [&](unsigned t) {
+  for_each_block((n + kBlock - 1) / kBlock, threads, [&](size_t b) {
     LayerBuilder builder(mesh, field);
-    for (uint32_t first = t * kBlock; first < n; first += count * kBlock) {
-      const uint32_t last = std::min(n, first + kBlock);
-      for (uint32_t v = first; v < last; ++v) {
-        if (alive[v]) cost[v] = builder.cost(v, apex[v]);
-      }
+    const uint32_t first = static_cast<uint32_t>(b) * kBlock;
+    const uint32_t last = std::min(n, first + kBlock);
+    for (uint32_t v = first; v < last; ++v) {
+      if (alive[v]) cost[v] = builder.cost(v, apex[v]);
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < count; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (std::thread& th : pool) th.join();
+  });
+}
+
+bool cheaper(const Candidate& a, const Candidate& b) {
+  return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
+}
+
+// Sorts the `m` cheapest candidates into candidates[0, m) (the rest stay
+// unsorted behind them): the same as a full sort's first m, since no two
+// candidates tie (vertex ids differ). Two selections split them into
+// halves that sort on their own threads; a full sort was 5 % of the
+// decimation, all of it on one core.
+void sort_cheapest(std::vector<Candidate>& candidates, size_t m, unsigned threads) {
+  const auto begin = candidates.begin();
+  if (m < candidates.size()) std::nth_element(begin, begin + m, candidates.end(), cheaper);
+  constexpr size_t kMinHalf = 8192;
+  if (threads < 2 || m < 2 * kMinHalf) {
+    std::sort(begin, begin + m, cheaper);
+    return;
+  }
+  const size_t half = m / 2;
+  std::nth_element(begin, begin + half, begin + m, cheaper);
+  for_each_block(2, threads, [&](size_t b) {
+    if (b == 0)
+      std::sort(begin, begin + half, cheaper);
+    else
+      std::sort(begin + half, begin + m, cheaper);
+  });
 }
 
 }  // namespace
@@ -425,14 +449,14 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
                           (v < layer_locked.size() && layer_locked[v] != 0);
       if (alive[v] && cost[v] >= 0 && !locked) candidates.push_back({cost[v], v});
     }
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-      return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
-    });
     std::fill(marks.begin(), marks.end(), 0);
     DecimationLayer layer;
     // The cheapest share first; all candidates when none of those is removable.
     const size_t share = static_cast<size_t>(options.candidate_share * double(candidates.size()));
-    for (size_t limit : {std::max<size_t>(share, 1), candidates.size()}) {
+    const size_t first = std::min(std::max<size_t>(share, 1), candidates.size());
+    sort_cheapest(candidates, first, threads);
+    for (size_t limit : {first, candidates.size()}) {
+      if (limit > first) std::sort(candidates.begin() + first, candidates.end(), cheaper);
       for (size_t i = 0; i < limit && i < candidates.size(); ++i) {
         if (alive_count - layer.removals.size() <= target) break;
         const uint32_t v = candidates[i].vertex;
