@@ -74,11 +74,17 @@ struct Quadric {
   }
 };
 
-// decimate_layers' per-layer vertex marks: removed or in a removed
-// vertex's ring (so not removable in this layer), and got a new edge or
-// face in this layer (LayerBuilder::planned_apex).
+// decimate_layers' per-layer vertex marks, one byte a vertex: removed or
+// in a removed vertex's ring (so not removable in this layer); got a new
+// edge or face in this layer; and in the high bits the index into the
+// vertex's ring of the apex that priced it at the layer's start
+// (LayerBuilder::planned_apex). One byte, not two: the decimation's arrays
+// are part of the encoder's peak.
 constexpr uint8_t kBlocked = 1;
 constexpr uint8_t kTouched = 2;
+constexpr int kApexShift = 4;
+static_assert(kMaxRemovalValence <= (1u << (8 - kApexShift)));
+uint32_t planned_apex_of(uint8_t mark) { return mark >> kApexShift; }
 
 struct Candidate {
   double cost;
@@ -370,15 +376,16 @@ uint32_t base_target(uint32_t vertices, const DecimateOptions& options) {
 namespace {
 
 // The removal cost of every live vertex (cost[v]; negative: not
-// removable) and the apex it was priced with, on `threads` threads over
-// blocks of vertex ids handed out one at a time (a thread that gets less
-// of a core under load takes fewer). The costs only read the mesh and the
-// quadrics, so every thread sees the same state and the result does not
-// depend on the thread count. (Keeping the costs of vertices no removal
-// touched does not pay: a layer removes about 15 % of the vertices, and
-// their 2-rings, which a cost reads, cover nearly the whole mesh.)
+// removable) and the apex it was priced with (in marks[v], whose flags it
+// clears), on `threads` threads over blocks of vertex ids handed out one
+// at a time (a thread that gets less of a core under load takes fewer).
+// The costs only read the mesh and the quadrics, so every thread sees the
+// same state and the result does not depend on the thread count. (Keeping
+// the costs of vertices no removal touched does not pay: a layer removes
+// about 15 % of the vertices, and their 2-rings, which a cost reads, cover
+// nearly the whole mesh.)
 void update_costs(EditableMesh& mesh, QuadricField& field, const std::vector<uint8_t>& alive,
-                  std::vector<double>& cost, std::vector<uint8_t>& apex, unsigned threads) {
+                  std::vector<double>& cost, std::vector<uint8_t>& marks, unsigned threads) {
   const uint32_t n = mesh.vertex_count();
   constexpr uint32_t kBlock = 4096;
   for_each_block((n + kBlock - 1) / kBlock, threads, [&](size_t b) {
@@ -386,7 +393,9 @@ void update_costs(EditableMesh& mesh, QuadricField& field, const std::vector<uin
     const uint32_t first = static_cast<uint32_t>(b) * kBlock;
     const uint32_t last = std::min(n, first + kBlock);
     for (uint32_t v = first; v < last; ++v) {
-      if (alive[v]) cost[v] = builder.cost(v, apex[v]);
+      uint8_t apex = 0;
+      if (alive[v]) cost[v] = builder.cost(v, apex);
+      marks[v] = static_cast<uint8_t>(apex << kApexShift);  // and no flags yet
     }
   });
 }
@@ -423,9 +432,7 @@ void sort_cheapest(std::vector<Candidate>& candidates, size_t m, unsigned thread
 DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& options) {
   DecimationResult result;
   const uint32_t n = mesh.vertex_count();
-  // apex[v]: the index into v's ring of the apex that priced it at the
-  // layer's start (LayerBuilder::planned_apex).
-  std::vector<uint8_t> alive(n, 1), marks(n, 0), apex(n, 0);
+  std::vector<uint8_t> alive(n, 1), marks(n, 0);
   uint32_t alive_count = n;
   QuadricField field;
   LayerBuilder builder(mesh, field);
@@ -438,7 +445,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
   std::vector<Candidate> candidates;
   std::vector<uint8_t> layer_locked;
   while (alive_count > target && result.layers.size() < options.max_layers) {
-    update_costs(mesh, field, alive, cost, apex, threads);
+    update_costs(mesh, field, alive, cost, marks, threads);
     if (options.layer_locks) {
       layer_locked.assign(n, 0);
       options.layer_locks(static_cast<uint32_t>(result.layers.size()), mesh, layer_locked);
@@ -449,7 +456,6 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
                           (v < layer_locked.size() && layer_locked[v] != 0);
       if (alive[v] && cost[v] >= 0 && !locked) candidates.push_back({cost[v], v});
     }
-    std::fill(marks.begin(), marks.end(), 0);
     DecimationLayer layer;
     // The cheapest share first; all candidates when none of those is removable.
     const size_t share = static_cast<size_t>(options.candidate_share * double(candidates.size()));
@@ -462,7 +468,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
         const uint32_t v = candidates[i].vertex;
         if (marks[v] & kBlocked) continue;
         Removal r;
-        if (!builder.try_remove(v, apex[v], marks, r, layer.rings)) continue;
+        if (!builder.try_remove(v, planned_apex_of(marks[v]), marks, r, layer.rings)) continue;
         marks[v] |= kBlocked;
         for (uint32_t u : layer.ring(r)) marks[u] |= kBlocked;
         alive[v] = 0;
