@@ -5,6 +5,8 @@
 #include <cmath>
 #include <thread>
 
+#include "common/base/parallel_blocks.h"
+
 namespace meshstream {
 namespace {
 
@@ -72,6 +74,18 @@ struct Quadric {
   }
 };
 
+// decimate_layers' per-layer vertex marks, one byte a vertex: removed or
+// in a removed vertex's ring (so not removable in this layer); got a new
+// edge or face in this layer; and in the high bits the index into the
+// vertex's ring of the apex that priced it at the layer's start
+// (LayerBuilder::planned_apex). One byte, not two: the decimation's arrays
+// are part of the encoder's peak.
+constexpr uint8_t kBlocked = 1;
+constexpr uint8_t kTouched = 2;
+constexpr int kApexShift = 4;
+static_assert(kMaxRemovalValence <= (1u << (8 - kApexShift)));
+uint32_t planned_apex_of(uint8_t mark) { return mark >> kApexShift; }
+
 struct Candidate {
   double cost;
   uint32_t vertex;
@@ -124,10 +138,13 @@ class LayerBuilder {
   // or not, called vertices cheap whose only zero-error collapse makes an
   // existing edge or a flipped triangle (crank at 1/4 of its vertices: RMS
   // per vertex 4.6x meshopt's, 1.7x with this).
-  double cost(uint32_t v) {
+  // `apex` gets the index into v's ring of the apex that priced it.
+  double cost(uint32_t v, uint8_t& apex) {
     if (m_.is_isolated(v)) return -1;
     double error = 0;
-    if (best_apex(v, error) == kNone) return -1;
+    const uint32_t a = best_apex(v, error);
+    if (a == kNone) return -1;
+    apex = static_cast<uint8_t>(a);
     const size_t k = ring_.size();
     const auto& p = m_.positions();
     Vec3d centroid{};
@@ -252,23 +269,7 @@ class LayerBuilder {
       const double score = kShapeWeight * worst - apex_error;
       if (best_apex != kNone && score <= best_quality) continue;
       // Only an apex that would win pays for its star (the edge checks).
-      m_.star(apex, apex_ring_, apex_corners_);
-      if (k == 3 && !boundary) {
-        // The single new triangle must not already exist (a tetrahedron's
-        // last vertex): look for a face of the apex holding both others.
-        const uint32_t b = wrapped[a + 1], c = wrapped[a + 2];
-        for (uint32_t corner : apex_corners_) {
-          const uint32_t x = m_.vertex(EditableMesh::next(corner));
-          const uint32_t y = m_.vertex(EditableMesh::prev(corner));
-          if ((x == b && y == c) || (x == c && y == b)) ok = false;
-        }
-      } else {
-        for (uint32_t j = 2; j + 2 <= k && ok; ++j) {
-          const uint32_t w = wrapped[a + j];
-          if (std::find(apex_ring_.begin(), apex_ring_.end(), w) != apex_ring_.end()) ok = false;
-        }
-      }
-      if (!ok) continue;
+      if (!apex_edges_ok(v, a)) continue;
       best_quality = score;
       best_apex = a;
     }
@@ -276,14 +277,78 @@ class LayerBuilder {
     return best_apex;
   }
 
-  // Tries to remove v; returns true, fills `removal` and appends its ring
-  // (apex first) to `ring_pool` on success.
-  bool try_remove(uint32_t v, Removal& removal, std::vector<uint32_t>& ring_pool) {
+  // Whether the fan from apex a of v's ring (ring_, corners_ hold v's star)
+  // makes no existing edge (or, for an interior valence-3 v, no existing
+  // face) on the mesh as it is now.
+  bool apex_edges_ok(uint32_t v, uint32_t a) {
+    const uint32_t k = static_cast<uint32_t>(ring_.size());
+    const bool boundary = m_.is_boundary(v);
+    m_.star(ring_[a], apex_ring_, apex_corners_);
+    if (k == 3 && !boundary) {
+      const uint32_t b = ring_[(a + 1) % k], c = ring_[(a + 2) % k];
+      for (uint32_t corner : apex_corners_) {
+        const uint32_t x = m_.vertex(EditableMesh::next(corner));
+        const uint32_t y = m_.vertex(EditableMesh::prev(corner));
+        if ((x == b && y == c) || (x == c && y == b)) return false;
+      }
+      return true;
+    }
+    for (uint32_t j = 2; j + 2 <= k; ++j) {
+      const uint32_t w = ring_[(a + j) % k];
+      if (std::find(apex_ring_.begin(), apex_ring_.end(), w) != apex_ring_.end()) return false;
+    }
+    return true;
+  }
+
+  // best_apex(v) now, given `planned`, the apex it gave at the layer's
+  // start, and `marks` (kTouched: a vertex that got a new edge or face in
+  // this layer since then). While v is not blocked, its star, its ring's
+  // positions and its quadric are those of the layer's start: the removals
+  // since only add edges and faces among its ring vertices (what they
+  // delete holds a removed vertex, never in v's ring). So the apexes valid
+  // now are a subset of those valid then, and the planned apex, the first
+  // best of those, is still the first best while it stays valid. Only a
+  // touched vertex can have a new edge, so its checks are redone only where
+  // one could have changed; else best_apex runs again. Returns the same as
+  // best_apex (ring_, corners_ hold v's star).
+  uint32_t planned_apex(uint32_t v, uint32_t planned, const std::vector<uint8_t>& marks) {
+    m_.star(v, ring_, corners_);
+    const uint32_t k = static_cast<uint32_t>(ring_.size());
+    const bool boundary = m_.is_boundary(v);
+    if (planned >= k) {
+      double error = 0;
+      return best_apex(v, error);
+    }
+    if (boundary && (marks[ring_[k - 1]] & kTouched) && (marks[ring_[0]] & kTouched)) {
+      // The new boundary edge (ring[k-1], ring[0]) may exist now.
+      m_.star(ring_[k - 1], apex_ring_, apex_corners_);
+      if (std::find(apex_ring_.begin(), apex_ring_.end(), ring_[0]) != apex_ring_.end())
+        return kNone;
+    }
+    const bool recheck = (k == 3 && !boundary) || (marks[ring_[planned]] & kTouched);
+    if (!recheck || apex_edges_ok(v, planned)) return planned;
     double error = 0;
-    const uint32_t best_apex = this->best_apex(v, error);
+    return best_apex(v, error);
+  }
+
+  // Tries to remove v, whose layer-start apex is `planned` (see
+  // planned_apex); returns true, fills `removal`, appends its ring (apex
+  // first) to `ring_pool` and marks the vertices that get new edges or
+  // faces kTouched in `marks` on success.
+  bool try_remove(uint32_t v, uint32_t planned, std::vector<uint8_t>& marks, Removal& removal,
+                  std::vector<uint32_t>& ring_pool) {
+    const uint32_t best_apex = planned_apex(v, planned, marks);
     if (best_apex == kNone) return false;
     const uint32_t k = static_cast<uint32_t>(ring_.size());
     const bool boundary = m_.is_boundary(v);
+    // New edges join the apex to R_a+2 .. R_a+k-2; a boundary vertex's also
+    // (ring[k-1], ring[0]); a new face holds the apex.
+    marks[ring_[best_apex]] |= kTouched;
+    for (uint32_t j = 2; j + 2 <= k; ++j) marks[ring_[(best_apex + j) % k]] |= kTouched;
+    if (boundary) {
+      marks[ring_[k - 1]] |= kTouched;
+      marks[ring_[0]] |= kTouched;
+    }
     removal.vertex = v;
     removal.ring_first = static_cast<uint32_t>(ring_pool.size());
     removal.ring_size = static_cast<uint16_t>(k);
@@ -311,30 +376,55 @@ uint32_t base_target(uint32_t vertices, const DecimateOptions& options) {
 namespace {
 
 // The removal cost of every live vertex (cost[v]; negative: not
-// removable), on `threads` threads over interleaved blocks of vertex ids.
+// removable) and the apex it was priced with (in marks[v], whose flags it
+// clears), on `threads` threads over blocks of vertex ids handed out one
+// at a time (a thread that gets less of a core under load takes fewer).
 // The costs only read the mesh and the quadrics, so every thread sees the
 // same state and the result does not depend on the thread count. (Keeping
 // the costs of vertices no removal touched does not pay: a layer removes
 // about 15 % of the vertices, and their 2-rings, which a cost reads, cover
 // nearly the whole mesh.)
 void update_costs(EditableMesh& mesh, QuadricField& field, const std::vector<uint8_t>& alive,
-                  std::vector<double>& cost, unsigned threads) {
+                  std::vector<double>& cost, std::vector<uint8_t>& marks, unsigned threads) {
   const uint32_t n = mesh.vertex_count();
   constexpr uint32_t kBlock = 4096;
-  const unsigned count = std::clamp<unsigned>((n + kBlock - 1) / kBlock, 1, std::max(threads, 1u));
-  auto work = [&](unsigned t) {
+  for_each_block((n + kBlock - 1) / kBlock, threads, [&](size_t b) {
     LayerBuilder builder(mesh, field);
-    for (uint32_t first = t * kBlock; first < n; first += count * kBlock) {
-      const uint32_t last = std::min(n, first + kBlock);
-      for (uint32_t v = first; v < last; ++v) {
-        if (alive[v]) cost[v] = builder.cost(v);
-      }
+    const uint32_t first = static_cast<uint32_t>(b) * kBlock;
+    const uint32_t last = std::min(n, first + kBlock);
+    for (uint32_t v = first; v < last; ++v) {
+      uint8_t apex = 0;
+      if (alive[v]) cost[v] = builder.cost(v, apex);
+      marks[v] = static_cast<uint8_t>(apex << kApexShift);  // and no flags yet
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < count; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (std::thread& th : pool) th.join();
+  });
+}
+
+bool cheaper(const Candidate& a, const Candidate& b) {
+  return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
+}
+
+// Sorts the `m` cheapest candidates into candidates[0, m) (the rest stay
+// unsorted behind them): the same as a full sort's first m, since no two
+// candidates tie (vertex ids differ). Two selections split them into
+// halves that sort on their own threads; a full sort was 5 % of the
+// decimation, all of it on one core.
+void sort_cheapest(std::vector<Candidate>& candidates, size_t m, unsigned threads) {
+  const auto begin = candidates.begin();
+  if (m < candidates.size()) std::nth_element(begin, begin + m, candidates.end(), cheaper);
+  constexpr size_t kMinHalf = 8192;
+  if (threads < 2 || m < 2 * kMinHalf) {
+    std::sort(begin, begin + m, cheaper);
+    return;
+  }
+  const size_t half = m / 2;
+  std::nth_element(begin, begin + half, begin + m, cheaper);
+  for_each_block(2, threads, [&](size_t b) {
+    if (b == 0)
+      std::sort(begin, begin + half, cheaper);
+    else
+      std::sort(begin + half, begin + m, cheaper);
+  });
 }
 
 }  // namespace
@@ -342,7 +432,7 @@ void update_costs(EditableMesh& mesh, QuadricField& field, const std::vector<uin
 DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& options) {
   DecimationResult result;
   const uint32_t n = mesh.vertex_count();
-  std::vector<uint8_t> alive(n, 1), blocked(n, 0);
+  std::vector<uint8_t> alive(n, 1), marks(n, 0);
   uint32_t alive_count = n;
   QuadricField field;
   LayerBuilder builder(mesh, field);
@@ -355,7 +445,7 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
   std::vector<Candidate> candidates;
   std::vector<uint8_t> layer_locked;
   while (alive_count > target && result.layers.size() < options.max_layers) {
-    update_costs(mesh, field, alive, cost, threads);
+    update_costs(mesh, field, alive, cost, marks, threads);
     if (options.layer_locks) {
       layer_locked.assign(n, 0);
       options.layer_locks(static_cast<uint32_t>(result.layers.size()), mesh, layer_locked);
@@ -366,22 +456,21 @@ DecimationResult decimate_layers(EditableMesh mesh, const DecimateOptions& optio
                           (v < layer_locked.size() && layer_locked[v] != 0);
       if (alive[v] && cost[v] >= 0 && !locked) candidates.push_back({cost[v], v});
     }
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-      return a.cost < b.cost || (a.cost == b.cost && a.vertex < b.vertex);
-    });
-    std::fill(blocked.begin(), blocked.end(), 0);
     DecimationLayer layer;
     // The cheapest share first; all candidates when none of those is removable.
     const size_t share = static_cast<size_t>(options.candidate_share * double(candidates.size()));
-    for (size_t limit : {std::max<size_t>(share, 1), candidates.size()}) {
+    const size_t first = std::min(std::max<size_t>(share, 1), candidates.size());
+    sort_cheapest(candidates, first, threads);
+    for (size_t limit : {first, candidates.size()}) {
+      if (limit > first) std::sort(candidates.begin() + first, candidates.end(), cheaper);
       for (size_t i = 0; i < limit && i < candidates.size(); ++i) {
         if (alive_count - layer.removals.size() <= target) break;
         const uint32_t v = candidates[i].vertex;
-        if (blocked[v]) continue;
+        if (marks[v] & kBlocked) continue;
         Removal r;
-        if (!builder.try_remove(v, r, layer.rings)) continue;
-        blocked[v] = 1;
-        for (uint32_t u : layer.ring(r)) blocked[u] = 1;
+        if (!builder.try_remove(v, planned_apex_of(marks[v]), marks, r, layer.rings)) continue;
+        marks[v] |= kBlocked;
+        for (uint32_t u : layer.ring(r)) marks[u] |= kBlocked;
         alive[v] = 0;
         layer.removals.push_back(r);
       }

@@ -13,6 +13,7 @@
 
 #include "common/codec/encoder.h"
 #include "common/codec/quantize.h"
+#include "common/mesh/procedural.h"
 
 namespace meshstream {
 namespace {
@@ -223,4 +224,43 @@ TEST(Decimate, CandidateShareBoundsTheLayerSize) {
 }
 
 }  // namespace
+// The removals are the same whatever the thread count: the costs and the
+// sort of the cheapest candidates (split over threads above 16k of them)
+// run on the threads, the removals on the calling one. A flat-faced cube
+// (most costs tie at zero, so the vertex id orders them) and a curved
+// surface, both big enough for the split sort.
+TEST(Decimate, TheLayersAreTheSameForEveryThreadCount) {
+  for (const Mesh& mesh : {subdivided_cube(80), make_demo_mesh(80'000)}) {
+    ASSERT_GT(mesh.vertex_count(), 2u * 16384);
+    DecimateOptions one;
+    one.threads = 1;
+    const auto reference = decimate_on_grid(mesh, one);
+    ASSERT_TRUE(reference);
+    const DecimationResult& ref = reference->result;
+    ASSERT_GT(ref.layers.size(), 3u);
+    for (unsigned threads : {2u, 3u}) {
+      DecimateOptions options;
+      options.threads = threads;
+      const auto decimated = decimate_on_grid(mesh, options);
+      ASSERT_TRUE(decimated);
+      const DecimationResult& dec = decimated->result;
+      ASSERT_EQ(dec.layers.size(), ref.layers.size()) << threads << " threads";
+      for (size_t l = 0; l < ref.layers.size(); ++l) {
+        const DecimationLayer& a = ref.layers[l];
+        const DecimationLayer& b = dec.layers[l];
+        ASSERT_EQ(b.removals.size(), a.removals.size()) << "layer " << l;
+        for (size_t i = 0; i < a.removals.size(); ++i) {
+          EXPECT_EQ(b.removals[i].vertex, a.removals[i].vertex);
+          EXPECT_EQ(b.removals[i].ring_first, a.removals[i].ring_first);
+          EXPECT_EQ(b.removals[i].ring_size, a.removals[i].ring_size);
+          EXPECT_EQ(b.removals[i].open_edge, a.removals[i].open_edge);
+        }
+        EXPECT_EQ(b.rings, a.rings) << "layer " << l;
+      }
+      EXPECT_EQ(dec.base_vertices, ref.base_vertices);
+      EXPECT_EQ(dec.base_faces, ref.base_faces);
+    }
+  }
+}
+
 }  // namespace meshstream
